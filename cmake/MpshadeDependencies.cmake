@@ -1,0 +1,37 @@
+# Third-party dependencies, all from Debian 12 packages (see scripts/setup.sh and docs/building.md).
+find_package(glm CONFIG REQUIRED)
+find_package(TBB CONFIG REQUIRED)
+find_package(embree 3 CONFIG REQUIRED)
+find_package(nlohmann_json CONFIG REQUIRED)
+find_package(fmt CONFIG REQUIRED)
+find_package(CLI11 CONFIG REQUIRED)
+find_package(OpenImageIO CONFIG REQUIRED)
+
+# OpenImageIO's exported target names /usr/include/opencv4, which exists only when
+# libopencv-core-dev is installed; drop include directories that do not exist.
+get_target_property(_oiio_inc OpenImageIO::OpenImageIO INTERFACE_INCLUDE_DIRECTORIES)
+if(_oiio_inc)
+  set(_oiio_kept "")
+  foreach(_dir IN LISTS _oiio_inc)
+    if(_dir MATCHES "^\\$<" OR EXISTS "${_dir}")
+      list(APPEND _oiio_kept "${_dir}")
+    endif()
+  endforeach()
+  set_target_properties(OpenImageIO::OpenImageIO PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_oiio_kept}")
+endif()
+
+# OpenSubdiv's Debian CMake config names static libraries the package does not ship, so it
+# is found by hand. libosdCPU holds Far, Sdc, Vtr and Bfr.
+find_path(OPENSUBDIV_INCLUDE_DIR opensubdiv/version.h REQUIRED)
+find_library(OPENSUBDIV_CPU_LIBRARY osdCPU REQUIRED)
+add_library(mpshade::opensubdiv UNKNOWN IMPORTED)
+set_target_properties(mpshade::opensubdiv PROPERTIES
+  IMPORTED_LOCATION "${OPENSUBDIV_CPU_LIBRARY}"
+  INTERFACE_INCLUDE_DIRECTORIES "${OPENSUBDIV_INCLUDE_DIR}")
+
+if(MPSHADE_BUILD_TESTS)
+  find_package(GTest CONFIG REQUIRED)
+endif()
+if(MPSHADE_BUILD_BENCH)
+  find_package(benchmark CONFIG REQUIRED)
+endif()

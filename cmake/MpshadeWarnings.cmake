@@ -1,0 +1,23 @@
+# mpshade_target_defaults(target): warnings (errors with MPSHADE_WERROR), sanitizers with
+# MPSHADE_SANITIZE, and the include root so headers are named by module: "geometry/surface.h".
+function(mpshade_target_defaults target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wshadow=local -Wno-unused-parameter
+    # GCC 12 reports false -Wrestrict positives inside std::string at -O3 (GCC bug 105329).
+    -Wno-restrict)
+  if(MPSHADE_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  if(MPSHADE_SANITIZE)
+    target_compile_options(${target} PUBLIC -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+    target_link_options(${target} PUBLIC -fsanitize=address,undefined)
+  endif()
+endfunction()
+
+# mpshade_library(name SOURCES ... DEPS ...): one library per module folder.
+function(mpshade_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_library(${name} STATIC ${ARG_SOURCES})
+  target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  target_link_libraries(${name} PUBLIC ${ARG_DEPS})
+  mpshade_target_defaults(${name})
+endfunction()

@@ -1,0 +1,202 @@
+#include "geometry/ray_scene.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <xmmintrin.h>
+#include <pmmintrin.h>
+
+#include "geometry/error.h"
+
+namespace mpshade {
+namespace {
+
+void embreeError(void*, RTCError code, const char* message) {
+    std::fprintf(stderr, "mpshade: Embree error %d: %s\n", static_cast<int>(code),
+                 message ? message : "");
+}
+
+// Solves the 3x3 system [a b c] x = r by Cramer's rule; false when singular.
+bool solve3(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c, const glm::dvec3& r,
+            glm::dvec3& x) {
+    const double det = glm::dot(a, glm::cross(b, c));
+    const double scale = glm::length(a) * glm::length(b) * glm::length(c);
+    if (!(std::fabs(det) > 1e-10 * scale)) return false;
+    x.x = glm::dot(r, glm::cross(b, c)) / det;
+    x.y = glm::dot(a, glm::cross(r, c)) / det;
+    x.z = glm::dot(a, glm::cross(b, r)) / det;
+    return true;
+}
+
+}  // namespace
+
+RTCDevice embreeDevice() {
+    static RTCDevice device = [] {
+        RTCDevice d = rtcNewDevice(nullptr);
+        MPSHADE_CHECK(d != nullptr);
+        rtcSetDeviceErrorFunction(d, embreeError, nullptr);
+        return d;
+    }();
+    return device;
+}
+
+void enableFlushToZero() {
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+SurfaceRayScene::SurfaceRayScene(const Surface& surface) : surface_(surface) {
+    RTCDevice device = embreeDevice();
+    scene_ = rtcNewScene(device);
+    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+
+    if (const auto* cloud = std::get_if<PointCloud>(&surface)) {
+        RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
+        const size_t n = cloud->centers.size();
+        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
+        auto* nb = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geom, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n));
+        for (size_t k = 0; k < n; ++k) {
+            v[4 * k + 0] = cloud->centers[k].x;
+            v[4 * k + 1] = cloud->centers[k].y;
+            v[4 * k + 2] = cloud->centers[k].z;
+            v[4 * k + 3] = cloud->radii[k];
+            nb[3 * k + 0] = cloud->normals[k].x;
+            nb[3 * k + 1] = cloud->normals[k].y;
+            nb[3 * k + 2] = cloud->normals[k].z;
+        }
+        rtcCommitGeometry(geom);
+        discGeom_ = rtcAttachGeometry(scene_, geom);
+        rtcReleaseGeometry(geom);
+    } else {
+        // A grid of (rate + 1)^2 exact surface points per chart, two triangles per cell.
+        std::vector<float> positions;
+        const int charts = chartCount(surface);
+        for (int chart = 0; chart < charts; ++chart) {
+            const int rate = std::visit([&](const auto& s) { return s.tessellationRate(chart); },
+                                        surface);
+            const unsigned base = static_cast<unsigned>(vertexUV_.size() / 2);
+            for (int j = 0; j <= rate; ++j) {
+                for (int i = 0; i <= rate; ++i) {
+                    const float u = static_cast<float>(i) / rate, v = static_cast<float>(j) / rate;
+                    const glm::vec3 p = evaluate(surface, {chart, u, v}).P;
+                    positions.insert(positions.end(), {p.x, p.y, p.z});
+                    vertexUV_.insert(vertexUV_.end(), {u, v});
+                }
+            }
+            const unsigned row = static_cast<unsigned>(rate + 1);
+            for (unsigned j = 0; j < static_cast<unsigned>(rate); ++j) {
+                for (unsigned i = 0; i < static_cast<unsigned>(rate); ++i) {
+                    const unsigned a = base + j * row + i, b = a + 1, c = a + row + 1, d = a + row;
+                    triIndex_.insert(triIndex_.end(), {a, b, c, a, c, d});
+                    triChart_.insert(triChart_.end(), {chart, chart});
+                }
+            }
+        }
+        RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        const size_t nv = positions.size() / 3, nt = triChart_.size();
+        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+            geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+        std::copy(positions.begin(), positions.end(), vb);
+        auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+            geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt));
+        std::copy(triIndex_.begin(), triIndex_.end(), ib);
+        rtcCommitGeometry(geom);
+        triGeom_ = rtcAttachGeometry(scene_, geom);
+        rtcReleaseGeometry(geom);
+    }
+    rtcCommitScene(scene_);
+}
+
+SurfaceRayScene::~SurfaceRayScene() { rtcReleaseScene(scene_); }
+
+bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, float bv,
+                                 float tHit, const glm::vec3& org, const glm::vec3& dir,
+                                 SurfaceHit& hit) const {
+    if (geomID == discGeom_) {
+        const auto& cloud = std::get<PointCloud>(surface_);
+        hit.at = cloud.chartPointOf(static_cast<int>(primID), org + tHit * dir);
+        hit.t = tHit;
+        hit.refined = true;  // a disc is flat: the Embree hit is exact
+        return true;
+    }
+    const unsigned* tri = &triIndex_[3 * static_cast<size_t>(primID)];
+    const float w0 = 1.0f - bu - bv;
+    ChartPoint at{triChart_[primID],
+                  w0 * vertexUV_[2 * tri[0]] + bu * vertexUV_[2 * tri[1]] + bv * vertexUV_[2 * tri[2]],
+                  w0 * vertexUV_[2 * tri[0] + 1] + bu * vertexUV_[2 * tri[1] + 1] +
+                      bv * vertexUV_[2 * tri[2] + 1]};
+    at.u = std::fmin(std::fmax(at.u, 0.0f), 1.0f);
+    at.v = std::fmin(std::fmax(at.v, 0.0f), 1.0f);
+
+    // Newton iteration on F(u, v, t) = P(u, v) - (org + t dir) = 0, in double precision.
+    const glm::dvec3 o(org), d(dir);
+    double u = at.u, v = at.v, t = tHit;
+    bool converged = false;
+    for (int iter = 0; iter < 8; ++iter) {
+        const SurfaceSample s = evaluate(surface_, {at.chart, static_cast<float>(u), static_cast<float>(v)});
+        const glm::dvec3 residual = glm::dvec3(s.P) - (o + t * d);
+        const double scale = std::fmax(glm::length(glm::dvec3(s.P)), 1e-30) + std::fabs(t) * glm::length(d);
+        if (glm::length(residual) <= 2e-7 * scale) {
+            converged = true;
+            break;
+        }
+        glm::dvec3 step;
+        if (!solve3(glm::dvec3(s.dPdu), glm::dvec3(s.dPdv), -d, -residual, step)) break;
+        u += step.x;
+        v += step.y;
+        t += step.z;
+        // Leaving the chart means the true hit belongs to a neighbour: keep the
+        // tessellation's answer rather than extrapolate.
+        if (u < -1e-4 || u > 1.0 + 1e-4 || v < -1e-4 || v > 1.0 + 1e-4 || !std::isfinite(t)) break;
+        u = std::fmin(std::fmax(u, 0.0), 1.0);
+        v = std::fmin(std::fmax(v, 0.0), 1.0);
+    }
+    if (converged) {
+        hit.at = {at.chart, static_cast<float>(u), static_cast<float>(v)};
+        hit.t = static_cast<float>(t);
+        hit.refined = true;
+    } else {
+        // Keep the tessellation's chart point and put the hit on the surface there.
+        const glm::vec3 p = evaluate(surface_, at).P;
+        hit.at = at;
+        hit.t = glm::dot(p - org, dir) / glm::dot(dir, dir);
+        hit.refined = false;
+    }
+    return std::isfinite(hit.t);
+}
+
+bool SurfaceRayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tnear,
+                                float tfar, SurfaceHit& hit) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh{};
+    rh.ray.org_x = org.x, rh.ray.org_y = org.y, rh.ray.org_z = org.z;
+    rh.ray.dir_x = dir.x, rh.ray.dir_y = dir.y, rh.ray.dir_z = dir.z;
+    rh.ray.tnear = tnear;
+    rh.ray.tfar = tfar;
+    rh.ray.mask = 0xFFFFFFFFu;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene_, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    return resolveHit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, org, dir, hit);
+}
+
+bool SurfaceRayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear,
+                               float tfar) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay ray{};
+    ray.org_x = org.x, ray.org_y = org.y, ray.org_z = org.z;
+    ray.dir_x = dir.x, ray.dir_y = dir.y, ray.dir_z = dir.z;
+    ray.tnear = tnear;
+    ray.tfar = tfar;
+    ray.mask = 0xFFFFFFFFu;
+    rtcOccluded1(scene_, &ctx, &ray);
+    return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
+}  // namespace mpshade

@@ -1,0 +1,70 @@
+// ray_scene.h -- Embree ray queries against one surface, in the surface's own coordinates,
+// reporting hits as exact points of the surface's global parameterization.
+//
+// Parametric surfaces are traced as a fine triangle tessellation whose vertices lie on the
+// exact surface, and each hit is then refined by Newton iteration on the exact surface
+// (Bfr limit evaluation for subdivision surfaces), so the reported (chart, u, v) and t lie
+// on the true surface to float precision. Where Newton cannot converge (singular charts,
+// grazing silhouettes) the tessellation hit is kept, and the hit point is moved onto the
+// surface at the interpolated (chart, u, v); that error is bounded by the tessellation's
+// chord sag (docs/geometry.md). Point clouds are traced as Embree oriented discs.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include <embree3/rtcore.h>
+#include <glm/vec3.hpp>
+
+#include "geometry/surface.h"
+
+namespace mpshade {
+
+// The process-wide Embree device (thread safe, created on first use).
+RTCDevice embreeDevice();
+
+// Sets flush-to-zero and denormals-are-zero on the calling thread, as Embree recommends.
+void enableFlushToZero();
+
+struct SurfaceHit {
+    ChartPoint at;
+    float t = 0.0f;       // ray parameter of the hit: P = org + t * dir
+    bool refined = false;  // Newton converged on the exact surface
+};
+
+class SurfaceRayScene {
+public:
+    // The surface must outlive this object.
+    explicit SurfaceRayScene(const Surface& surface);
+    ~SurfaceRayScene();
+    SurfaceRayScene(const SurfaceRayScene&) = delete;
+    SurfaceRayScene& operator=(const SurfaceRayScene&) = delete;
+
+    RTCScene scene() const { return scene_; }
+    const Surface& surface() const { return surface_; }
+
+    // Turns an Embree hit on scene() (geomID, primID, barycentrics) of the object-space ray
+    // org + t dir into an exact hit. Returns false if refinement moves it outside
+    // [tnear, tfar].
+    bool resolveHit(unsigned geomID, unsigned primID, float bu, float bv, float tHit,
+                    const glm::vec3& org, const glm::vec3& dir, SurfaceHit& hit) const;
+
+    // Nearest hit along org + t dir, t in [tnear, tfar]; object space.
+    bool intersect(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar,
+                   SurfaceHit& hit) const;
+    // Any hit along the segment (shadow and occlusion rays).
+    bool occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const;
+
+    size_t triangleCount() const { return triChart_.size(); }
+
+private:
+    const Surface& surface_;
+    RTCScene scene_ = nullptr;
+    unsigned triGeom_ = RTC_INVALID_GEOMETRY_ID;
+    unsigned discGeom_ = RTC_INVALID_GEOMETRY_ID;
+    std::vector<int> triChart_;         // chart of each triangle
+    std::vector<unsigned> triIndex_;    // 3 vertex indices per triangle
+    std::vector<float> vertexUV_;       // (u, v) per tessellation vertex
+};
+
+}  // namespace mpshade

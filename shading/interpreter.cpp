@@ -1,0 +1,197 @@
+#include "shading/interpreter.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include <glm/geometric.hpp>
+
+#include "geometry/error.h"
+#include "geometry/point_cloud.h"
+#include "geometry/ray_scene.h"
+#include "shading/lighting.h"
+#include "shading/scalar_ops.h"
+
+namespace mpshade {
+namespace {
+
+template <Op OP>
+void unaryLoop(float* o, const float* a, int m) {
+    for (int l = 0; l < m; ++l) o[l] = scalar::unary(OP, a[l]);
+}
+template <Op OP>
+void binaryLoop(float* o, const float* a, const float* b, int m) {
+    for (int l = 0; l < m; ++l) o[l] = scalar::binary(OP, a[l], b[l]);
+}
+template <Op OP>
+void ternaryLoop(float* o, const float* a, const float* b, const float* c, int m) {
+    for (int l = 0; l < m; ++l) o[l] = scalar::ternary(OP, a[l], b[l], c[l]);
+}
+
+}  // namespace
+
+ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
+    // Last instruction reading each value; outputs live to the end.
+    std::vector<int> lastUse(static_cast<size_t>(program.valueCount), -1);
+    for (size_t k = 0; k < program.insts.size(); ++k) {
+        const Inst& inst = program.insts[k];
+        for (int a = 0; a < inst.nargs; ++a)
+            lastUse[static_cast<size_t>(program.argsOf(inst)[a])] = static_cast<int>(k);
+    }
+    for (int v : program.ci) lastUse[static_cast<size_t>(v)] = std::numeric_limits<int>::max();
+    for (int v : program.oi) lastUse[static_cast<size_t>(v)] = std::numeric_limits<int>::max();
+
+    std::vector<int32_t> reg(static_cast<size_t>(program.valueCount), -1);
+    std::vector<char> constantReg;
+    std::vector<int32_t> freeRegs;
+    auto allocate = [&]() {
+        if (!freeRegs.empty()) {
+            const int32_t r = freeRegs.back();
+            freeRegs.pop_back();
+            return r;
+        }
+        constantReg.push_back(0);
+        return static_cast<int32_t>(registerCount_++);
+    };
+    for (size_t k = 0; k < program.insts.size(); ++k) {
+        const Inst& inst = program.insts[k];
+        if (inst.op == Op::Const) {
+            // Constants keep their own register, filled once per run.
+            const int32_t r = allocate();
+            reg[static_cast<size_t>(inst.result)] = r;
+            constantReg[static_cast<size_t>(r)] = 1;
+            constants_.emplace_back(r, inst.constant);
+            continue;
+        }
+        ExecInst e;
+        e.op = inst.op;
+        e.nin = inst.nargs;
+        e.nout = inst.nout;
+        e.imm = inst.imm;
+        const int32_t* args = program.argsOf(inst);
+        for (int a = 0; a < inst.nargs; ++a) e.in[a] = reg[static_cast<size_t>(args[a])];
+        // Outputs never share a register with this instruction's own inputs.
+        for (int o = 0; o < inst.nout; ++o) e.out[o] = reg[static_cast<size_t>(inst.result + o)] = allocate();
+        for (int a = 0; a < inst.nargs; ++a) {
+            int& last = lastUse[static_cast<size_t>(args[a])];
+            if (last == static_cast<int>(k) && !constantReg[static_cast<size_t>(e.in[a])]) {
+                freeRegs.push_back(e.in[a]);
+                last = -2;  // freed; a repeated argument is not freed twice
+            }
+        }
+        // Results nobody reads are dead at once.
+        for (int o = 0; o < inst.nout; ++o)
+            if (lastUse[static_cast<size_t>(inst.result + o)] == -1) freeRegs.push_back(e.out[o]);
+        code_.push_back(e);
+    }
+    for (int k = 0; k < 3; ++k) {
+        ci_[k] = reg[static_cast<size_t>(program.ci[k])];
+        oi_[k] = reg[static_cast<size_t>(program.oi[k])];
+    }
+}
+
+void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in, size_t n,
+                       const ShadingOutputs& out, std::vector<float>& workspace,
+                       ShadingCounters& counters) const {
+    const size_t need = static_cast<size_t>(registerCount_) * kLanes;
+    if (workspace.size() < need) workspace.resize(need);
+    float* regs = workspace.data();
+    auto R = [&](int32_t r) { return regs + static_cast<size_t>(r) * kLanes; };
+    for (const auto& [r, value] : constants_) std::fill_n(R(r), kLanes, value);
+
+    for (size_t start = 0; start < n; start += kLanes) {
+        const int m = static_cast<int>(std::min<size_t>(kLanes, n - start));
+        for (const ExecInst& e : code_) {
+            float* o = R(e.out[0]);
+            const float* a = e.nin > 0 ? R(e.in[0]) : nullptr;
+            const float* b = e.nin > 1 ? R(e.in[1]) : nullptr;
+            const float* c = e.nin > 2 ? R(e.in[2]) : nullptr;
+            switch (e.op) {
+                case Op::Global: {
+                    const auto id = static_cast<GlobalId>(e.imm);
+                    const float* const* src = nullptr;
+                    const float* scalarSrc = nullptr;
+                    switch (id) {
+                        case GlobalId::P: src = in.P; break;
+                        case GlobalId::N: src = in.N; break;
+                        case GlobalId::Ng: src = in.Ng; break;
+                        case GlobalId::dPdu: src = in.dPdu; break;
+                        case GlobalId::dPdv: src = in.dPdv; break;
+                        case GlobalId::I: src = in.I; break;
+                        case GlobalId::u: scalarSrc = in.u; break;
+                        case GlobalId::v: scalarSrc = in.v; break;
+                        case GlobalId::s: scalarSrc = in.s; break;
+                        case GlobalId::t: scalarSrc = in.t; break;
+                        case GlobalId::E:
+                            for (int k = 0; k < 3; ++k) std::fill_n(R(e.out[k]), m, uniforms.eye[k]);
+                            break;
+                        case GlobalId::time: std::fill_n(o, m, uniforms.time); break;
+                        case GlobalId::Count: break;
+                    }
+                    if (src) {
+                        for (int k = 0; k < 3; ++k) {
+                            MPSHADE_CHECK(src[k] != nullptr);
+                            std::memcpy(R(e.out[k]), src[k] + start, sizeof(float) * static_cast<size_t>(m));
+                        }
+                    } else if (scalarSrc) {
+                        std::memcpy(o, scalarSrc + start, sizeof(float) * static_cast<size_t>(m));
+                    }
+                    break;
+                }
+                case Op::Param:
+                    for (int k = 0; k < e.nout; ++k)
+                        std::fill_n(R(e.out[k]), m, uniforms.params[static_cast<size_t>(e.imm + k)]);
+                    break;
+                case Op::LightAmbient:
+                    for (int k = 0; k < 3; ++k)
+                        std::fill_n(R(e.out[k]), m, uniforms.lights[static_cast<size_t>(e.imm)].color[k]);
+                    break;
+#define MPSHADE_UNARY(X) case Op::X: unaryLoop<Op::X>(o, a, m); break;
+                MPSHADE_UNARY(Neg) MPSHADE_UNARY(Abs) MPSHADE_UNARY(Floor) MPSHADE_UNARY(Ceil)
+                MPSHADE_UNARY(Fract) MPSHADE_UNARY(Sqrt) MPSHADE_UNARY(Exp) MPSHADE_UNARY(Log)
+                MPSHADE_UNARY(Sin) MPSHADE_UNARY(Cos) MPSHADE_UNARY(Tan) MPSHADE_UNARY(Asin)
+                MPSHADE_UNARY(Acos) MPSHADE_UNARY(Atan) MPSHADE_UNARY(Sign) MPSHADE_UNARY(Trunc)
+                MPSHADE_UNARY(Not) MPSHADE_UNARY(Bake) MPSHADE_UNARY(Dynamic)
+#undef MPSHADE_UNARY
+#define MPSHADE_BINARY(X) case Op::X: binaryLoop<Op::X>(o, a, b, m); break;
+                MPSHADE_BINARY(Add) MPSHADE_BINARY(Sub) MPSHADE_BINARY(Mul) MPSHADE_BINARY(Div)
+                MPSHADE_BINARY(IDiv) MPSHADE_BINARY(Min) MPSHADE_BINARY(Max) MPSHADE_BINARY(Mod)
+                MPSHADE_BINARY(Pow) MPSHADE_BINARY(Atan2) MPSHADE_BINARY(Step) MPSHADE_BINARY(Lt)
+                MPSHADE_BINARY(Le) MPSHADE_BINARY(Gt) MPSHADE_BINARY(Ge) MPSHADE_BINARY(Eq)
+                MPSHADE_BINARY(Ne) MPSHADE_BINARY(And) MPSHADE_BINARY(Or)
+#undef MPSHADE_BINARY
+#define MPSHADE_TERNARY(X) case Op::X: ternaryLoop<Op::X>(o, a, b, c, m); break;
+                MPSHADE_TERNARY(Clamp) MPSHADE_TERNARY(Mix) MPSHADE_TERNARY(Smoothstep)
+                MPSHADE_TERNARY(Select)
+#undef MPSHADE_TERNARY
+                case Op::Noise: case Op::Snoise: case Op::Cellnoise: case Op::Fbm: case Op::Turbulence:
+                    for (int l = 0; l < m; ++l) o[l] = scalar::pattern(e.op, e.imm, a[l], b[l], c[l]);
+                    break;
+                case Op::Diffuse: case Op::Specular: case Op::Phong: {
+                    const LightSample& light = uniforms.lights[static_cast<size_t>(e.imm)];
+                    const float* arg[10];
+                    for (int k = 0; k < e.nin; ++k) arg[k] = R(e.in[k]);
+                    float* rgb[3] = {R(e.out[0]), R(e.out[1]), R(e.out[2])};
+                    shadeLight(e.op, light, arg, rgb, m);
+                    break;
+                }
+                case Op::Occlusion: {
+                    const float* arg[6];
+                    for (int k = 0; k < 6; ++k) arg[k] = R(e.in[k]);
+                    counters.occlusionRays += occlusionLanes(uniforms.occluder, uniforms.occlusionBias,
+                                                             e.imm, arg, o, m);
+                    break;
+                }
+                case Op::Const: case Op::Count: break;
+            }
+        }
+        for (int k = 0; k < 3; ++k) {
+            std::memcpy(out.Ci[k] + start, R(ci_[k]), sizeof(float) * static_cast<size_t>(m));
+            std::memcpy(out.Oi[k] + start, R(oi_[k]), sizeof(float) * static_cast<size_t>(m));
+        }
+        counters.instructions += code_.size() * static_cast<uint64_t>(m);
+    }
+    counters.points += n;
+}
+
+}  // namespace mpshade

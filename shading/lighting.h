@@ -1,0 +1,32 @@
+// lighting.h -- the lighting and visibility builtins on a run of lanes (spec: "Lighting").
+//
+// For one light: L is the unit direction to the light and Cl its color arriving at P
+// (point lights fall off as 1 / distance^2).
+//   diffuse:  Cl max(0, N.L)
+//   specular: Cl D(N.H) max(0, N.L) / 4, H = normalize(L + V), D the GGX (Trowbridge-Reitz)
+//             distribution alpha^2 / (pi ((N.H)^2 (alpha^2 - 1) + 1)^2) with
+//             alpha = roughness^2 (roughness clamped to [0.01, 1])
+//   phong:    Cl max(0, R.L)^exponent, R = reflect(-V, N)
+// occlusion: the cosine-weighted fraction of the hemisphere around N left open by the
+// object's own geometry, from `rays` directions of a fixed Hammersley pattern, so it is a
+// deterministic function of P and N.
+#pragma once
+
+#include <cstdint>
+
+#include "shading/interpreter.h"
+
+namespace mpshade {
+
+// args: P(3) N(3) [V(3) param]; each a run of m lanes. Writes rgb[3][m].
+void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb, int m);
+
+// args: P(3) N(3). Writes the open fraction per lane; returns the rays traced.
+uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,
+                        const float* const* args, float* out, int m);
+
+// One lane of each, for tests and the constant folder's peers.
+glm::vec3 shadeLightOne(Op op, const LightSample& light, const glm::vec3& P, const glm::vec3& N,
+                        const glm::vec3& V, float param);
+
+}  // namespace mpshade

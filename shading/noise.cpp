@@ -1,0 +1,114 @@
+#include "shading/noise.h"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+namespace mpshade {
+namespace {
+
+// A fixed permutation of 0..255 (Fisher-Yates driven by a 32-bit LCG with a fixed seed):
+// integer arithmetic only, so every machine builds the same table.
+struct Permutation {
+    std::array<uint8_t, 512> p{};
+    Permutation() {
+        std::array<uint8_t, 256> base{};
+        for (int i = 0; i < 256; ++i) base[i] = static_cast<uint8_t>(i);
+        uint32_t state = 0x6d707368u;  // "mpsh"
+        for (int i = 255; i > 0; --i) {
+            state = state * 1664525u + 1013904223u;
+            const int j = static_cast<int>((state >> 8) % static_cast<uint32_t>(i + 1));
+            std::swap(base[i], base[j]);
+        }
+        for (int i = 0; i < 512; ++i) p[i] = base[i & 255];
+    }
+};
+const Permutation kPerm;
+
+inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
+inline float lerp(float t, float a, float b) { return a + t * (b - a); }
+
+// Perlin 2002's gradient: one of 12 cube-edge directions chosen by the hash.
+inline float grad(int hash, float x, float y, float z) {
+    const int h = hash & 15;
+    const float u = h < 8 ? x : y;
+    const float v = h < 4 ? y : (h == 12 || h == 14 ? x : z);
+    return ((h & 1) ? -u : u) + ((h & 2) ? -v : v);
+}
+
+// Splits x into a lattice cell index (mod 256) and the fraction within the cell. False for
+// non-finite input; huge inputs wrap without overflowing an int.
+inline bool lattice(float x, int& cell, float& frac) {
+    if (!std::isfinite(x)) return false;
+    const double f = std::floor(static_cast<double>(x));
+    frac = static_cast<float>(static_cast<double>(x) - f);
+    double m = std::fmod(f, 256.0);
+    if (m < 0.0) m += 256.0;
+    cell = static_cast<int>(m) & 255;
+    return true;
+}
+
+inline uint32_t hash3(int64_t x, int64_t y, int64_t z) {
+    // A 64-bit mix (splitmix64's finalizer) of the packed cell coordinates.
+    uint64_t h = static_cast<uint64_t>(x) * 0x9E3779B97F4A7C15ull ^
+                 static_cast<uint64_t>(y) * 0xC2B2AE3D27D4EB4Full ^
+                 static_cast<uint64_t>(z) * 0x165667B19E3779F9ull;
+    h ^= h >> 30;
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 27;
+    h *= 0x94D049BB133111EBull;
+    h ^= h >> 31;
+    return static_cast<uint32_t>(h);
+}
+
+inline int64_t cellOf(float x) {
+    const double f = std::floor(static_cast<double>(x));
+    return static_cast<int64_t>(std::fmax(std::fmin(f, 9.0e15), -9.0e15));
+}
+
+}  // namespace
+
+float snoise3(float x, float y, float z) {
+    int X, Y, Z;
+    if (!lattice(x, X, x) || !lattice(y, Y, y) || !lattice(z, Z, z)) return 0.0f;
+    const uint8_t* p = kPerm.p.data();
+    const float u = fade(x), v = fade(y), w = fade(z);
+    const int A = p[X] + Y, AA = p[A] + Z, AB = p[A + 1] + Z;
+    const int B = p[X + 1] + Y, BA = p[B] + Z, BB = p[B + 1] + Z;
+    const float r =
+        lerp(w,
+             lerp(v, lerp(u, grad(p[AA], x, y, z), grad(p[BA], x - 1, y, z)),
+                  lerp(u, grad(p[AB], x, y - 1, z), grad(p[BB], x - 1, y - 1, z))),
+             lerp(v, lerp(u, grad(p[AA + 1], x, y, z - 1), grad(p[BA + 1], x - 1, y, z - 1)),
+                  lerp(u, grad(p[AB + 1], x, y - 1, z - 1), grad(p[BB + 1], x - 1, y - 1, z - 1))));
+    return std::fmin(std::fmax(r, -1.0f), 1.0f);
+}
+
+float noise3(float x, float y, float z) { return 0.5f + 0.5f * snoise3(x, y, z); }
+
+float cellnoise3(float x, float y, float z) {
+    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return 0.0f;
+    return static_cast<float>(hash3(cellOf(x), cellOf(y), cellOf(z)) >> 8) * (1.0f / 16777216.0f);
+}
+
+float fbm3(float x, float y, float z, int octaves) {
+    float sum = 0.0f, amp = 1.0f, freq = 1.0f;
+    for (int i = 0; i < octaves; ++i) {
+        sum += amp * snoise3(x * freq, y * freq, z * freq);
+        amp *= 0.5f;
+        freq *= 2.0f;
+    }
+    return sum;
+}
+
+float turbulence3(float x, float y, float z, int octaves) {
+    float sum = 0.0f, amp = 1.0f, freq = 1.0f;
+    for (int i = 0; i < octaves; ++i) {
+        sum += amp * std::fabs(snoise3(x * freq, y * freq, z * freq));
+        amp *= 0.5f;
+        freq *= 2.0f;
+    }
+    return sum;
+}
+
+}  // namespace mpshade

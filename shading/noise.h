@@ -1,0 +1,18 @@
+// noise.h -- deterministic procedural noise (the same values on every machine and run).
+//
+// snoise3: Perlin's improved gradient noise (Perlin 2002, "Improving Noise") with his
+// reference permutation and 12 edge gradients; zero at integer lattice points, clamped
+// to [-1, 1]. noise3 = 0.5 + 0.5 snoise3, in [0, 1]. cellnoise3: a hash of the unit cell
+// containing p, in [0, 1), constant per cell. fbm3: sum over octaves i < n of
+// 0.5^i snoise3(2^i p); turbulence3: the same sum of |snoise3|.
+#pragma once
+
+namespace mpshade {
+
+float snoise3(float x, float y, float z);
+float noise3(float x, float y, float z);
+float cellnoise3(float x, float y, float z);
+float fbm3(float x, float y, float z, int octaves);
+float turbulence3(float x, float y, float z, int octaves);
+
+}  // namespace mpshade
