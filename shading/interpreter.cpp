@@ -53,16 +53,17 @@ ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
         constantReg.push_back(0);
         return static_cast<int32_t>(registerCount_++);
     };
+    // Constants first: each keeps a register of its own for the whole run, filled once.
+    for (const Inst& inst : program.insts) {
+        if (inst.op != Op::Const) continue;
+        const int32_t r = allocate();
+        reg[static_cast<size_t>(inst.result)] = r;
+        constantReg[static_cast<size_t>(r)] = 1;
+        constants_.emplace_back(r, inst.constant);
+    }
     for (size_t k = 0; k < program.insts.size(); ++k) {
         const Inst& inst = program.insts[k];
-        if (inst.op == Op::Const) {
-            // Constants keep their own register, filled once per run.
-            const int32_t r = allocate();
-            reg[static_cast<size_t>(inst.result)] = r;
-            constantReg[static_cast<size_t>(r)] = 1;
-            constants_.emplace_back(r, inst.constant);
-            continue;
-        }
+        if (inst.op == Op::Const) continue;
         ExecInst e;
         e.op = inst.op;
         e.nin = inst.nargs;

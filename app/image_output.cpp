@@ -1,0 +1,45 @@
+// OpenImageIO bundles fmt with libfmt's include guards: include fmt first (see docs/building.md).
+#include <fmt/format.h>
+
+#include "app/image_output.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+
+namespace mpshade {
+namespace {
+
+void write(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format, const void* data) {
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw std::runtime_error("cannot write " + path + ": " + OIIO::geterror());
+    if (!out->open(path, spec) || !out->write_image(format, data) || !out->close())
+        throw std::runtime_error("cannot write " + path + ": " + out->geterror());
+}
+
+float linearToSrgb(float c) {
+    c = std::clamp(c, 0.0f, 1.0f);
+    return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+}  // namespace
+
+void writeExr(const Image& image, const std::string& path) {
+    OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::HALF);
+    spec.attribute("compression", "zip");
+    write(path, spec, OIIO::TypeDesc::FLOAT, image.rgba.data());
+}
+
+void writePng(const Image& image, const std::string& path) {
+    std::vector<unsigned char> rgb(static_cast<size_t>(image.width) * image.height * 3);
+    for (size_t i = 0; i < static_cast<size_t>(image.width) * image.height; ++i)
+        for (int c = 0; c < 3; ++c)
+            rgb[3 * i + c] = static_cast<unsigned char>(std::lround(255.0f * linearToSrgb(image.rgba[4 * i + c])));
+    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+    write(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+}
+
+}  // namespace mpshade

@@ -1,0 +1,15 @@
+// image_output.h -- writes frames with OpenImageIO: linear half-float RGBA OpenEXR, and an
+// sRGB-encoded 8-bit PNG for viewing. Kept apart so only this file pays for OIIO's headers.
+#pragma once
+
+#include <string>
+
+#include "phases/image.h"
+
+namespace mpshade {
+
+// Throws std::runtime_error with OpenImageIO's message on failure.
+void writeExr(const Image& image, const std::string& path);
+void writePng(const Image& image, const std::string& path);
+
+}  // namespace mpshade

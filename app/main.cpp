@@ -1,0 +1,45 @@
+// mpshade -- the command line. Exit codes: 0 success, 1 internal failure, 2 bad input.
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "app/render_command.h"
+
+int main(int argc, char** argv) {
+    CLI::App app{"mpshade: multi-phase procedural shading"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "mpshade 0.1.0");
+
+    mpshade::RenderCommandOptions render;
+    CLI::App* renderCmd = app.add_subcommand("render", "Render frames of a scene to OpenEXR and PNG");
+    renderCmd->add_option("scene", render.scene, "Scene file (.json)")->required();
+    renderCmd->add_option("--out", render.outDir, "Output folder (created if missing)")->required();
+    renderCmd->add_option("--mode", render.mode, "Renderer: reference (single-phase, exact geometry)")
+        ->capture_default_str();
+    renderCmd->add_option("--frames", render.frames, "Frames A:B (half-open; 0:2 is frames 0 and 1) or N");
+    renderCmd->add_option("--size", render.size, "Image size WxH (overrides the scene)");
+    renderCmd->add_option("--spp", render.spp, "Samples per pixel (overrides the scene)");
+    renderCmd->add_option("--seed", render.seed, "Seed of the sample positions")->capture_default_str();
+    renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::fprintf(stderr, "mpshade: error: %s\nRun 'mpshade --help' for usage.\n", e.what());
+        return 2;
+    }
+    try {
+        if (renderCmd->parsed()) return mpshade::runRenderCommand(render);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "mpshade: internal error: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

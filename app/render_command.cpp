@@ -1,0 +1,156 @@
+#include "app/render_command.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "app/image_output.h"
+#include "geometry/error.h"
+#include "phases/reference_renderer.h"
+#include "scene/scene.h"
+
+namespace mpshade {
+namespace {
+
+bool parseInt(const std::string& s, long& out) {
+    if (s.empty() || s.size() > 9) return false;
+    for (char c : s)
+        if (c < '0' || c > '9') return false;
+    out = std::stol(s);
+    return true;
+}
+
+// "A:B" (half-open) or "N"; checked against the scene's frame count.
+void parseFrames(const std::string& spec, int frameCount, int& first, int& last) {
+    first = 0;
+    last = frameCount;
+    if (spec.empty()) return;
+    const InputLocation where{"--frames", 0, 0, {}};
+    long a, b;
+    const auto colon = spec.find(':');
+    if (colon == std::string::npos) {
+        if (!parseInt(spec, a)) throw InputError(where, "expected A:B or N, found '" + spec + "'");
+        b = a + 1;
+    } else if (!parseInt(spec.substr(0, colon), a) || !parseInt(spec.substr(colon + 1), b)) {
+        throw InputError(where, "expected A:B with whole numbers, found '" + spec + "'");
+    }
+    if (!(a < b)) throw InputError(where, "the range " + spec + " is empty (frames are half-open: 0:2 is frames 0 and 1)");
+    if (b > frameCount)
+        throw InputError(where, "the range " + spec + " goes past the scene's " + std::to_string(frameCount) +
+                                    " frames (0:" + std::to_string(frameCount) + ")");
+    first = static_cast<int>(a);
+    last = static_cast<int>(b);
+}
+
+void parseSize(const std::string& spec, int& width, int& height) {
+    if (spec.empty()) return;
+    const auto x = spec.find('x');
+    long w, h;
+    if (x == std::string::npos || !parseInt(spec.substr(0, x), w) || !parseInt(spec.substr(x + 1), h) ||
+        w < 1 || h < 1 || w > 16384 || h > 16384)
+        throw InputError({"--size", 0, 0, {}}, "expected WxH with each in 1..16384, found '" + spec + "'");
+    width = static_cast<int>(w);
+    height = static_cast<int>(h);
+}
+
+class ProgressBar {
+public:
+    explicit ProgressBar(bool enabled) : enabled_(enabled) {}
+    void update(int frame, int frames, int done, int total) {
+        if (!enabled_) return;
+        std::lock_guard<std::mutex> lock(mutex_);
+        const int width = 30;
+        const int filled = total > 0 ? done * width / total : 0;
+        const int percent = total > 0 ? done * 100 / total : 0;
+        if (percent == lastPercent_ && frame == lastFrame_) return;
+        lastPercent_ = percent;
+        lastFrame_ = frame;
+        std::fprintf(stderr, "\rframe %d (%d of %d) [%s%s] %3d%%", frame, frame - first_ + 1, frames,
+                     std::string(static_cast<size_t>(filled), '#').c_str(),
+                     std::string(static_cast<size_t>(width - filled), '.').c_str(), percent);
+        std::fflush(stderr);
+    }
+    void setFirst(int first) { first_ = first; }
+    void finish() {
+        if (enabled_) std::fprintf(stderr, "\n");
+    }
+
+private:
+    bool enabled_;
+    std::mutex mutex_;
+    int lastPercent_ = -1, lastFrame_ = -1, first_ = 0;
+};
+
+}  // namespace
+
+int runRenderCommand(const RenderCommandOptions& options) {
+    try {
+        if (options.mode != "reference")
+            throw InputError({"--mode", 0, 0, {}}, "unknown mode '" + options.mode + "' (available: reference)");
+        if (options.spp < 0 || options.spp > 1024)
+            throw InputError({"--spp", 0, 0, {}}, "expected 1..1024, found " + std::to_string(options.spp));
+        const Scene scene = loadScene(options.scene);
+        RenderOptions render;
+        render.seed = options.seed;
+        render.samplesPerPixel = options.spp;
+        parseSize(options.size, render.width, render.height);
+        int first, last;
+        parseFrames(options.frames, scene.frameCount(), first, last);
+
+        std::error_code ec;
+        std::filesystem::create_directories(options.outDir, ec);
+        if (ec) throw InputError({options.outDir, 0, 0, {}}, "cannot create the output folder: " + ec.message());
+
+        const ReferenceRenderer renderer(scene);
+        ProgressBar bar(!options.quiet && isatty(STDERR_FILENO));
+        bar.setFirst(first);
+        nlohmann::json frames = nlohmann::json::array();
+        const auto start = std::chrono::steady_clock::now();
+        for (int frame = first; frame < last; ++frame) {
+            FrameStats stats;
+            const Image image = renderer.renderFrame(frame, render, stats, [&](int done, int total) {
+                bar.update(frame, last - first, done, total);
+            });
+            char name[32];
+            std::snprintf(name, sizeof name, "frame_%04d", frame);
+            const std::string base = (std::filesystem::path(options.outDir) / name).string();
+            writeExr(image, base + ".exr");
+            writePng(image, base + ".png");
+            frames.push_back({{"index", stats.index},
+                              {"time", stats.time},
+                              {"wall_seconds", stats.wallSeconds},
+                              {"samples", stats.samples},
+                              {"rays", stats.rays},
+                              {"occlusion_rays", stats.occlusionRays},
+                              {"shaded_points", stats.shadedPoints},
+                              {"shader_instructions", stats.shaderInstructions},
+                              {"nonfinite_samples", stats.nonFiniteSamples}});
+        }
+        bar.finish();
+        const int width = render.width > 0 ? render.width : scene.settings.width;
+        const int height = render.height > 0 ? render.height : scene.settings.height;
+        nlohmann::json doc = {
+            {"scene", options.scene},
+            {"mode", options.mode},
+            {"width", width},
+            {"height", height},
+            {"samples_per_pixel", render.samplesPerPixel > 0 ? render.samplesPerPixel : scene.settings.samplesPerPixel},
+            {"seed", options.seed},
+            {"total_wall_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
+            {"frames", frames}};
+        std::ofstream out(std::filesystem::path(options.outDir) / "stats.json");
+        out << doc.dump(2) << "\n";
+        if (!out) throw std::runtime_error("cannot write stats.json in " + options.outDir);
+        return 0;
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "mpshade: %s\n", e.what());
+        return 2;
+    }
+}
+
+}  // namespace mpshade

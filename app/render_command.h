@@ -1,0 +1,23 @@
+// render_command.h -- `mpshade render`: options and the command itself.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace mpshade {
+
+struct RenderCommandOptions {
+    std::string scene;             // scene file
+    std::string outDir;            // created if missing
+    std::string mode = "reference";
+    std::string frames;            // "A:B" half-open, or "N"; empty = every frame
+    std::string size;              // "WxH"; empty = the scene's
+    int spp = 0;                   // 0 = the scene's
+    uint32_t seed = 0;
+    bool quiet = false;            // no progress bar
+};
+
+// Returns the process exit code: 0 success, 2 bad input (message already on stderr).
+int runRenderCommand(const RenderCommandOptions& options);
+
+}  // namespace mpshade

@@ -1,0 +1,279 @@
+#include "phases/reference_renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+namespace mpshade {
+namespace {
+
+struct PendingRay {
+    uint32_t sample;   // index into the tile's sample arrays
+    float tnear, tfar;
+};
+
+struct Hit {
+    uint32_t ray;      // index into the pending rays
+    uint32_t object;
+    unsigned geomID, primID;
+    float u, v, t;
+};
+
+// Per-thread scratch, reused across tiles so the hot loops never allocate once warm.
+struct Scratch {
+    std::vector<glm::vec3> dir;       // per tile sample, world space
+    std::vector<float> color;         // 3 per tile sample
+    std::vector<float> transmit;      // 3 per tile sample
+    std::vector<PendingRay> active, next;
+    std::vector<Hit> hits;
+    std::vector<ChartPoint> chart;
+    std::vector<SurfaceSample> geom;
+    std::vector<uint32_t> hitOfPoint;
+    std::vector<float> soa;           // shading inputs and outputs, structure of arrays
+    std::vector<float> workspace;     // interpreter registers
+    FrameStats counters;
+};
+
+// Shading input/output arrays carved from one buffer: 24 input rows + 6 output rows.
+constexpr int kSoaRows = 30;
+
+}  // namespace
+
+ReferenceRenderer::ReferenceRenderer(const Scene& scene) : scene_(scene), resources_(scene) {}
+
+Image ReferenceRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
+                                     const ProgressFn& progress) const {
+    const SampleBuffer samples = renderSamples(frame, options, stats, progress);
+    const auto start = std::chrono::steady_clock::now();
+    Image image = resolvePixels(samples, options.filter);
+    stats.wallSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return image;
+}
+
+SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& options,
+                                              FrameStats& stats, const ProgressFn& progress) const {
+    const auto start = std::chrono::steady_clock::now();
+    const RenderSettings& settings = scene_.settings;
+    const int width = options.width > 0 ? options.width : settings.width;
+    const int height = options.height > 0 ? options.height : settings.height;
+    const int spp = options.samplesPerPixel > 0 ? options.samplesPerPixel : settings.samplesPerPixel;
+    const float time = scene_.frameTime(frame);
+
+    const CameraState camera = cameraAt(scene_, time, width, height);
+    std::vector<ObjectState> states;
+    std::vector<std::vector<float>> params(scene_.objects.size());
+    std::vector<std::vector<LightSample>> lights(scene_.objects.size());
+    std::vector<ShadingUniforms> uniforms(scene_.objects.size());
+    for (size_t i = 0; i < scene_.objects.size(); ++i) {
+        const SceneObject& obj = scene_.objects[i];
+        const ObjectResources& res = resources_.object(i);
+        states.push_back(objectAt(obj, time, camera));
+        animatedParamsAt(obj, res.kernel->program(), time, params[i]);
+        lightsAt(scene_, states[i], time, lights[i]);
+        ShadingUniforms& u = uniforms[i];
+        u.time = time;
+        u.eye = states[i].eye;
+        u.params = params[i];
+        u.lights = lights[i];
+        u.occluder = res.rayScene;
+        u.occlusionBias = res.occlusionBias;
+    }
+    const WorldRayScene world(resources_, states);
+
+    SampleBuffer samples;
+    samples.resize(width, height, spp);
+    const int tile = std::max(1, options.tileSize);
+    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
+    const int tileCount = tilesX * tilesY;
+    std::atomic<int> tilesDone{0};
+    tbb::enumerable_thread_specific<Scratch> scratchPerThread;
+
+    tbb::parallel_for(0, tileCount, [&](int tileIndex) {
+        enableFlushToZero();
+        Scratch& s = scratchPerThread.local();
+        const int x0 = (tileIndex % tilesX) * tile, y0 = (tileIndex / tilesX) * tile;
+        const int x1 = std::min(width, x0 + tile), y1 = std::min(height, y0 + tile);
+        const int tw = x1 - x0;
+        const size_t n = static_cast<size_t>(tw) * (y1 - y0) * spp;
+        s.dir.resize(n);
+        s.color.assign(3 * n, 0.0f);
+        s.transmit.assign(3 * n, 1.0f);
+        s.active.clear();
+        for (int py = y0; py < y1; ++py) {
+            for (int px = x0; px < x1; ++px) {
+                for (int k = 0; k < spp; ++k) {
+                    const size_t local = (static_cast<size_t>(py - y0) * tw + (px - x0)) * spp + k;
+                    const size_t global = samples.index(px, py, k);
+                    float x, y;
+                    samplePosition(options.seed, px, py, k, spp, x, y);
+                    samples.xy[2 * global] = x;
+                    samples.xy[2 * global + 1] = y;
+                    s.dir[local] = camera.direction(x, y);
+                    // Clip to the near and far planes, which are perpendicular to the view axis.
+                    const float cosine = glm::dot(s.dir[local], camera.forward);
+                    s.active.push_back({static_cast<uint32_t>(local), camera.zNear / cosine, camera.zFar / cosine});
+                }
+            }
+        }
+        RTCIntersectContext ctx;
+        for (int layer = 0; layer < options.maxLayers && !s.active.empty(); ++layer) {
+            // Trace every pending ray of this layer.
+            s.hits.clear();
+            for (uint32_t r = 0; r < s.active.size(); ++r) {
+                const PendingRay& pr = s.active[r];
+                rtcInitIntersectContext(&ctx);
+                RTCRayHit rh{};
+                const glm::vec3& d = s.dir[pr.sample];
+                rh.ray.org_x = camera.eye.x, rh.ray.org_y = camera.eye.y, rh.ray.org_z = camera.eye.z;
+                rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+                rh.ray.tnear = pr.tnear;
+                rh.ray.tfar = pr.tfar;
+                rh.ray.mask = 0xFFFFFFFFu;
+                rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                rtcIntersect1(world.scene(), &ctx, &rh);
+                ++s.counters.rays;
+                if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+                s.hits.push_back({r, rh.hit.instID[0], rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar});
+            }
+            // Shade the hits object by object, each object's points as one batch.
+            std::sort(s.hits.begin(), s.hits.end(), [](const Hit& a, const Hit& b) {
+                return a.object != b.object ? a.object < b.object : a.ray < b.ray;
+            });
+            s.next.clear();
+            for (size_t begin = 0; begin < s.hits.size();) {
+                const uint32_t objIndex = s.hits[begin].object;
+                size_t end = begin;
+                while (end < s.hits.size() && s.hits[end].object == objIndex) ++end;
+                const ObjectResources& res = resources_.object(objIndex);
+                const ObjectState& st = states[objIndex];
+                const SurfaceRayScene& rs = *res.rayScene;
+                s.chart.clear();
+                s.hitOfPoint.clear();
+                std::vector<float>& soa = s.soa;
+                const size_t m = end - begin;
+                soa.resize(kSoaRows * m);
+                auto row = [&](int r) { return soa.data() + static_cast<size_t>(r) * m; };
+                for (size_t h = begin; h < end; ++h) {
+                    Hit& hit = s.hits[h];
+                    const PendingRay& pr = s.active[hit.ray];
+                    const glm::vec3 org = glm::vec3(st.worldToObject * glm::vec4(camera.eye, 1.0f));
+                    const glm::vec3 dir = glm::vec3(st.worldToObject * glm::vec4(s.dir[pr.sample], 0.0f));
+                    SurfaceHit sh;
+                    if (!rs.resolveHit(hit.geomID, hit.primID, hit.u, hit.v, hit.t, org, dir, sh)) continue;
+                    hit.t = sh.t;
+                    const size_t p = s.chart.size();
+                    s.chart.push_back(sh.at);
+                    s.hitOfPoint.push_back(static_cast<uint32_t>(h));
+                    const glm::vec3 I = glm::normalize(dir);
+                    row(15)[p] = I.x, row(16)[p] = I.y, row(17)[p] = I.z;
+                }
+                const size_t points = s.chart.size();
+                s.geom.resize(points);
+                evaluateBatch(rs.surface(), s.chart, std::span<SurfaceSample>(s.geom.data(), points));
+                for (size_t p = 0; p < points; ++p) {
+                    const SurfaceSample& g = s.geom[p];
+                    for (int k = 0; k < 3; ++k) {
+                        row(0 + k)[p] = g.P[k];
+                        row(3 + k)[p] = g.N[k];
+                        row(6 + k)[p] = g.Ng[k];
+                        row(9 + k)[p] = g.dPdu[k];
+                        row(12 + k)[p] = g.dPdv[k];
+                    }
+                    row(18)[p] = s.chart[p].u;
+                    row(19)[p] = s.chart[p].v;
+                    row(20)[p] = g.s;
+                    row(21)[p] = g.t;
+                }
+                ShadingInputs in;
+                for (int k = 0; k < 3; ++k) {
+                    in.P[k] = row(0 + k);
+                    in.N[k] = row(3 + k);
+                    in.Ng[k] = row(6 + k);
+                    in.dPdu[k] = row(9 + k);
+                    in.dPdv[k] = row(12 + k);
+                    in.I[k] = row(15 + k);
+                }
+                in.u = row(18), in.v = row(19), in.s = row(20), in.t = row(21);
+                ShadingOutputs out;
+                for (int k = 0; k < 3; ++k) out.Ci[k] = row(24 + k), out.Oi[k] = row(27 + k);
+                ShadingCounters counters;
+                res.kernel->run(uniforms[objIndex], in, points, out, s.workspace, counters);
+                s.counters.shaderInstructions += counters.instructions;
+                s.counters.shadedPoints += counters.points;
+                s.counters.occlusionRays += counters.occlusionRays;
+                // Composite front to back: C += T * Oi * Ci, T *= 1 - Oi, per channel.
+                for (size_t p = 0; p < points; ++p) {
+                    const Hit& hit = s.hits[s.hitOfPoint[p]];
+                    const PendingRay& pr = s.active[hit.ray];
+                    float ci[3], oi[3];
+                    bool finite = true;
+                    for (int k = 0; k < 3; ++k) {
+                        ci[k] = out.Ci[k][p];
+                        oi[k] = out.Oi[k][p];
+                        finite = finite && std::isfinite(ci[k]) && std::isfinite(oi[k]);
+                    }
+                    if (!finite) {
+                        ++s.counters.nonFiniteSamples;
+                        for (int k = 0; k < 3; ++k) {
+                            ci[k] = 0.0f;
+                            oi[k] = 1.0f;
+                        }
+                    }
+                    float* C = &s.color[3 * pr.sample];
+                    float* T = &s.transmit[3 * pr.sample];
+                    float remaining = 0.0f;
+                    for (int k = 0; k < 3; ++k) {
+                        const float o = std::clamp(oi[k], 0.0f, 1.0f);
+                        C[k] += T[k] * o * ci[k];
+                        T[k] *= 1.0f - o;
+                        remaining = std::max(remaining, T[k]);
+                    }
+                    if (remaining > 1e-3f) {
+                        // Continue behind this surface; the offset is relative to the distance.
+                        s.next.push_back({pr.sample, hit.t * (1.0f + 1e-5f) + 1e-6f, pr.tfar});
+                    }
+                }
+                begin = end;
+            }
+            std::swap(s.active, s.next);
+        }
+        // Whatever light still passes shows the background.
+        for (int py = y0; py < y1; ++py) {
+            for (int px = x0; px < x1; ++px) {
+                for (int k = 0; k < spp; ++k) {
+                    const size_t local = (static_cast<size_t>(py - y0) * tw + (px - x0)) * spp + k;
+                    float* out = &samples.rgba[4 * samples.index(px, py, k)];
+                    const float* C = &s.color[3 * local];
+                    const float* T = &s.transmit[3 * local];
+                    for (int c = 0; c < 3; ++c) out[c] = C[c] + T[c] * settings.background[c];
+                    out[3] = 1.0f - (T[0] + T[1] + T[2]) / 3.0f;
+                }
+            }
+        }
+        const int done = ++tilesDone;
+        if (progress) progress(done, tileCount);
+    });
+
+    stats = FrameStats{};
+    stats.index = frame;
+    stats.time = time;
+    stats.samples = static_cast<uint64_t>(width) * height * spp;
+    for (const Scratch& s : scratchPerThread) {
+        stats.rays += s.counters.rays;
+        stats.occlusionRays += s.counters.occlusionRays;
+        stats.shadedPoints += s.counters.shadedPoints;
+        stats.shaderInstructions += s.counters.shaderInstructions;
+        stats.nonFiniteSamples += s.counters.nonFiniteSamples;
+    }
+    stats.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return samples;
+}
+
+}  // namespace mpshade

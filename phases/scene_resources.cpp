@@ -1,0 +1,37 @@
+#include "phases/scene_resources.h"
+
+#include "scene/variability.h"
+#include "shading/shader_compiler.h"
+
+namespace mpshade {
+
+SceneResources::SceneResources(const Scene& scene) : scene_(scene) {
+    for (const SceneObject& obj : scene.objects) {
+        ObjectResources r;
+        r.kernel = buildKernel(*obj.shader, bindingOf(scene, obj));
+        auto& rs = rayScenes_[obj.surface.get()];
+        if (!rs) rs = std::make_unique<SurfaceRayScene>(*obj.surface);
+        r.rayScene = rs.get();
+        r.occlusionBias = 1e-4f * std::max(surfaceBounds(*obj.surface).diagonal(), 1e-6f);
+        objects_.push_back(std::move(r));
+    }
+}
+
+WorldRayScene::WorldRayScene(const SceneResources& resources, const std::vector<ObjectState>& states) {
+    RTCDevice device = embreeDevice();
+    scene_ = rtcNewScene(device);
+    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+    for (size_t i = 0; i < resources.objectCount(); ++i) {
+        RTCGeometry inst = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(inst, resources.object(i).rayScene->scene());
+        rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &states[i].objectToWorld[0][0]);
+        rtcCommitGeometry(inst);
+        rtcAttachGeometryByID(scene_, inst, static_cast<unsigned>(i));
+        rtcReleaseGeometry(inst);
+    }
+    rtcCommitScene(scene_);
+}
+
+WorldRayScene::~WorldRayScene() { rtcReleaseScene(scene_); }
+
+}  // namespace mpshade

@@ -1,0 +1,49 @@
+// scene_resources.h -- what every renderer builds once per scene: each object's shader
+// kernel specialized to its binding, and one Embree scene per distinct surface.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "geometry/ray_scene.h"
+#include "scene/scene.h"
+#include "scene/scene_state.h"
+#include "shading/interpreter.h"
+
+namespace mpshade {
+
+struct ObjectResources {
+    std::shared_ptr<const ShaderKernel> kernel;
+    const SurfaceRayScene* rayScene = nullptr;  // owned by SceneResources
+    float occlusionBias = 1e-4f;                // object units
+};
+
+class SceneResources {
+public:
+    explicit SceneResources(const Scene& scene);
+    const Scene& scene() const { return scene_; }
+    const ObjectResources& object(size_t i) const { return objects_[i]; }
+    size_t objectCount() const { return objects_.size(); }
+
+private:
+    const Scene& scene_;
+    std::vector<ObjectResources> objects_;
+    std::map<const Surface*, std::unique_ptr<SurfaceRayScene>> rayScenes_;
+};
+
+// The frame's world: Embree instances of each object's surface, placed at time t.
+// Instance (geometry) id i is scene object i.
+class WorldRayScene {
+public:
+    WorldRayScene(const SceneResources& resources, const std::vector<ObjectState>& states);
+    ~WorldRayScene();
+    WorldRayScene(const WorldRayScene&) = delete;
+    WorldRayScene& operator=(const WorldRayScene&) = delete;
+    RTCScene scene() const { return scene_; }
+
+private:
+    RTCScene scene_ = nullptr;
+};
+
+}  // namespace mpshade

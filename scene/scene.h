@@ -1,0 +1,97 @@
+// scene.h -- an evolving scene as loaded from a scene file (see docs/scene-format.md).
+// Coordinates are world space, y up; angles in degrees; colors linear RGB; times seconds.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "geometry/surface.h"
+#include "scene/animation.h"
+#include "shading/ast.h"
+#include "shading/binding.h"
+
+namespace mpshade {
+
+struct RenderSettings {
+    int width = 640;           // pixels, 1..16384
+    int height = 360;          // pixels, 1..16384
+    float fps = 30.0f;         // frames per second, > 0
+    float duration = 1.0f;     // seconds, > 0
+    int samplesPerPixel = 4;   // 1..1024
+    glm::vec3 background{0.0f};  // linear RGB behind everything
+};
+
+struct Camera {
+    float fovY = 40.0f;  // vertical field of view, degrees, in (0, 180)
+    float zNear = 0.05f;  // > 0
+    float zFar = 200.0f;  // > zNear
+    Keyframes<glm::vec3> eye, target, up;  // up defaults to +y
+};
+
+struct Light {
+    LightKind kind = LightKind::Distant;
+    Keyframes<glm::vec3> color;      // linear RGB
+    Keyframes<float> intensity;      // scalar multiplier, >= 0
+    Keyframes<glm::vec3> position;   // point lights
+    Keyframes<glm::vec3> direction;  // distant lights: the direction the light travels
+    bool animated() const {
+        return color.varies() || intensity.varies() || position.varies() || direction.varies();
+    }
+};
+
+struct ParamValue {
+    std::string name;
+    int components = 1;             // 1 (float, int) or 3
+    Keyframes<glm::vec3> value;     // one key when constant; components beyond `components` unused
+};
+
+struct ObjectTransform {
+    Keyframes<glm::vec3> translate;
+    Keyframes<glm::vec4> rotate;  // axis xyz, angle in degrees
+    Keyframes<float> scale;       // uniform, > 0
+    bool animated() const { return translate.varies() || rotate.varies() || scale.varies(); }
+};
+
+enum class Representation { Facets, ShaderMap };
+
+struct RangeOptions {
+    float distanceFactor = 2.0f;  // the view distance may change by this factor
+    float angle = 20.0f;          // degrees around the object
+};
+
+struct SceneObject {
+    std::string name;
+    std::string geometryType;  // scene-format name
+    std::shared_ptr<const Surface> surface;
+    std::string shaderName;
+    std::shared_ptr<const ShaderAst> shader;
+    std::vector<ParamValue> params;  // only the parameters the scene binds
+    ObjectTransform transform;
+    Representation representation = Representation::Facets;
+    int shadermapResolution = 0;  // 0: chosen from the screen size
+    RangeOptions range;
+};
+
+struct Scene {
+    std::string file;  // as given
+    RenderSettings settings;
+    Camera camera;
+    std::vector<Light> lights;
+    std::map<std::string, std::shared_ptr<const ShaderAst>> shaders;
+    std::vector<SceneObject> objects;
+
+    // Frames cover [0, duration): frame i is at time i / fps.
+    int frameCount() const;
+    float frameTime(int frame) const { return static_cast<float>(frame) / settings.fps; }
+};
+
+// Loads and validates a scene with its geometry and shaders. Throws InputError naming the
+// file and the JSON path (or the geometry/shader file's line) of the first problem.
+Scene loadScene(const std::string& path);
+
+}  // namespace mpshade
