@@ -20,7 +20,7 @@ struct BezierPatches {
     int chartCount() const { return static_cast<int>(controlPoints.size() / 16); }
     SurfaceSample evaluate(int chart, float u, float v) const;
     Bounds3 bounds() const;
-    int tessellationRate(int chart) const { return 12; }
+    int tessellationRate(int chart) const { return 32; }
 };
 
 // Loads a patch file; throws InputError naming file:line for malformed content.

@@ -136,11 +136,12 @@ bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, flo
     const glm::dvec3 o(org), d(dir);
     double u = at.u, v = at.v, t = tHit;
     bool converged = false;
-    for (int iter = 0; iter < 8; ++iter) {
+    int clampedSteps = 0;
+    for (int iter = 0; iter < 10; ++iter) {
         const SurfaceSample s = evaluate(surface_, {at.chart, static_cast<float>(u), static_cast<float>(v)});
         const glm::dvec3 residual = glm::dvec3(s.P) - (o + t * d);
         const double scale = std::fmax(glm::length(glm::dvec3(s.P)), 1e-30) + std::fabs(t) * glm::length(d);
-        if (glm::length(residual) <= 2e-7 * scale) {
+        if (glm::length(residual) <= 1e-6 * scale) {
             converged = true;
             break;
         }
@@ -149,11 +150,14 @@ bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, flo
         u += step.x;
         v += step.y;
         t += step.z;
-        // Leaving the chart means the true hit belongs to a neighbour: keep the
-        // tessellation's answer rather than extrapolate.
-        if (u < -1e-4 || u > 1.0 + 1e-4 || v < -1e-4 || v > 1.0 + 1e-4 || !std::isfinite(t)) break;
+        if (!std::isfinite(u + v + t)) break;
+        // A step may overshoot the chart; clamp and go on. If the true hit lies in a
+        // neighbouring chart the iteration stalls on the edge and the tessellation's
+        // answer is kept.
+        const bool outside = u < 0.0 || u > 1.0 || v < 0.0 || v > 1.0;
         u = std::fmin(std::fmax(u, 0.0), 1.0);
         v = std::fmin(std::fmax(v, 0.0), 1.0);
+        if (outside && ++clampedSteps > 3) break;
     }
     if (converged) {
         hit.at = {at.chart, static_cast<float>(u), static_cast<float>(v)};

@@ -35,7 +35,7 @@ public:
     int chartCount() const;
     SurfaceSample evaluate(int chart, float u, float v) const;
     Bounds3 bounds() const;
-    int tessellationRate(int chart) const { return 8; }
+    int tessellationRate(int chart) const { return 24; }
     // The cage face a chart belongs to.
     int chartFace(int chart) const;
 

@@ -23,9 +23,11 @@ glm::vec3 normalFromDerivatives(const glm::vec3& dPdu, const glm::vec3& dPdv,
                                 const glm::vec3& fallback) {
     glm::vec3 c = glm::cross(dPdu, dPdv);
     float len2 = glm::dot(c, c);
-    // Relative test: parallel or vanishing derivatives (poles, collapsed patch edges).
-    float scale = glm::dot(dPdu, dPdu) * glm::dot(dPdv, dPdv);
-    if (!(len2 > 1e-12f * scale) || !(len2 > 0.0f)) return fallback;
+    // Degenerate when the frame has (nearly) collapsed relative to its larger derivative:
+    // a vanishing derivative at a pole or collapsed patch edge is rounding noise, and its
+    // direction means nothing even though the cross product is not exactly zero.
+    const float big = std::fmax(glm::dot(dPdu, dPdu), glm::dot(dPdv, dPdv));
+    if (!(len2 > 1e-10f * big * big) || !(len2 > 0.0f)) return fallback;
     return c / std::sqrt(len2);
 }
 

@@ -1,6 +1,7 @@
 #include "scene/json_reader.h"
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -118,6 +119,30 @@ glm::vec3 JsonNode::vec3() const {
                      static_cast<float>(at(2).number()));
 }
 
+std::string shortNumber(double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%g", value);
+    return buffer;
+}
+
+namespace {
+
+InputLocation locationOfByte(const std::string& path, const std::string& text, size_t byte) {
+    if (byte > text.size()) byte = text.size();
+    int line = 1, col = 1;
+    for (size_t i = 0; i < byte; ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            col = 1;
+        } else {
+            ++col;
+        }
+    }
+    return {path, line, col, {}};
+}
+
+}  // namespace
+
 nlohmann::json parseJsonFile(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError({path, 0, 0, {}}, "cannot open scene file");
@@ -128,20 +153,19 @@ nlohmann::json parseJsonFile(const std::string& path) {
         return nlohmann::json::parse(text);
     } catch (const nlohmann::json::parse_error& e) {
         // e.byte is 1-based, at or just past the offending character.
-        size_t byte = e.byte > 0 ? e.byte - 1 : 0;
-        if (byte > text.size()) byte = text.size();
-        int line = 1, col = 1;
-        for (size_t i = 0; i < byte; ++i) {
-            if (text[i] == '\n') {
-                ++line;
-                col = 1;
-            } else {
-                ++col;
-            }
-        }
         std::string what = e.what();
         if (auto pos = what.find("syntax error"); pos != std::string::npos) what = what.substr(pos);
-        throw InputError({path, line, col, {}}, "invalid JSON: " + what);
+        throw InputError(locationOfByte(path, text, e.byte > 0 ? e.byte - 1 : 0), "invalid JSON: " + what);
+    } catch (const nlohmann::json::out_of_range& e) {
+        // "number overflow parsing '1e999'": point at the first occurrence of the literal.
+        std::string what = e.what();
+        if (auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
+        size_t byte = 0;
+        if (auto q = what.find('\''); q != std::string::npos) {
+            const std::string literal = what.substr(q + 1, what.rfind('\'') - q - 1);
+            if (auto at = text.find(literal); at != std::string::npos) byte = at;
+        }
+        throw InputError(locationOfByte(path, text, byte), "invalid JSON: " + what + " (numbers must be finite floats)");
     }
 }
 

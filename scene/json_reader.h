@@ -52,6 +52,9 @@ private:
     std::string path_;
 };
 
+// A number as a person writes it: 0.5, 1e-06, 12.
+std::string shortNumber(double value);
+
 // Parses a JSON file; syntax errors name file:line:col.
 nlohmann::json parseJsonFile(const std::string& path);
 

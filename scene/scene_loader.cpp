@@ -39,7 +39,7 @@ void readKeys(const JsonNode& keys, std::initializer_list<const char*> fields, F
         const float t = static_cast<float>(key["t"].number());
         if (!(t > previous))
             key["t"].fail("keys must be sorted by strictly increasing t (previous key has t = " +
-                          std::to_string(previous) + ")");
+                          shortNumber(previous) + ")");
         previous = t;
         read(key, t);
     }
@@ -121,6 +121,18 @@ private:
         return full;
     }
 
+    // Errors inside a file that a JSON value names (a mesh, a shader) keep their own
+    // file:line:col and say which value loaded the file.
+    template <typename F>
+    static auto withContext(const JsonNode& node, F&& load) {
+        try {
+            return load();
+        } catch (const InputError& e) {
+            if (e.where().file == node.file()) throw;
+            throw InputError(e.where(), e.message() + " (loading " + node.path() + " of " + node.file() + ")");
+        }
+    }
+
     void settings(const JsonNode& s) {
         s.allowKeys({"width", "height", "fps", "duration", "samples_per_pixel", "background"});
         RenderSettings& r = scene_.settings;
@@ -143,7 +155,7 @@ private:
         }
         if (auto n = c.optional("near")) cam.zNear = static_cast<float>(n->positive());
         if (auto n = c.optional("far")) cam.zFar = static_cast<float>(n->positive());
-        if (!(cam.zFar > cam.zNear)) c.fail("far (" + std::to_string(cam.zFar) + ") must exceed near (" + std::to_string(cam.zNear) + ")");
+        if (!(cam.zFar > cam.zNear)) c.fail("far (" + shortNumber(cam.zFar) + ") must exceed near (" + shortNumber(cam.zNear) + ")");
         if (auto k = c.optional("keys")) {
             readKeys(*k, {"eye", "target", "up"}, [&](const JsonNode& key, float t) {
                 addKey(cam.eye, key, "eye", t, vec3Of);
@@ -169,7 +181,7 @@ private:
         // The view direction must be defined at every key time.
         for (float t : cam.eye.times) {
             const glm::vec3 d = cam.target.at(t) - cam.eye.at(t);
-            if (!(d.x * d.x + d.y * d.y + d.z * d.z > 0.0f)) c.fail("eye and target coincide at t = " + std::to_string(t));
+            if (!(d.x * d.x + d.y * d.y + d.z * d.z > 0.0f)) c.fail("eye and target coincide at t = " + shortNumber(t));
         }
     }
 
@@ -227,7 +239,8 @@ private:
         if (!s.isObject()) s.fail("expected an object mapping shader names to .sl files");
         for (auto it = s.raw().begin(); it != s.raw().end(); ++it) {
             JsonNode entry(*it, s.file(), s.path() + "." + it.key());
-            scene_.shaders[it.key()] = loadShaderFile(existingFile(entry));
+            const std::string file = existingFile(entry);
+            scene_.shaders[it.key()] = withContext(entry, [&] { return loadShaderFile(file); });
         }
     }
 
@@ -323,7 +336,7 @@ private:
         if (obj.name.empty()) o["name"].fail("an object name must not be empty");
         for (const auto& other : scene_.objects)
             if (other.name == obj.name) o["name"].fail("another object is already named '" + obj.name + "'");
-        obj.surface = geometry(o["geometry"], obj.geometryType);
+        obj.surface = withContext(o["geometry"], [&] { return geometry(o["geometry"], obj.geometryType); });
         obj.shaderName = o["shader"].string();
         auto sh = scene_.shaders.find(obj.shaderName);
         if (sh == scene_.shaders.end()) o["shader"].fail("no shader named '" + obj.shaderName + "' in 'shaders'");
