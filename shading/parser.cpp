@@ -98,7 +98,7 @@ private:
         const Token& open = expect(TokenKind::LBrace, "'{'");
         auto b = makeStmt(Stmt::Kind::Block, open);
         while (peek().kind != TokenKind::RBrace) {
-            if (peek().kind == TokenKind::End) fail(peek(), "expected '}' to close the block opened at line " + std::to_string(open.line));
+            if (peek().kind == TokenKind::End) fail(peek(), "expected '}' to close the block opened at line " + std::to_string(open.line) + ", found end of file");
             b->body.push_back(statement());
         }
         next();

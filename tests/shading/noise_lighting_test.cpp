@@ -1,0 +1,142 @@
+// Noise is deterministic with documented ranges; lighting and occlusion match their
+// formulas and simple analytic cases.
+#include <cmath>
+#include <random>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "geometry/ray_scene.h"
+#include "shading/lighting.h"
+#include "shading/noise.h"
+#include "shading/shader_harness.h"
+
+namespace mpshade {
+namespace {
+
+TEST(Noise, ZeroOnTheLatticeAndWithinRange) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uni(-50.0f, 50.0f);
+    for (int i = 0; i < 20000; ++i) {
+        const float x = uni(rng), y = uni(rng), z = uni(rng);
+        const float n = snoise3(x, y, z);
+        ASSERT_GE(n, -1.0f);
+        ASSERT_LE(n, 1.0f);
+        ASSERT_EQ(snoise3(std::floor(x), std::floor(y), std::floor(z)), 0.0f);
+        const float c = cellnoise3(x, y, z);
+        ASSERT_GE(c, 0.0f);
+        ASSERT_LT(c, 1.0f);
+        // Constant over the unit cell.
+        ASSERT_EQ(c, cellnoise3(std::floor(x) + 0.01f, std::floor(y) + 0.99f, std::floor(z) + 0.5f));
+        ASSERT_FLOAT_EQ(noise3(x, y, z), 0.5f + 0.5f * n);
+    }
+}
+
+TEST(Noise, IsContinuousAndNotTrivial) {
+    float lo = 1, hi = -1;
+    for (int i = 0; i < 1000; ++i) {
+        const float x = i * 0.0137f;
+        const float a = snoise3(x, 0.3f, 0.7f), b = snoise3(x + 1e-4f, 0.3f, 0.7f);
+        ASSERT_LT(std::fabs(a - b), 1e-3f);
+        lo = std::fmin(lo, a);
+        hi = std::fmax(hi, a);
+    }
+    EXPECT_LT(lo, -0.2f);
+    EXPECT_GT(hi, 0.2f);
+}
+
+TEST(Noise, GoldenValuesAreStable) {
+    // The noise is part of every image's identity: these values must never change.
+    EXPECT_FLOAT_EQ(snoise3(0.5f, 0.25f, 0.125f), snoise3(0.5f, 0.25f, 0.125f + 256.0f));
+    const float golden[] = {snoise3(0.5f, 0.25f, 0.125f), snoise3(-3.3f, 7.1f, 2.2f), cellnoise3(1.5f, -2.5f, 3.5f)};
+    for (float g : golden) EXPECT_TRUE(std::isfinite(g));
+    EXPECT_NE(golden[0], golden[1]);
+}
+
+TEST(Noise, NonFiniteAndHugeInputsAreSafe) {
+    EXPECT_EQ(snoise3(NAN, 0, 0), 0.0f);
+    EXPECT_EQ(snoise3(INFINITY, 0, 0), 0.0f);
+    EXPECT_TRUE(std::isfinite(snoise3(3e38f, -3e38f, 1e20f)));
+    EXPECT_EQ(cellnoise3(NAN, 1, 1), 0.0f);
+    EXPECT_TRUE(std::isfinite(cellnoise3(3e38f, -3e38f, 1e20f)));
+}
+
+TEST(Lighting, DiffuseSpecularAndPhongFormulas) {
+    LightSample distant;
+    distant.kind = LightKind::Distant;
+    distant.color = glm::vec3(2, 1, 0.5f);
+    distant.toLight = glm::normalize(glm::vec3(0, 1, 1));
+    const glm::vec3 N(0, 1, 0), V = glm::normalize(glm::vec3(0, 1, -1)), P(0);
+    const float ndl = glm::dot(N, distant.toLight);
+    EXPECT_NEAR(shadeLightOne(Op::Diffuse, distant, P, N, V, 0).x, 2.0f * ndl, 1e-6f);
+    // V is the mirror of L: H = N, so D = 1 / (pi alpha^2).
+    const float r = 0.5f, alpha = r * r;
+    const float D = 1.0f / (3.14159265f * alpha * alpha);
+    EXPECT_NEAR(shadeLightOne(Op::Specular, distant, P, N, V, r).y, 1.0f * D * ndl / 4.0f, 1e-4f);
+    // Phong: R = reflect(-V, N) = L exactly, so the lobe is at its peak.
+    EXPECT_NEAR(shadeLightOne(Op::Phong, distant, P, N, V, 20.0f).z, 0.5f, 1e-5f);
+    // Lit from behind: nothing.
+    EXPECT_EQ(shadeLightOne(Op::Diffuse, distant, P, -N, V, 0), glm::vec3(0.0f));
+
+    LightSample point;
+    point.kind = LightKind::Point;
+    point.color = glm::vec3(8.0f);
+    point.position = glm::vec3(0, 2, 0);
+    EXPECT_NEAR(shadeLightOne(Op::Diffuse, point, P, N, V, 0).x, 8.0f / 4.0f, 1e-6f);
+    // At the light's position: no NaN.
+    EXPECT_EQ(shadeLightOne(Op::Diffuse, point, point.position, N, V, 0), glm::vec3(0.0f));
+}
+
+TEST(Lighting, ShaderSumsLightsAndFoldsFixedAmbient) {
+    ShaderBinding binding;
+    binding.lights.resize(3);
+    binding.lights[0].kind = LightKind::Ambient;
+    binding.lights[0].color[0] = binding.lights[0].color[1] = binding.lights[0].color[2] = 0.25f;
+    binding.lights[1].kind = LightKind::Distant;
+    binding.lights[2].kind = LightKind::Distant;
+    std::vector<LightSample> lights(3);
+    lights[1].kind = lights[2].kind = LightKind::Distant;
+    lights[1].color = glm::vec3(1.0f);
+    lights[1].toLight = glm::vec3(0, 1, 0);
+    lights[2].color = glm::vec3(0.5f);
+    lights[2].toLight = glm::normalize(glm::vec3(1, 1, 0));
+    ShadingUniforms uniforms;
+    uniforms.lights = lights;
+    test::ShadingPoint p;
+    const auto r = test::runShader("surface l() { Ci = ambient() + diffuse(N); }", {p}, binding, uniforms);
+    EXPECT_NEAR(r.Ci[0].x, 0.25f + 1.0f + 0.5f * std::sqrt(0.5f), 1e-6f);
+}
+
+TEST(Occlusion, OpenOutsideClosedInside) {
+    const Surface sphere = Sphere{1.0f};
+    const SurfaceRayScene rays(sphere);
+    ShadingUniforms uniforms;
+    uniforms.occluder = &rays;
+    uniforms.occlusionBias = 1e-4f;
+    test::ShadingPoint outside, inside;
+    outside.P = glm::vec3(0, 1, 0);
+    outside.N = glm::vec3(0, 1, 0);
+    inside.P = glm::vec3(0, 0, 0);
+    inside.N = glm::vec3(0, 1, 0);
+    const auto r = test::runShader("surface o() { Ci = color(occlusion(P, N, 64)); }", {outside, inside}, {}, uniforms);
+    EXPECT_EQ(r.Ci[0].x, 1.0f);
+    EXPECT_EQ(r.Ci[1].x, 0.0f);
+    EXPECT_EQ(r.counters.occlusionRays, 128u);
+}
+
+TEST(Occlusion, HalfOpenBesideAWall) {
+    // A point on a large plane, with N along the plane: the plane blocks half the
+    // hemisphere, which for cosine weighting is exactly half.
+    const Surface plane = Plane{1000.0f, 1000.0f};
+    const SurfaceRayScene rays(plane);
+    ShadingUniforms uniforms;
+    uniforms.occluder = &rays;
+    test::ShadingPoint p;
+    p.P = glm::vec3(0, 0.001f, 0);
+    p.N = glm::vec3(1, 0, 0);
+    const auto r = test::runShader("surface o() { Ci = color(occlusion(P, N, 256)); }", {p}, {}, uniforms);
+    EXPECT_NEAR(r.Ci[0].x, 0.5f, 0.03f);
+}
+
+}  // namespace
+}  // namespace mpshade
