@@ -92,12 +92,12 @@ int runRenderCommand(const RenderCommandOptions& options) {
     try {
         if (options.mode != "reference")
             throw InputError({"--mode", 0, 0, {}}, "unknown mode '" + options.mode + "' (available: reference)");
-        if (options.spp < 0 || options.spp > 1024)
+        if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
             throw InputError({"--spp", 0, 0, {}}, "expected 1..1024, found " + std::to_string(options.spp));
         const Scene scene = loadScene(options.scene);
         RenderOptions render;
         render.seed = options.seed;
-        render.samplesPerPixel = options.spp;
+        render.samplesPerPixel = options.spp > 0 ? options.spp : 0;
         parseSize(options.size, render.width, render.height);
         int first, last;
         parseFrames(options.frames, scene.frameCount(), first, last);

@@ -12,7 +12,7 @@ struct RenderCommandOptions {
     std::string mode = "reference";
     std::string frames;            // "A:B" half-open, or "N"; empty = every frame
     std::string size;              // "WxH"; empty = the scene's
-    int spp = 0;                   // 0 = the scene's
+    int spp = -1;                  // -1 = the scene's; else 1..1024
     uint32_t seed = 0;
     bool quiet = false;            // no progress bar
 };

@@ -164,16 +164,16 @@ private:
             });
         }
         if (auto n = c.optional("eye")) {
-            if (!cam.eye.empty()) n->fail("give 'eye' either in keys or directly, not both");
-            cam.eye = constant(n->vec3());
+            const glm::vec3 value = n->vec3();
+            if (cam.eye.empty()) cam.eye = constant(value);  // keys override
         }
         if (auto n = c.optional("target")) {
-            if (!cam.target.empty()) n->fail("give 'target' either in keys or directly, not both");
-            cam.target = constant(n->vec3());
+            const glm::vec3 value = n->vec3();
+            if (cam.target.empty()) cam.target = constant(value);  // keys override
         }
         if (auto n = c.optional("up")) {
-            if (!cam.up.empty()) n->fail("give 'up' either in keys or directly, not both");
-            cam.up = constant(directionOf(*n));
+            const glm::vec3 value = directionOf(*n);
+            if (cam.up.empty()) cam.up = constant(value);  // keys override
         }
         if (cam.eye.empty()) c.fail("the camera needs an 'eye' (directly or in keys)");
         if (cam.target.empty()) c.fail("the camera needs a 'target' (directly or in keys)");
@@ -218,10 +218,11 @@ private:
                          if (hasDir) addKey(light.direction, key, "direction", t, directionOf);
                      });
         }
+        // As for objects, keyed fields override the light's own (scene-format.md).
         auto direct = [&](const char* field, auto& frames, auto get) {
             if (auto n = l.optional(field)) {
-                if (!frames.empty()) n->fail(std::string("give '") + field + "' either in keys or directly, not both");
-                frames = constant(get(*n));
+                const auto value = get(*n);
+                if (frames.empty()) frames = constant(value);
             }
         };
         direct("color", light.color, colorOf);

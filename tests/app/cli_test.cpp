@@ -1,0 +1,142 @@
+// The mpshade command line as a user runs it: exit codes, messages naming the place,
+// and images OpenImageIO reads back.
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct CliRun {
+    int exitCode;
+    std::string output;  // stdout and stderr
+};
+
+CliRun mpshade(const std::string& args) {
+    const std::string command = "cd '" MPSHADE_SOURCE_DIR "' && '" MPSHADE_BINARY "' " + args + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    CliRun run{-1, ""};
+    if (!pipe) return run;
+    std::array<char, 4096> buffer;
+    while (fgets(buffer.data(), buffer.size(), pipe)) run.output += buffer.data();
+    const int status = pclose(pipe);
+    run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return run;
+}
+
+std::string tempDir(const std::string& name) {
+    const std::string dir = ::testing::TempDir() + "mpshade_cli_" + name;
+    std::filesystem::remove_all(dir);
+    return dir;
+}
+
+TEST(Cli, RendersTheVaseToReadableFrames) {
+    const std::string out = tempDir("vase");
+    const CliRun run = mpshade("render examples/vase/scene.json --mode reference --frames 0:2 --size 160x90 --out " + out);
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    for (const char* frame : {"frame_0000", "frame_0001"}) {
+        OIIO::ImageBuf exr(out + "/" + frame + ".exr");
+        ASSERT_TRUE(exr.read()) << exr.geterror();
+        EXPECT_EQ(exr.spec().width, 160);
+        EXPECT_EQ(exr.spec().nchannels, 4);
+        const auto stats = OIIO::ImageBufAlgo::computePixelStats(exr);
+        for (int c = 0; c < 4; ++c) {
+            EXPECT_EQ(stats.nancount[c], 0u);
+            EXPECT_EQ(stats.infcount[c], 0u);
+        }
+        // Not blank: the vase and floor cover much of the frame, with real contrast.
+        EXPECT_GT(stats.avg[3], 0.3f);
+        EXPECT_GT(stats.stddev[0], 0.05f);
+        OIIO::ImageBuf png(out + "/" + frame + ".png");
+        ASSERT_TRUE(png.read()) << png.geterror();
+        EXPECT_EQ(png.spec().nchannels, 3);
+    }
+    std::ifstream statsFile(out + "/stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(statsFile);
+    ASSERT_EQ(stats["frames"].size(), 2u);
+    EXPECT_EQ(stats["frames"][1]["index"], 1);
+    EXPECT_NEAR(stats["frames"][1]["time"].get<double>(), 1.0 / 24.0, 1e-6);
+    EXPECT_EQ(stats["frames"][0]["samples"], 160 * 90 * 4);
+    EXPECT_GT(stats["frames"][0]["shader_instructions"].get<double>(), 0.0);
+    EXPECT_GT(stats["frames"][0]["rays"].get<double>(), 0.0);
+    EXPECT_GT(stats["frames"][0]["wall_seconds"].get<double>(), 0.0);
+    EXPECT_EQ(run.output, "");  // no progress bar when stderr is not a terminal
+}
+
+TEST(Cli, SppAndSeedOverrideTheScene) {
+    const std::string out = tempDir("spp");
+    const CliRun run = mpshade("render examples/teapot/scene.json --frames 5 --size 40x30 --spp 2 --seed 3 --out " + out);
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_TRUE(std::filesystem::exists(out + "/frame_0005.exr"));
+    std::ifstream statsFile(out + "/stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(statsFile);
+    EXPECT_EQ(stats["frames"][0]["samples"], 40 * 30 * 2);
+    EXPECT_EQ(stats["seed"], 3);
+}
+
+struct BadRun {
+    const char* args;
+    const char* expected;  // the start of the output
+};
+
+TEST(Cli, BadInputExitsTwoNamingThePlace) {
+    const BadRun cases[] = {
+        {"render tests/data/bad_scenes/negative_radius.json --out /tmp/x",
+         "mpshade: tests/data/bad_scenes/negative_radius.json: objects[0].geometry.radius: error: expected a positive number, found -1\n"},
+        {"render tests/data/bad_scenes/syntax_error.json --out /tmp/x",
+         "mpshade: tests/data/bad_scenes/syntax_error.json:2:30: error: invalid JSON"},
+        {"render tests/data/bad_scenes/bad_shader.json --out /tmp/x",
+         "mpshade: tests/data/bad_shaders/missing_semicolon.sl:3:5: error: expected ';' after the statement, found 'Ci'"},
+        {"render tests/data/bad_scenes/malformed_obj.json --out /tmp/x",
+         "mpshade: tests/data/meshes/bad_number.obj:2:7: error: expected a number, found 'zero'"},
+        {"render examples/vase/scene.json --frames 0:999 --out /tmp/x",
+         "mpshade: --frames: error: the range 0:999 goes past the scene's 48 frames (0:48)\n"},
+        {"render examples/vase/scene.json --frames 3:3 --out /tmp/x",
+         "mpshade: --frames: error: the range 3:3 is empty"},
+        {"render examples/vase/scene.json --frames a:b --out /tmp/x",
+         "mpshade: --frames: error: expected A:B with whole numbers, found 'a:b'\n"},
+        {"render examples/vase/scene.json --size 0x10 --out /tmp/x",
+         "mpshade: --size: error: expected WxH with each in 1..16384, found '0x10'\n"},
+        {"render examples/vase/scene.json --mode fast --out /tmp/x",
+         "mpshade: --mode: error: unknown mode 'fast' (available: reference)\n"},
+        {"render examples/vase/scene.json --spp 0 --out /tmp/x", "mpshade: --spp: error: expected 1..1024, found 0\n"},
+        {"render nowhere.json --out /tmp/x", "mpshade: nowhere.json: error: cannot open scene file\n"},
+        {"render examples/vase/scene.json", "mpshade: error: --out is required"},
+        {"paint", "mpshade: error: "},
+    };
+    for (const BadRun& c : cases) {
+        const CliRun run = mpshade(c.args);
+        EXPECT_EQ(run.exitCode, 2) << c.args << "\n" << run.output;
+        EXPECT_EQ(run.output.rfind(c.expected, 0), 0u) << c.args << "\n" << run.output;
+    }
+}
+
+TEST(Cli, EveryBadSceneExitsTwo) {
+    int count = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(MPSHADE_SOURCE_DIR "/tests/data/bad_scenes")) {
+        const std::string rel = "tests/data/bad_scenes/" + entry.path().filename().string();
+        const CliRun run = mpshade("render " + rel + " --out " + tempDir("bad"));
+        EXPECT_EQ(run.exitCode, 2) << rel << "\n" << run.output;
+        EXPECT_NE(run.output.find(": error: "), std::string::npos) << run.output;
+        EXPECT_EQ(run.output.find("internal error"), std::string::npos) << run.output;
+        ++count;
+    }
+    EXPECT_GT(count, 20);
+}
+
+TEST(Cli, HelpAndVersion) {
+    EXPECT_EQ(mpshade("--version").exitCode, 0);
+    const CliRun help = mpshade("render --help");
+    EXPECT_EQ(help.exitCode, 0);
+    EXPECT_NE(help.output.find("--frames"), std::string::npos);
+}
+
+}  // namespace

@@ -1,0 +1,155 @@
+// The reference renderer on cases with known answers: silhouette coverage of a sphere,
+// front-to-back compositing of translucent layers, determinism, and non-finite shaders.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "phases/reference_renderer.h"
+#include "scene/scene.h"
+#include "test_support.h"
+
+namespace mpshade {
+namespace {
+
+std::string writeScene(const std::string& name, const std::string& json, const std::string& shader) {
+    const std::string dir = ::testing::TempDir() + "mpshade_render_test_" + name + "/";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "s.sl") << shader;
+    std::ofstream(dir + "scene.json") << json;
+    return dir + "scene.json";
+}
+
+const char* kBallScene = R"({
+  "settings": { "width": 96, "height": 96, "samples_per_pixel": 4, "background": [0, 0, 1] },
+  "camera": { "fov_y": 40, "eye": [0, 0, 6], "target": [0, 0, 0] },
+  "shaders": { "s": "s.sl" },
+  "objects": [ { "name": "ball", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s" } ]
+})";
+
+TEST(ReferenceRenderer, SphereCoverageMatchesItsSilhouette) {
+    const Scene scene = loadScene(writeScene("coverage", kBallScene, "surface s() { Ci = color(1, 0, 0); }"));
+    const ReferenceRenderer renderer(scene);
+    RenderOptions options;
+    FrameStats stats;
+    const SampleBuffer samples = renderer.renderSamples(0, options, stats);
+    // The silhouette is a circle of angular radius asin(r / d) around the image centre.
+    const float tanHalf = std::tan(20.0f * 3.14159265f / 180.0f);
+    const float radiusPx = std::tan(std::asin(1.0f / 6.0f)) / tanHalf * 48.0f;
+    int wrong = 0, boundary = 0;
+    for (size_t i = 0; i < samples.xy.size() / 2; ++i) {
+        const float dx = samples.xy[2 * i] - 48.0f, dy = samples.xy[2 * i + 1] - 48.0f;
+        const float r = std::sqrt(dx * dx + dy * dy);
+        const bool covered = samples.rgba[4 * i + 3] > 0.5f;
+        if (std::fabs(r - radiusPx) < 0.05f) {
+            ++boundary;
+            continue;
+        }
+        if (covered != (r < radiusPx)) ++wrong;
+        if (covered) {
+            ASSERT_EQ(samples.rgba[4 * i + 0], 1.0f);
+            ASSERT_EQ(samples.rgba[4 * i + 2], 0.0f);
+        } else {
+            ASSERT_EQ(samples.rgba[4 * i + 2], 1.0f);  // the background
+        }
+    }
+    EXPECT_EQ(wrong, 0);
+    EXPECT_LT(boundary, 200);
+    EXPECT_EQ(stats.samples, 96u * 96u * 4u);
+    EXPECT_EQ(stats.rays, stats.samples);
+}
+
+TEST(ReferenceRenderer, TranslucentLayersCompositeFrontToBack) {
+    // Two parallel planes facing the camera, each Oi = 0.5: red in front of green, on blue.
+    const char* json = R"({
+      "settings": { "width": 16, "height": 16, "samples_per_pixel": 1, "background": [0, 0, 1] },
+      "camera": { "fov_y": 30, "eye": [0, 5, 0], "target": [0, 0, 0], "up": [0, 0, -1] },
+      "shaders": { "s": "s.sl" },
+      "objects": [
+        { "name": "front", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
+          "params": { "c": [1, 0, 0] }, "transform": { "translate": [0, 1, 0] } },
+        { "name": "back", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
+          "params": { "c": [0, 1, 0] } } ]
+    })";
+    const Scene scene = loadScene(writeScene("layers", json, "surface s(color c = 0) { Ci = c; Oi = 0.5; }"));
+    const ReferenceRenderer renderer(scene);
+    FrameStats stats;
+    const Image image = renderer.renderFrame(0, {}, stats);
+    for (int y = 0; y < 16; ++y) {
+        for (int x = 0; x < 16; ++x) {
+            const float* p = image.pixel(x, y);
+            ASSERT_NEAR(p[0], 0.5f, 1e-5f);
+            ASSERT_NEAR(p[1], 0.25f, 1e-5f);
+            ASSERT_NEAR(p[2], 0.25f, 1e-5f);
+            ASSERT_NEAR(p[3], 0.75f, 1e-5f);
+        }
+    }
+    EXPECT_EQ(stats.rays, 3u * 256u);  // each camera ray passes two layers and leaves
+    EXPECT_EQ(stats.shadedPoints, 2u * 256u);
+}
+
+TEST(ReferenceRenderer, IsDeterministicForASeed) {
+    const Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
+    const ReferenceRenderer renderer(scene);
+    RenderOptions options;
+    options.width = 80;
+    options.height = 60;
+    FrameStats s1, s2, s3;
+    const Image a = renderer.renderFrame(3, options, s1);
+    const Image b = renderer.renderFrame(3, options, s2);
+    EXPECT_EQ(a.rgba, b.rgba);
+    options.seed = 99;
+    const Image c = renderer.renderFrame(3, options, s3);
+    EXPECT_NE(a.rgba, c.rgba);
+    EXPECT_EQ(s1.shaderInstructions, s2.shaderInstructions);
+}
+
+TEST(ReferenceRenderer, NonFiniteShaderResultsAreCountedAndZeroed) {
+    const Scene scene = loadScene(writeScene("nan", kBallScene, "surface s() { Ci = color(exp(1000 * u) - exp(1000 * u)); }"));
+    const ReferenceRenderer renderer(scene);
+    FrameStats stats;
+    const Image image = renderer.renderFrame(0, {}, stats);
+    EXPECT_GT(stats.nonFiniteSamples, 0u);
+    for (float v : image.rgba) ASSERT_TRUE(std::isfinite(v));
+}
+
+TEST(PixelFilter, PreservesAConstantImage) {
+    SampleBuffer samples;
+    samples.resize(7, 5, 3);
+    for (int y = 0; y < 5; ++y)
+        for (int x = 0; x < 7; ++x)
+            for (int k = 0; k < 3; ++k) {
+                const size_t i = samples.index(x, y, k);
+                samplePosition(1, x, y, k, 3, samples.xy[2 * i], samples.xy[2 * i + 1]);
+                for (int c = 0; c < 4; ++c) samples.rgba[4 * i + c] = 0.25f * (c + 1);
+            }
+    const Image image = resolvePixels(samples, {});
+    for (int y = 0; y < 5; ++y)
+        for (int x = 0; x < 7; ++x)
+            for (int c = 0; c < 4; ++c) ASSERT_NEAR(image.pixel(x, y)[c], 0.25f * (c + 1), 1e-6f);
+}
+
+TEST(SamplePattern, StratifiesWithinThePixel) {
+    for (int spp : {1, 4, 5, 16}) {
+        for (int k = 0; k < spp; ++k) {
+            float x, y;
+            samplePosition(0, 3, 7, k, spp, x, y);
+            EXPECT_GE(x, 3.0f);
+            EXPECT_LT(x, 4.0f);
+            EXPECT_GE(y, 7.0f);
+            EXPECT_LT(y, 8.0f);
+        }
+    }
+    // With 4 samples, one per quadrant.
+    int quadrants = 0;
+    for (int k = 0; k < 4; ++k) {
+        float x, y;
+        samplePosition(0, 0, 0, k, 4, x, y);
+        quadrants |= 1 << ((x >= 0.5f) + 2 * (y >= 0.5f));
+    }
+    EXPECT_EQ(quadrants, 15);
+}
+
+}  // namespace
+}  // namespace mpshade

@@ -1,0 +1,197 @@
+// The scene file: golden errors for a corpus of bad scenes, keys, the evolving scene at
+// time t, and which inputs of each object vary.
+#include <filesystem>
+#include <fstream>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "geometry/error.h"
+#include "scene/scene.h"
+#include "scene/scene_state.h"
+#include "scene/variability.h"
+#include "test_support.h"
+
+namespace mpshade {
+namespace {
+
+using test::sourcePath;
+
+struct BadScene {
+    const char* name;
+    const char* file;      // the file the error must name: "" = the scene itself
+    const char* jsonPath;  // "" when the error is not in JSON
+    int line, column;
+    const char* message;
+};
+
+const BadScene kBadScenes[] = {
+    {"missing_camera", "", "(top level)", 0, 0, "missing required key 'camera'"},
+    {"extra_key", "", "objects[0].colour", 0, 0, "unknown key 'colour' (expected one of: name, geometry, shader, params, transform, keys, representation, shadermap_resolution, range)"},
+    {"wrong_type", "", "objects[0].geometry.radius", 0, 0, "expected a number, found a string"},
+    {"negative_radius", "", "objects[0].geometry.radius", 0, 0, "expected a positive number, found -1"},
+    {"missing_obj", "", "objects[0].geometry.file", 0, 0, "file '../meshes/nope.obj' not found (looked for " },
+    {"malformed_obj", "tests/data/meshes/bad_number.obj", "", 2, 7, "expected a number, found 'zero' (loading objects[0].geometry of "},
+    {"bad_obj_index", "tests/data/meshes/bad_index.obj", "", 4, 7, "vertex index 4 is out of range (3 defined so far) (loading objects[0].geometry of "},
+    {"unsorted_keys", "", "camera.keys[1].t", 0, 0, "keys must be sorted by strictly increasing t (previous key has t = 1)"},
+    {"empty_scene", "", "objects", 0, 0, "the scene has no objects"},
+    {"zero_size", "", "settings.width", 0, 0, "expected a whole number in [1, 16384], found 0"},
+    {"zero_plane", "", "objects[0].geometry.size[0]", 0, 0, "expected a positive number, found 0"},
+    {"unknown_shader", "", "objects[0].shader", 0, 0, "no shader named 'marble' in 'shaders'"},
+    {"unknown_param", "", "objects[0].params.Kss", 0, 0, "shader 'plastic' has no parameter 'Kss' (it has: Cs, Kd, Ks, roughness)"},
+    {"param_type", "", "objects[0].params.Cs", 0, 0, "expected an array of 3 numbers, found a string"},
+    {"unknown_geometry", "", "objects[0].geometry.type", 0, 0, "unknown geometry type 'cone' (expected sphere, torus, plane, bezier, subdiv, mesh or points)"},
+    {"eye_is_target", "", "camera", 0, 0, "eye and target coincide at t = 0"},
+    {"bad_light", "", "lights[2].type", 0, 0, "unknown light type 'spot' (expected ambient, distant or point)"},
+    {"negative_color", "", "lights[0].color", 0, 0, "color components must be non-negative"},
+    {"bad_shader", "tests/data/bad_shaders/missing_semicolon.sl", "", 3, 5, "expected ';' after the statement, found 'Ci' (loading shaders.plastic of "},
+    {"bad_points", "tests/data/meshes/bad_points.txt", "", 2, 0, "the normal is zero (loading objects[0].geometry of "},
+    {"loop_quads", "tests/data/meshes/cube.obj", "", 0, 0, "face 0 has 4 sides; the loop scheme takes triangles only (loading objects[0].geometry of "},
+    {"empty_keys", "", "objects[0].keys", 0, 0, "expected at least one key"},
+    {"nonuniform_scale", "", "objects[0].transform.scale", 0, 0, "scale must be one positive number (mpshade supports uniform scale only)"},
+    {"duplicate_name", "", "objects[1].name", 0, 0, "another object is already named 'ball'"},
+    {"far_before_near", "", "camera", 0, 0, "far (0.01) must exceed near (0.1)"},
+    {"syntax_error", "", "", 2, 30, "invalid JSON: syntax error while parsing object key - unexpected '}'; expected string literal"},
+    {"nan_value", "", "", 79, 19, "invalid JSON: syntax error while parsing value - invalid literal; last read: '\"radius\": N'"},
+    {"inf_value", "", "", 79, 19, "invalid JSON: number overflow parsing '1e999' (numbers must be finite floats)"},
+    {"empty_file", "", "", 1, 1, "invalid JSON: syntax error while parsing value - unexpected end of input; expected '[', '{', or a literal"},
+    {"not_an_object", "", "(top level)", 0, 0, "a scene must be a JSON object"},
+};
+
+TEST(BadScenes, GoldenErrors) {
+    size_t checked = 0;
+    for (const BadScene& bad : kBadScenes) {
+        const std::string path = sourcePath(std::string("tests/data/bad_scenes/") + bad.name + ".json");
+        try {
+            loadScene(path);
+            ADD_FAILURE() << bad.name << " was accepted";
+        } catch (const InputError& e) {
+            const std::string expectedFile = *bad.file ? std::filesystem::path(sourcePath(bad.file)).lexically_normal().string() : path;
+            EXPECT_EQ(e.where().file, expectedFile) << bad.name;
+            EXPECT_EQ(e.where().jsonPath, bad.jsonPath) << bad.name;
+            EXPECT_EQ(e.where().line, bad.line) << bad.name;
+            EXPECT_EQ(e.where().column, bad.column) << bad.name;
+            EXPECT_EQ(e.message().rfind(bad.message, 0), 0u) << bad.name << ": " << e.message();
+        }
+        ++checked;
+    }
+    // Every file of the corpus is in the table.
+    size_t files = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(sourcePath("tests/data/bad_scenes"))) files += entry.path().extension() == ".json";
+    EXPECT_EQ(files, checked);
+}
+
+TEST(Keyframes, InterpolateLinearlyAndHoldOutside) {
+    Keyframes<float> k;
+    k.times = {1.0f, 3.0f};
+    k.values = {10.0f, 30.0f};
+    EXPECT_EQ(k.at(0.0f), 10.0f);
+    EXPECT_EQ(k.at(1.0f), 10.0f);
+    EXPECT_EQ(k.at(2.0f), 20.0f);
+    EXPECT_EQ(k.at(2.5f), 25.0f);
+    EXPECT_EQ(k.at(9.0f), 30.0f);
+    EXPECT_TRUE(k.varies());
+    k.values = {5.0f, 5.0f};
+    EXPECT_FALSE(k.varies());
+}
+
+class ExampleScenes : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(ExampleScenes, LoadAndBind) {
+    const Scene scene = loadScene(sourcePath(GetParam()));
+    EXPECT_GT(scene.objects.size(), 0u);
+    EXPECT_GT(scene.frameCount(), 1);
+    for (const SceneObject& obj : scene.objects) {
+        const ObjectVariability v = variabilityOf(scene, obj);
+        EXPECT_EQ(v.lightMovesRelative.size(), scene.lights.size());
+        const ShaderBinding b = bindingOf(scene, obj);
+        EXPECT_EQ(b.lights.size(), scene.lights.size());
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(All, ExampleScenes,
+                         ::testing::Values("examples/vase/scene.json", "examples/teapot/scene.json",
+                                           "examples/courtyard/scene.json"));
+
+std::string writeScene(const std::string& name, const std::string& json) {
+    const std::string dir = ::testing::TempDir() + "mpshade_scene_test/";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "s.sl") << "surface s(float k = 1, color c = 0) { Ci = c * k + diffuse(N) + color(time); }";
+    std::ofstream(dir + name) << json;
+    return dir + name;
+}
+
+TEST(Variability, FollowsWhatTheSceneAnimates) {
+    const std::string path = writeScene("var.json", R"({
+      "camera": { "eye": [0, 0, 5], "target": [0, 0, 0] },
+      "lights": [ { "type": "ambient", "color": [0.1, 0.1, 0.1] },
+                  { "type": "distant", "direction": [0, -1, 0] },
+                  { "type": "point", "position": [0, 3, 0],
+                    "keys": [ { "t": 0, "position": [0, 3, 0] }, { "t": 1, "position": [1, 3, 0] } ] } ],
+      "shaders": { "s": "s.sl" },
+      "objects": [
+        { "name": "still", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s",
+          "params": { "k": 2, "c": { "keys": [ { "t": 0, "value": [1, 0, 0] }, { "t": 1, "value": [0, 1, 0] } ] } } },
+        { "name": "moving", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s",
+          "params": { "c": { "keys": [ { "t": 0, "value": 1 }, { "t": 1, "value": 1 } ] } },
+          "keys": [ { "t": 0, "translate": [0, 0, 0] }, { "t": 1, "translate": [1, 0, 0] } ] } ]
+    })");
+    const Scene scene = loadScene(path);
+    const ObjectVariability still = variabilityOf(scene, scene.objects[0]);
+    EXPECT_FALSE(still.cameraMoves);
+    EXPECT_FALSE(still.transformAnimated);
+    EXPECT_EQ(still.lightMovesRelative, (std::vector<bool>{false, false, true}));
+    EXPECT_EQ(still.animatedParams, std::vector<std::string>{"c"});
+    const ObjectVariability moving = variabilityOf(scene, scene.objects[1]);
+    EXPECT_TRUE(moving.transformAnimated);
+    // The distant light is fixed in the world but moves relative to a moving object; an
+    // ambient light has no position.
+    EXPECT_EQ(moving.lightMovesRelative, (std::vector<bool>{false, true, true}));
+    // Keys with equal values do not animate.
+    EXPECT_TRUE(moving.animatedParams.empty());
+    const ShaderBinding b = bindingOf(scene, scene.objects[0]);
+    EXPECT_EQ(b.params.at("k").kind, ParamBinding::Kind::Constant);
+    EXPECT_EQ(b.params.at("k").value[0], 2.0f);
+    EXPECT_EQ(b.params.at("c").kind, ParamBinding::Kind::Animated);
+}
+
+TEST(SceneState, CameraRaysAndProjectionAgree) {
+    const Scene scene = loadScene(sourcePath("examples/vase/scene.json"));
+    const CameraState cam = cameraAt(scene, 0.5f, 320, 200);
+    for (float x : {0.5f, 100.0f, 319.5f}) {
+        for (float y : {0.5f, 77.0f, 199.5f}) {
+            float px, py;
+            ASSERT_TRUE(cam.project(cam.eye + 3.0f * cam.direction(x, y), px, py));
+            EXPECT_NEAR(px, x, 1e-3f);
+            EXPECT_NEAR(py, y, 1e-3f);
+        }
+    }
+    // The image centre looks at the target.
+    const glm::vec3 toTarget = glm::normalize(scene.camera.target.at(0.5f) - cam.eye);
+    EXPECT_NEAR(glm::dot(cam.direction(160, 100), toTarget), 1.0f, 1e-5f);
+}
+
+TEST(SceneState, LightsInObjectSpaceKeepWorldFalloff) {
+    const std::string path = writeScene("lights.json", R"({
+      "camera": { "eye": [0, 0, 5], "target": [0, 0, 0] },
+      "lights": [ { "type": "point", "position": [0, 4, 0], "intensity": 16 },
+                  { "type": "distant", "direction": [0, -1, 0] } ],
+      "shaders": { "s": "s.sl" },
+      "objects": [ { "name": "o", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s",
+                     "transform": { "translate": [0, 2, 0], "rotate": [0, 0, 1, 90], "scale": 2 } } ]
+    })");
+    const Scene scene = loadScene(path);
+    const CameraState cam = cameraAt(scene, 0, 64, 64);
+    const ObjectState st = objectAt(scene.objects[0], 0, cam);
+    std::vector<LightSample> lights;
+    lightsAt(scene, st, 0, lights);
+    // World: light 2 above the object's origin. Object space: 1 unit away, along -x
+    // (the object is rotated 90 degrees about z), with the world's 1/d^2 kept.
+    EXPECT_NEAR(glm::length(lights[0].position - glm::vec3(1, 0, 0)), 0.0f, 1e-5f);
+    const float worldIrradiance = 16.0f / (2.0f * 2.0f);
+    EXPECT_NEAR(lights[0].color.x / glm::dot(lights[0].position, lights[0].position), worldIrradiance, 1e-4f);
+    EXPECT_NEAR(glm::length(lights[1].toLight - glm::vec3(1, 0, 0)), 0.0f, 1e-5f);
+}
+
+}  // namespace
+}  // namespace mpshade
