@@ -13,7 +13,8 @@
 namespace mpshade {
 namespace {
 
-void write(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format, const void* data) {
+void write(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format,
+           const void* data) {
     auto out = OIIO::ImageOutput::create(path);
     if (!out) throw std::runtime_error("cannot write " + path + ": " + OIIO::geterror());
     if (!out->open(path, spec) || !out->write_image(format, data) || !out->close())
@@ -37,7 +38,8 @@ void writePng(const Image& image, const std::string& path) {
     std::vector<unsigned char> rgb(static_cast<size_t>(image.width) * image.height * 3);
     for (size_t i = 0; i < static_cast<size_t>(image.width) * image.height; ++i)
         for (int c = 0; c < 3; ++c)
-            rgb[3 * i + c] = static_cast<unsigned char>(std::lround(255.0f * linearToSrgb(image.rgba[4 * i + c])));
+            rgb[3 * i + c] = static_cast<unsigned char>(
+                std::lround(255.0f * linearToSrgb(image.rgba[4 * i + c])));
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
     write(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
 }

@@ -12,15 +12,19 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", "mpshade 0.1.0");
 
     mpshade::RenderCommandOptions render;
-    CLI::App* renderCmd = app.add_subcommand("render", "Render frames of a scene to OpenEXR and PNG");
+    CLI::App* renderCmd =
+        app.add_subcommand("render", "Render frames of a scene to OpenEXR and PNG");
     renderCmd->add_option("scene", render.scene, "Scene file (.json)")->required();
     renderCmd->add_option("--out", render.outDir, "Output folder (created if missing)")->required();
-    renderCmd->add_option("--mode", render.mode, "Renderer: reference (single-phase, exact geometry)")
+    renderCmd
+        ->add_option("--mode", render.mode, "Renderer: reference (single-phase, exact geometry)")
         ->capture_default_str();
-    renderCmd->add_option("--frames", render.frames, "Frames A:B (half-open; 0:2 is frames 0 and 1) or N");
+    renderCmd->add_option("--frames", render.frames,
+                          "Frames A:B (half-open; 0:2 is frames 0 and 1) or N");
     renderCmd->add_option("--size", render.size, "Image size WxH (overrides the scene)");
     renderCmd->add_option("--spp", render.spp, "Samples per pixel (overrides the scene)");
-    renderCmd->add_option("--seed", render.seed, "Seed of the sample positions")->capture_default_str();
+    renderCmd->add_option("--seed", render.seed, "Seed of the sample positions")
+        ->capture_default_str();
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
 
     try {

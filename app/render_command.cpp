@@ -6,8 +6,8 @@
 #include <fstream>
 #include <mutex>
 
-#include <nlohmann/json.hpp>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include "app/image_output.h"
 #include "geometry/error.h"
@@ -39,9 +39,12 @@ void parseFrames(const std::string& spec, int frameCount, int& first, int& last)
     } else if (!parseInt(spec.substr(0, colon), a) || !parseInt(spec.substr(colon + 1), b)) {
         throw InputError(where, "expected A:B with whole numbers, found '" + spec + "'");
     }
-    if (!(a < b)) throw InputError(where, "the range " + spec + " is empty (frames are half-open: 0:2 is frames 0 and 1)");
+    if (!(a < b))
+        throw InputError(
+            where, "the range " + spec + " is empty (frames are half-open: 0:2 is frames 0 and 1)");
     if (b > frameCount)
-        throw InputError(where, "the range " + spec + " goes past the scene's " + std::to_string(frameCount) +
+        throw InputError(where, "the range " + spec + " goes past the scene's " +
+                                    std::to_string(frameCount) +
                                     " frames (0:" + std::to_string(frameCount) + ")");
     first = static_cast<int>(a);
     last = static_cast<int>(b);
@@ -51,15 +54,16 @@ void parseSize(const std::string& spec, int& width, int& height) {
     if (spec.empty()) return;
     const auto x = spec.find('x');
     long w, h;
-    if (x == std::string::npos || !parseInt(spec.substr(0, x), w) || !parseInt(spec.substr(x + 1), h) ||
-        w < 1 || h < 1 || w > 16384 || h > 16384)
-        throw InputError({"--size", 0, 0, {}}, "expected WxH with each in 1..16384, found '" + spec + "'");
+    if (x == std::string::npos || !parseInt(spec.substr(0, x), w) ||
+        !parseInt(spec.substr(x + 1), h) || w < 1 || h < 1 || w > 16384 || h > 16384)
+        throw InputError({"--size", 0, 0, {}},
+                         "expected WxH with each in 1..16384, found '" + spec + "'");
     width = static_cast<int>(w);
     height = static_cast<int>(h);
 }
 
 class ProgressBar {
-public:
+  public:
     explicit ProgressBar(bool enabled) : enabled_(enabled) {}
     void update(int frame, int frames, int done, int total) {
         if (!enabled_) return;
@@ -70,8 +74,8 @@ public:
         if (percent == lastPercent_ && frame == lastFrame_) return;
         lastPercent_ = percent;
         lastFrame_ = frame;
-        std::fprintf(stderr, "\rframe %d (%d of %d) [%s%s] %3d%%", frame, frame - first_ + 1, frames,
-                     std::string(static_cast<size_t>(filled), '#').c_str(),
+        std::fprintf(stderr, "\rframe %d (%d of %d) [%s%s] %3d%%", frame, frame - first_ + 1,
+                     frames, std::string(static_cast<size_t>(filled), '#').c_str(),
                      std::string(static_cast<size_t>(width - filled), '.').c_str(), percent);
         std::fflush(stderr);
     }
@@ -80,7 +84,7 @@ public:
         if (enabled_) std::fprintf(stderr, "\n");
     }
 
-private:
+  private:
     bool enabled_;
     std::mutex mutex_;
     int lastPercent_ = -1, lastFrame_ = -1, first_ = 0;
@@ -91,9 +95,11 @@ private:
 int runRenderCommand(const RenderCommandOptions& options) {
     try {
         if (options.mode != "reference")
-            throw InputError({"--mode", 0, 0, {}}, "unknown mode '" + options.mode + "' (available: reference)");
+            throw InputError({"--mode", 0, 0, {}},
+                             "unknown mode '" + options.mode + "' (available: reference)");
         if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
-            throw InputError({"--spp", 0, 0, {}}, "expected 1..1024, found " + std::to_string(options.spp));
+            throw InputError({"--spp", 0, 0, {}},
+                             "expected 1..1024, found " + std::to_string(options.spp));
         const Scene scene = loadScene(options.scene);
         RenderOptions render;
         render.seed = options.seed;
@@ -104,7 +110,9 @@ int runRenderCommand(const RenderCommandOptions& options) {
 
         std::error_code ec;
         std::filesystem::create_directories(options.outDir, ec);
-        if (ec) throw InputError({options.outDir, 0, 0, {}}, "cannot create the output folder: " + ec.message());
+        if (ec)
+            throw InputError({options.outDir, 0, 0, {}},
+                             "cannot create the output folder: " + ec.message());
 
         const ReferenceRenderer renderer(scene);
         ProgressBar bar(!options.quiet && isatty(STDERR_FILENO));
@@ -113,9 +121,9 @@ int runRenderCommand(const RenderCommandOptions& options) {
         const auto start = std::chrono::steady_clock::now();
         for (int frame = first; frame < last; ++frame) {
             FrameStats stats;
-            const Image image = renderer.renderFrame(frame, render, stats, [&](int done, int total) {
-                bar.update(frame, last - first, done, total);
-            });
+            const Image image = renderer.renderFrame(
+                frame, render, stats,
+                [&](int done, int total) { bar.update(frame, last - first, done, total); });
             char name[32];
             std::snprintf(name, sizeof name, "frame_%04d", frame);
             const std::string base = (std::filesystem::path(options.outDir) / name).string();
@@ -139,9 +147,11 @@ int runRenderCommand(const RenderCommandOptions& options) {
             {"mode", options.mode},
             {"width", width},
             {"height", height},
-            {"samples_per_pixel", render.samplesPerPixel > 0 ? render.samplesPerPixel : scene.settings.samplesPerPixel},
+            {"samples_per_pixel",
+             render.samplesPerPixel > 0 ? render.samplesPerPixel : scene.settings.samplesPerPixel},
             {"seed", options.seed},
-            {"total_wall_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
+            {"total_wall_seconds",
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
             {"frames", frames}};
         std::ofstream out(std::filesystem::path(options.outDir) / "stats.json");
         out << doc.dump(2) << "\n";

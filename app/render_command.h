@@ -7,14 +7,14 @@
 namespace mpshade {
 
 struct RenderCommandOptions {
-    std::string scene;             // scene file
-    std::string outDir;            // created if missing
+    std::string scene;   // scene file
+    std::string outDir;  // created if missing
     std::string mode = "reference";
-    std::string frames;            // "A:B" half-open, or "N"; empty = every frame
-    std::string size;              // "WxH"; empty = the scene's
-    int spp = -1;                  // -1 = the scene's; else 1..1024
+    std::string frames;  // "A:B" half-open, or "N"; empty = every frame
+    std::string size;    // "WxH"; empty = the scene's
+    int spp = -1;        // -1 = the scene's; else 1..1024
     uint32_t seed = 0;
-    bool quiet = false;            // no progress bar
+    bool quiet = false;  // no progress bar
 };
 
 // Returns the process exit code: 0 success, 2 bad input (message already on stderr).

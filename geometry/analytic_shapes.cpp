@@ -27,7 +27,9 @@ SurfaceSample Sphere::evaluate(int, float u, float v) const {
     return s;
 }
 
-Bounds3 Sphere::bounds() const { return {glm::vec3(-radius), glm::vec3(radius)}; }
+Bounds3 Sphere::bounds() const {
+    return {glm::vec3(-radius), glm::vec3(radius)};
+}
 
 SurfaceSample Torus::evaluate(int, float u, float v) const {
     const float phi = kTwoPi * u;

@@ -22,7 +22,7 @@ struct Sphere {
 };
 
 struct Torus {
-    float major = 1.0f;  // ring radius, > minor
+    float major = 1.0f;   // ring radius, > minor
     float minor = 0.25f;  // tube radius, > 0
     int chartCount() const { return 1; }
     SurfaceSample evaluate(int chart, float u, float v) const;

@@ -23,8 +23,7 @@ void bernstein(float t, float b[4], float db[4]) {
     db[3] = 3.0f * t * t;
 }
 
-void evalPatch(const glm::vec3* cp, float u, float v, glm::vec3& P, glm::vec3& du,
-               glm::vec3& dv) {
+void evalPatch(const glm::vec3* cp, float u, float v, glm::vec3& P, glm::vec3& du, glm::vec3& dv) {
     float bu[4], dbu[4], bv[4], dbv[4];
     bernstein(u, bu, dbu);
     bernstein(v, bv, dbv);
@@ -41,7 +40,7 @@ void evalPatch(const glm::vec3* cp, float u, float v, glm::vec3& P, glm::vec3& d
 
 // Reads numbers from a patch file, tracking line numbers for diagnostics.
 class PatchFileReader {
-public:
+  public:
     explicit PatchFileReader(const std::string& path) : path_(path), in_(path) {
         if (!in_) throw InputError({path, 0, 0, {}}, "cannot open Bezier patch file");
     }
@@ -66,7 +65,7 @@ public:
         throw InputError({path_, line_, 0, {}}, message);
     }
 
-private:
+  private:
     std::string token(const char* what) {
         for (;;) {
             std::string tok;
@@ -136,10 +135,10 @@ BezierPatches loadBezierPatches(const std::string& path) {
     result.controlPoints.reserve(indices.size());
     for (size_t i = 0; i < indices.size(); ++i) {
         if (indices[i] < 1 || indices[i] > vertices)
-            throw InputError({path, 0, 0, {}},
-                             "patch " + std::to_string(i / 16) + " names control point " +
-                                 std::to_string(indices[i]) + ", outside 1.." +
-                                 std::to_string(vertices));
+            throw InputError({path, 0, 0, {}}, "patch " + std::to_string(i / 16) +
+                                                   " names control point " +
+                                                   std::to_string(indices[i]) + ", outside 1.." +
+                                                   std::to_string(vertices));
         result.controlPoints.push_back(points[static_cast<size_t>(indices[i] - 1)]);
     }
     return result;

@@ -12,10 +12,10 @@ namespace mpshade {
 
 // Where in the user's input something is. Any field may be empty/zero when unknown.
 struct InputLocation {
-    std::string file;       // path as the user gave it
-    int line = 0;           // 1-based; 0 = unknown
-    int column = 0;         // 1-based; 0 = unknown
-    std::string jsonPath;   // e.g. "objects[2].geometry.radius"; empty when not JSON
+    std::string file;      // path as the user gave it
+    int line = 0;          // 1-based; 0 = unknown
+    int column = 0;        // 1-based; 0 = unknown
+    std::string jsonPath;  // e.g. "objects[2].geometry.radius"; empty when not JSON
 
     // "file:line:col" or "file: objects[2].radius" -- the prefix of a diagnostic.
     std::string str() const;
@@ -23,12 +23,12 @@ struct InputLocation {
 
 // Bad user input. what() is the full one-line diagnostic: "<location>: error: <message>".
 class InputError : public std::runtime_error {
-public:
+  public:
     InputError(InputLocation where, const std::string& message);
     const InputLocation& where() const { return where_; }
     const std::string& message() const { return message_; }
 
-private:
+  private:
     InputLocation where_;
     std::string message_;
 };
@@ -38,5 +38,4 @@ private:
 }  // namespace mpshade
 
 // Internal invariant; failure is a bug in mpshade, never a user error.
-#define MPSHADE_CHECK(expr) \
-    ((expr) ? (void)0 : ::mpshade::checkFailed(#expr, __FILE__, __LINE__))
+#define MPSHADE_CHECK(expr) ((expr) ? (void)0 : ::mpshade::checkFailed(#expr, __FILE__, __LINE__))

@@ -14,14 +14,14 @@ namespace mpshade {
 namespace {
 
 class ObjLine {
-public:
+  public:
     ObjLine(const std::string& path, int line, std::string_view text)
         : path_(path), line_(line), text_(text) {}
 
     // Next white-space separated word; empty at end of line.
     std::string_view word() {
-        while (pos_ < text_.size() && (text_[pos_] == ' ' || text_[pos_] == '\t' ||
-                                       text_[pos_] == '\r'))
+        while (pos_ < text_.size() &&
+               (text_[pos_] == ' ' || text_[pos_] == '\t' || text_[pos_] == '\r'))
             ++pos_;
         wordStart_ = pos_;
         while (pos_ < text_.size() && text_[pos_] != ' ' && text_[pos_] != '\t' &&
@@ -46,7 +46,7 @@ public:
         throw InputError({path_, line_, static_cast<int>(wordStart_) + 1, {}}, message);
     }
 
-private:
+  private:
     const std::string& path_;
     int line_;
     std::string_view text_;
@@ -60,11 +60,12 @@ int resolveIndex(ObjLine& line, std::string_view text, size_t count, const char*
     std::string s(text);
     char* end = nullptr;
     long value = std::strtol(s.c_str(), &end, 10);
-    if (end == s.c_str() || *end != '\0') line.fail(std::string("malformed ") + what + " index '" + s + "'");
+    if (end == s.c_str() || *end != '\0')
+        line.fail(std::string("malformed ") + what + " index '" + s + "'");
     long resolved = value > 0 ? value - 1 : static_cast<long>(count) + value;
     if (value == 0 || resolved < 0 || resolved >= static_cast<long>(count))
-        line.fail(std::string(what) + " index " + s + " is out of range (" +
-                  std::to_string(count) + " defined so far)");
+        line.fail(std::string(what) + " index " + s + " is out of range (" + std::to_string(count) +
+                  " defined so far)");
     return static_cast<int>(resolved);
 }
 
@@ -111,13 +112,14 @@ PolygonMeshData readObjPolygons(const std::string& path) {
                     c.texcoord = resolveIndex(line, rest.substr(0, s2), mesh.texcoords.size(),
                                               "texture coordinate");
                     if (s2 != std::string_view::npos)
-                        c.normal = resolveIndex(line, rest.substr(s2 + 1), mesh.normals.size(),
-                                                "normal");
+                        c.normal =
+                            resolveIndex(line, rest.substr(s2 + 1), mesh.normals.size(), "normal");
                 }
                 mesh.corners.push_back(c);
                 ++size;
             }
-            if (size < 3) line.fail("a face needs at least 3 corners, this one has " + std::to_string(size));
+            if (size < 3)
+                line.fail("a face needs at least 3 corners, this one has " + std::to_string(size));
             mesh.faceSizes.push_back(size);
         } else if (kind == "o" || kind == "g" || kind == "s" || kind == "usemtl" ||
                    kind == "mtllib" || kind == "l" || kind == "p") {

@@ -72,7 +72,8 @@ PointCloud loadPointCloud(const std::string& path) {
         std::string word;
         while (words >> word) {
             if (count == 7)
-                throw InputError({path, lineNo, 0, {}}, "expected 7 numbers (x y z nx ny nz radius), found more");
+                throw InputError({path, lineNo, 0, {}},
+                                 "expected 7 numbers (x y z nx ny nz radius), found more");
             char* end = nullptr;
             double value = std::strtod(word.c_str(), &end);
             if (end == word.c_str() || *end != '\0' || !std::isfinite(value) ||
@@ -82,8 +83,9 @@ PointCloud loadPointCloud(const std::string& path) {
         }
         if (count == 0) continue;
         if (count != 7)
-            throw InputError({path, lineNo, 0, {}},
-                             "expected 7 numbers (x y z nx ny nz radius), found " + std::to_string(count));
+            throw InputError(
+                {path, lineNo, 0, {}},
+                "expected 7 numbers (x y z nx ny nz radius), found " + std::to_string(count));
         glm::vec3 n(f[3], f[4], f[5]);
         if (!(glm::length(n) > 0.0f)) throw InputError({path, lineNo, 0, {}}, "the normal is zero");
         if (!(f[6] > 0.0f)) throw InputError({path, lineNo, 0, {}}, "the radius must be positive");

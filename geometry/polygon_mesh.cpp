@@ -56,8 +56,14 @@ SurfaceSample PolygonMesh::evaluate(int chart, float u, float v) const {
         s.P += w[k] * p;
         s.dPdu += wu[k] * p;
         s.dPdv += wv[k] * p;
-        if (k_.normal >= 0) N += w[k] * data_.normals[k_.normal]; else hasN = false;
-        if (k_.texcoord >= 0) st += w[k] * data_.texcoords[k_.texcoord]; else hasT = false;
+        if (k_.normal >= 0)
+            N += w[k] * data_.normals[k_.normal];
+        else
+            hasN = false;
+        if (k_.texcoord >= 0)
+            st += w[k] * data_.texcoords[k_.texcoord];
+        else
+            hasT = false;
     }
     // The face's own edges give Ng even where a triangle chart collapses (v = 1).
     const glm::vec3& p0 = data_.positions[c.corner[0].position];

@@ -36,7 +36,7 @@ struct PolygonMeshData {
 PolygonMeshData readObjPolygons(const std::string& path);
 
 class PolygonMesh {
-public:
+  public:
     explicit PolygonMesh(PolygonMeshData data);
 
     int chartCount() const { return static_cast<int>(charts_.size()); }
@@ -45,7 +45,7 @@ public:
     int tessellationRate(int chart) const { return 1; }
     int droppedFaces() const { return dropped_; }
 
-private:
+  private:
     struct Chart {
         std::array<ObjCorner, 4> corner;
         bool quad;

@@ -4,9 +4,9 @@
 #include <cstdio>
 #include <limits>
 
-#include <glm/geometric.hpp>
-#include <xmmintrin.h>
 #include <pmmintrin.h>
+#include <xmmintrin.h>
+#include <glm/geometric.hpp>
 
 #include "geometry/error.h"
 
@@ -76,8 +76,8 @@ SurfaceRayScene::SurfaceRayScene(const Surface& surface) : surface_(surface) {
         std::vector<float> positions;
         const int charts = chartCount(surface);
         for (int chart = 0; chart < charts; ++chart) {
-            const int rate = std::visit([&](const auto& s) { return s.tessellationRate(chart); },
-                                        surface);
+            const int rate =
+                std::visit([&](const auto& s) { return s.tessellationRate(chart); }, surface);
             const unsigned base = static_cast<unsigned>(vertexUV_.size() / 2);
             for (int j = 0; j <= rate; ++j) {
                 for (int i = 0; i <= rate; ++i) {
@@ -111,10 +111,12 @@ SurfaceRayScene::SurfaceRayScene(const Surface& surface) : surface_(surface) {
     rtcCommitScene(scene_);
 }
 
-SurfaceRayScene::~SurfaceRayScene() { rtcReleaseScene(scene_); }
+SurfaceRayScene::~SurfaceRayScene() {
+    rtcReleaseScene(scene_);
+}
 
-bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, float bv,
-                                 float tHit, const glm::vec3& org, const glm::vec3& dir,
+bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, float bv, float tHit,
+                                 const glm::vec3& org, const glm::vec3& dir,
                                  SurfaceHit& hit) const {
     if (geomID == discGeom_) {
         const auto& cloud = std::get<PointCloud>(surface_);
@@ -125,10 +127,11 @@ bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, flo
     }
     const unsigned* tri = &triIndex_[3 * static_cast<size_t>(primID)];
     const float w0 = 1.0f - bu - bv;
-    ChartPoint at{triChart_[primID],
-                  w0 * vertexUV_[2 * tri[0]] + bu * vertexUV_[2 * tri[1]] + bv * vertexUV_[2 * tri[2]],
-                  w0 * vertexUV_[2 * tri[0] + 1] + bu * vertexUV_[2 * tri[1] + 1] +
-                      bv * vertexUV_[2 * tri[2] + 1]};
+    ChartPoint at{
+        triChart_[primID],
+        w0 * vertexUV_[2 * tri[0]] + bu * vertexUV_[2 * tri[1]] + bv * vertexUV_[2 * tri[2]],
+        w0 * vertexUV_[2 * tri[0] + 1] + bu * vertexUV_[2 * tri[1] + 1] +
+            bv * vertexUV_[2 * tri[2] + 1]};
     at.u = std::fmin(std::fmax(at.u, 0.0f), 1.0f);
     at.v = std::fmin(std::fmax(at.v, 0.0f), 1.0f);
 
@@ -138,9 +141,11 @@ bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, flo
     bool converged = false;
     int clampedSteps = 0;
     for (int iter = 0; iter < 10; ++iter) {
-        const SurfaceSample s = evaluate(surface_, {at.chart, static_cast<float>(u), static_cast<float>(v)});
+        const SurfaceSample s =
+            evaluate(surface_, {at.chart, static_cast<float>(u), static_cast<float>(v)});
         const glm::dvec3 residual = glm::dvec3(s.P) - (o + t * d);
-        const double scale = std::fmax(glm::length(glm::dvec3(s.P)), 1e-30) + std::fabs(t) * glm::length(d);
+        const double scale =
+            std::fmax(glm::length(glm::dvec3(s.P)), 1e-30) + std::fabs(t) * glm::length(d);
         if (glm::length(residual) <= 1e-6 * scale) {
             converged = true;
             break;
@@ -173,8 +178,8 @@ bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, flo
     return std::isfinite(hit.t);
 }
 
-bool SurfaceRayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tnear,
-                                float tfar, SurfaceHit& hit) const {
+bool SurfaceRayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar,
+                                SurfaceHit& hit) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh{};

@@ -28,12 +28,12 @@ void enableFlushToZero();
 
 struct SurfaceHit {
     ChartPoint at;
-    float t = 0.0f;       // ray parameter of the hit: P = org + t * dir
+    float t = 0.0f;        // ray parameter of the hit: P = org + t * dir
     bool refined = false;  // Newton converged on the exact surface
 };
 
 class SurfaceRayScene {
-public:
+  public:
     // The surface must outlive this object.
     explicit SurfaceRayScene(const Surface& surface);
     ~SurfaceRayScene();
@@ -57,14 +57,14 @@ public:
 
     size_t triangleCount() const { return triChart_.size(); }
 
-private:
+  private:
     const Surface& surface_;
     RTCScene scene_ = nullptr;
     unsigned triGeom_ = RTC_INVALID_GEOMETRY_ID;
     unsigned discGeom_ = RTC_INVALID_GEOMETRY_ID;
-    std::vector<int> triChart_;         // chart of each triangle
-    std::vector<unsigned> triIndex_;    // 3 vertex indices per triangle
-    std::vector<float> vertexUV_;       // (u, v) per tessellation vertex
+    std::vector<int> triChart_;       // chart of each triangle
+    std::vector<unsigned> triIndex_;  // 3 vertex indices per triangle
+    std::vector<float> vertexUV_;     // (u, v) per tessellation vertex
 };
 
 }  // namespace mpshade

@@ -2,10 +2,10 @@
 
 #include <cmath>
 
-#include <glm/geometric.hpp>
 #include <opensubdiv/bfr/refinerSurfaceFactory.h>
 #include <opensubdiv/bfr/surface.h>
 #include <opensubdiv/far/topologyDescriptor.h>
+#include <glm/geometric.hpp>
 
 #include "geometry/error.h"
 #include "geometry/polygon_mesh.h"
@@ -29,8 +29,7 @@ struct SubdivSurface::Impl {
     Bounds3 bounds;
 };
 
-SubdivSurface::SubdivSurface(const SubdivCage& cage, SubdivScheme scheme,
-                             const std::string& source)
+SubdivSurface::SubdivSurface(const SubdivCage& cage, SubdivScheme scheme, const std::string& source)
     : impl_(std::make_unique<Impl>()) {
     impl_->scheme = scheme;
     if (cage.positions.empty() || cage.faceSizes.empty())
@@ -54,8 +53,7 @@ SubdivSurface::SubdivSurface(const SubdivCage& cage, SubdivScheme scheme,
     Factory::Options options(scheme == SubdivScheme::Loop ? Sdc::SCHEME_LOOP : Sdc::SCHEME_CATMARK,
                              sdc);
     std::unique_ptr<Far::TopologyRefiner> refiner(Factory::Create(desc, options));
-    if (!refiner)
-        throw InputError({source, 0, 0, {}}, "OpenSubdiv rejected the cage topology");
+    if (!refiner) throw InputError({source, 0, 0, {}}, "OpenSubdiv rejected the cage topology");
 
     Bfr::RefinerSurfaceFactory<> factory(*refiner);
     const float* meshPoints = &cage.positions[0].x;
@@ -97,9 +95,15 @@ SubdivSurface::~SubdivSurface() = default;
 SubdivSurface::SubdivSurface(SubdivSurface&&) noexcept = default;
 SubdivSurface& SubdivSurface::operator=(SubdivSurface&&) noexcept = default;
 
-int SubdivSurface::chartCount() const { return static_cast<int>(impl_->charts.size()); }
-int SubdivSurface::chartFace(int chart) const { return impl_->charts[chart].face; }
-Bounds3 SubdivSurface::bounds() const { return impl_->bounds; }
+int SubdivSurface::chartCount() const {
+    return static_cast<int>(impl_->charts.size());
+}
+int SubdivSurface::chartFace(int chart) const {
+    return impl_->charts[chart].face;
+}
+Bounds3 SubdivSurface::bounds() const {
+    return impl_->bounds;
+}
 
 SurfaceSample SubdivSurface::evaluate(int chart, float u, float v) const {
     const Impl::Chart& c = impl_->charts[static_cast<size_t>(chart)];
@@ -132,8 +136,9 @@ SurfaceSample SubdivSurface::evaluate(int chart, float u, float v) const {
     // The face's own frame gives the normal even where the chart collapses (Loop, v = 1).
     glm::vec3 n = normalFromDerivatives(du, dv, glm::vec3(0.0f));
     if (n == glm::vec3(0.0f)) {
-        float inner[2] = {uv[0] + 1e-3f * ((impl_->scheme == SubdivScheme::Loop ? 1.0f / 3.0f : 0.5f) - uv[0]),
-                          uv[1] + 1e-3f * ((impl_->scheme == SubdivScheme::Loop ? 1.0f / 3.0f : 0.5f) - uv[1])};
+        float inner[2] = {
+            uv[0] + 1e-3f * ((impl_->scheme == SubdivScheme::Loop ? 1.0f / 3.0f : 0.5f) - uv[0]),
+            uv[1] + 1e-3f * ((impl_->scheme == SubdivScheme::Loop ? 1.0f / 3.0f : 0.5f) - uv[1])};
         float P2[3], Du2[3], Dv2[3];
         surface.Evaluate(inner, pts, 3, P2, Du2, Dv2);
         n = normalFromDerivatives(glm::vec3(Du2[0], Du2[1], Du2[2]),

@@ -24,7 +24,7 @@ struct SubdivCage {
 };
 
 class SubdivSurface {
-public:
+  public:
     // Builds the limit surface; throws InputError (naming `source`) for cages OpenSubdiv
     // cannot subdivide (e.g. non-triangles with Loop, or no valid face).
     SubdivSurface(const SubdivCage& cage, SubdivScheme scheme, const std::string& source);
@@ -39,7 +39,7 @@ public:
     // The cage face a chart belongs to.
     int chartFace(int chart) const;
 
-private:
+  private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };

@@ -5,8 +5,8 @@
 namespace mpshade {
 
 const char* surfaceTypeName(const Surface& surface) {
-    static constexpr const char* kNames[] = {"sphere", "torus",  "plane", "bezier",
-                                             "subdiv", "mesh", "points"};
+    static constexpr const char* kNames[] = {"sphere", "torus", "plane", "bezier",
+                                             "subdiv", "mesh",  "points"};
     return kNames[surface.index()];
 }
 

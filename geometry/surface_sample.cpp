@@ -17,7 +17,9 @@ void Bounds3::extend(const Bounds3& b) {
     extend(b.hi);
 }
 
-float Bounds3::diagonal() const { return empty() ? 0.0f : glm::length(hi - lo); }
+float Bounds3::diagonal() const {
+    return empty() ? 0.0f : glm::length(hi - lo);
+}
 
 glm::vec3 normalFromDerivatives(const glm::vec3& dPdu, const glm::vec3& dPdv,
                                 const glm::vec3& fallback) {

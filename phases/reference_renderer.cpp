@@ -6,20 +6,20 @@
 #include <cmath>
 #include <limits>
 
-#include <glm/geometric.hpp>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <glm/geometric.hpp>
 
 namespace mpshade {
 namespace {
 
 struct PendingRay {
-    uint32_t sample;   // index into the tile's sample arrays
+    uint32_t sample;  // index into the tile's sample arrays
     float tnear, tfar;
 };
 
 struct Hit {
-    uint32_t ray;      // index into the pending rays
+    uint32_t ray;  // index into the pending rays
     uint32_t object;
     unsigned geomID, primID;
     float u, v, t;
@@ -27,16 +27,16 @@ struct Hit {
 
 // Per-thread scratch, reused across tiles so the hot loops never allocate once warm.
 struct Scratch {
-    std::vector<glm::vec3> dir;       // per tile sample, world space
-    std::vector<float> color;         // 3 per tile sample
-    std::vector<float> transmit;      // 3 per tile sample
+    std::vector<glm::vec3> dir;   // per tile sample, world space
+    std::vector<float> color;     // 3 per tile sample
+    std::vector<float> transmit;  // 3 per tile sample
     std::vector<PendingRay> active, next;
     std::vector<Hit> hits;
     std::vector<ChartPoint> chart;
     std::vector<SurfaceSample> geom;
     std::vector<uint32_t> hitOfPoint;
-    std::vector<float> soa;           // shading inputs and outputs, structure of arrays
-    std::vector<float> workspace;     // interpreter registers
+    std::vector<float> soa;        // shading inputs and outputs, structure of arrays
+    std::vector<float> workspace;  // interpreter registers
     FrameStats counters;
 };
 
@@ -52,7 +52,8 @@ Image ReferenceRenderer::renderFrame(int frame, const RenderOptions& options, Fr
     const SampleBuffer samples = renderSamples(frame, options, stats, progress);
     const auto start = std::chrono::steady_clock::now();
     Image image = resolvePixels(samples, options.filter);
-    stats.wallSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.wallSeconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return image;
 }
 
@@ -62,7 +63,8 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
     const RenderSettings& settings = scene_.settings;
     const int width = options.width > 0 ? options.width : settings.width;
     const int height = options.height > 0 ? options.height : settings.height;
-    const int spp = options.samplesPerPixel > 0 ? options.samplesPerPixel : settings.samplesPerPixel;
+    const int spp =
+        options.samplesPerPixel > 0 ? options.samplesPerPixel : settings.samplesPerPixel;
     const float time = scene_.frameTime(frame);
 
     const CameraState camera = cameraAt(scene_, time, width, height);
@@ -117,7 +119,8 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
                     s.dir[local] = camera.direction(x, y);
                     // Clip to the near and far planes, which are perpendicular to the view axis.
                     const float cosine = glm::dot(s.dir[local], camera.forward);
-                    s.active.push_back({static_cast<uint32_t>(local), camera.zNear / cosine, camera.zFar / cosine});
+                    s.active.push_back({static_cast<uint32_t>(local), camera.zNear / cosine,
+                                        camera.zFar / cosine});
                 }
             }
         }
@@ -130,7 +133,8 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
                 rtcInitIntersectContext(&ctx);
                 RTCRayHit rh{};
                 const glm::vec3& d = s.dir[pr.sample];
-                rh.ray.org_x = camera.eye.x, rh.ray.org_y = camera.eye.y, rh.ray.org_z = camera.eye.z;
+                rh.ray.org_x = camera.eye.x, rh.ray.org_y = camera.eye.y,
+                rh.ray.org_z = camera.eye.z;
                 rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
                 rh.ray.tnear = pr.tnear;
                 rh.ray.tfar = pr.tfar;
@@ -140,7 +144,8 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
                 rtcIntersect1(world.scene(), &ctx, &rh);
                 ++s.counters.rays;
                 if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
-                s.hits.push_back({r, rh.hit.instID[0], rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar});
+                s.hits.push_back({r, rh.hit.instID[0], rh.hit.geomID, rh.hit.primID, rh.hit.u,
+                                  rh.hit.v, rh.ray.tfar});
             }
             // Shade the hits object by object, each object's points as one batch.
             std::sort(s.hits.begin(), s.hits.end(), [](const Hit& a, const Hit& b) {
@@ -164,9 +169,11 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
                     Hit& hit = s.hits[h];
                     const PendingRay& pr = s.active[hit.ray];
                     const glm::vec3 org = glm::vec3(st.worldToObject * glm::vec4(camera.eye, 1.0f));
-                    const glm::vec3 dir = glm::vec3(st.worldToObject * glm::vec4(s.dir[pr.sample], 0.0f));
+                    const glm::vec3 dir =
+                        glm::vec3(st.worldToObject * glm::vec4(s.dir[pr.sample], 0.0f));
                     SurfaceHit sh;
-                    if (!rs.resolveHit(hit.geomID, hit.primID, hit.u, hit.v, hit.t, org, dir, sh)) continue;
+                    if (!rs.resolveHit(hit.geomID, hit.primID, hit.u, hit.v, hit.t, org, dir, sh))
+                        continue;
                     hit.t = sh.t;
                     const size_t p = s.chart.size();
                     s.chart.push_back(sh.at);
@@ -176,7 +183,8 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
                 }
                 const size_t points = s.chart.size();
                 s.geom.resize(points);
-                evaluateBatch(rs.surface(), s.chart, std::span<SurfaceSample>(s.geom.data(), points));
+                evaluateBatch(rs.surface(), s.chart,
+                              std::span<SurfaceSample>(s.geom.data(), points));
                 for (size_t p = 0; p < points; ++p) {
                     const SurfaceSample& g = s.geom[p];
                     for (int k = 0; k < 3; ++k) {
@@ -272,7 +280,8 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
         stats.shaderInstructions += s.counters.shaderInstructions;
         stats.nonFiniteSamples += s.counters.nonFiniteSamples;
     }
-    stats.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.wallSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return samples;
 }
 

@@ -14,12 +14,12 @@
 namespace mpshade {
 
 struct RenderOptions {
-    int width = 0;           // 0: the scene's setting
-    int height = 0;          // 0: the scene's setting
+    int width = 0;            // 0: the scene's setting
+    int height = 0;           // 0: the scene's setting
     int samplesPerPixel = 0;  // 0: the scene's setting
-    uint32_t seed = 0;       // sample positions depend only on this (and the pixel)
-    int tileSize = 16;       // pixels per side of a parallel work item
-    int maxLayers = 16;      // translucent surfaces a camera ray passes through at most
+    uint32_t seed = 0;        // sample positions depend only on this (and the pixel)
+    int tileSize = 16;        // pixels per side of a parallel work item
+    int maxLayers = 16;       // translucent surfaces a camera ray passes through at most
     PixelFilter filter;
 };
 
@@ -27,7 +27,7 @@ struct RenderOptions {
 using ProgressFn = std::function<void(int, int)>;
 
 class ReferenceRenderer {
-public:
+  public:
     explicit ReferenceRenderer(const Scene& scene);
 
     // Renders frame `frame` (time frame / fps). Deterministic for given options.
@@ -41,7 +41,7 @@ public:
 
     const SceneResources& resources() const { return resources_; }
 
-private:
+  private:
     const Scene& scene_;
     SceneResources resources_;
 };

@@ -49,8 +49,10 @@ Image resolvePixels(const SampleBuffer& samples, const PixelFilter& filter) {
         for (int px = 0; px < samples.width; ++px) {
             const float cx = static_cast<float>(px) + 0.5f, cy = static_cast<float>(py) + 0.5f;
             double sum[4] = {0, 0, 0, 0}, weight = 0.0;
-            for (int qy = std::max(0, py - reach); qy <= std::min(samples.height - 1, py + reach); ++qy) {
-                for (int qx = std::max(0, px - reach); qx <= std::min(samples.width - 1, px + reach); ++qx) {
+            for (int qy = std::max(0, py - reach); qy <= std::min(samples.height - 1, py + reach);
+                 ++qy) {
+                for (int qx = std::max(0, px - reach);
+                     qx <= std::min(samples.width - 1, px + reach); ++qx) {
                     for (int k = 0; k < samples.spp; ++k) {
                         const size_t i = samples.index(qx, qy, k);
                         const float dx = std::fabs(samples.xy[2 * i] - cx);
@@ -64,7 +66,8 @@ Image resolvePixels(const SampleBuffer& samples, const PixelFilter& filter) {
                 }
             }
             float* out = image.pixel(px, py);
-            for (int c = 0; c < 4; ++c) out[c] = weight > 0.0 ? static_cast<float>(sum[c] / weight) : 0.0f;
+            for (int c = 0; c < 4; ++c)
+                out[c] = weight > 0.0 ? static_cast<float>(sum[c] / weight) : 0.0f;
         }
     });
     return image;

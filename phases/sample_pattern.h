@@ -3,8 +3,8 @@
 // each sample's color was computed.
 #pragma once
 
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "phases/image.h"

@@ -17,14 +17,16 @@ SceneResources::SceneResources(const Scene& scene) : scene_(scene) {
     }
 }
 
-WorldRayScene::WorldRayScene(const SceneResources& resources, const std::vector<ObjectState>& states) {
+WorldRayScene::WorldRayScene(const SceneResources& resources,
+                             const std::vector<ObjectState>& states) {
     RTCDevice device = embreeDevice();
     scene_ = rtcNewScene(device);
     rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
     for (size_t i = 0; i < resources.objectCount(); ++i) {
         RTCGeometry inst = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(inst, resources.object(i).rayScene->scene());
-        rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &states[i].objectToWorld[0][0]);
+        rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR,
+                                &states[i].objectToWorld[0][0]);
         rtcCommitGeometry(inst);
         rtcAttachGeometryByID(scene_, inst, static_cast<unsigned>(i));
         rtcReleaseGeometry(inst);
@@ -32,6 +34,8 @@ WorldRayScene::WorldRayScene(const SceneResources& resources, const std::vector<
     rtcCommitScene(scene_);
 }
 
-WorldRayScene::~WorldRayScene() { rtcReleaseScene(scene_); }
+WorldRayScene::~WorldRayScene() {
+    rtcReleaseScene(scene_);
+}
 
 }  // namespace mpshade

@@ -20,13 +20,13 @@ struct ObjectResources {
 };
 
 class SceneResources {
-public:
+  public:
     explicit SceneResources(const Scene& scene);
     const Scene& scene() const { return scene_; }
     const ObjectResources& object(size_t i) const { return objects_[i]; }
     size_t objectCount() const { return objects_.size(); }
 
-private:
+  private:
     const Scene& scene_;
     std::vector<ObjectResources> objects_;
     std::map<const Surface*, std::unique_ptr<SurfaceRayScene>> rayScenes_;
@@ -35,14 +35,14 @@ private:
 // The frame's world: Embree instances of each object's surface, placed at time t.
 // Instance (geometry) id i is scene object i.
 class WorldRayScene {
-public:
+  public:
     WorldRayScene(const SceneResources& resources, const std::vector<ObjectState>& states);
     ~WorldRayScene();
     WorldRayScene(const WorldRayScene&) = delete;
     WorldRayScene& operator=(const WorldRayScene&) = delete;
     RTCScene scene() const { return scene_; }
 
-private:
+  private:
     RTCScene scene_ = nullptr;
 };
 

@@ -22,7 +22,8 @@ struct Keyframes {
     T at(float t) const {
         if (times.size() == 1 || t <= times.front()) return values.front();
         if (t >= times.back()) return values.back();
-        const size_t hi = static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
+        const size_t hi =
+            static_cast<size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
         const size_t lo = hi - 1;
         const float w = (t - times[lo]) / (times[hi] - times[lo]);
         return values[lo] * (1.0f - w) + values[hi] * w;

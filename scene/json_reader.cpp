@@ -12,15 +12,22 @@ namespace {
 
 const char* kindOf(const nlohmann::json& j) {
     switch (j.type()) {
-        case nlohmann::json::value_t::null: return "null";
-        case nlohmann::json::value_t::object: return "an object";
-        case nlohmann::json::value_t::array: return "an array";
-        case nlohmann::json::value_t::string: return "a string";
-        case nlohmann::json::value_t::boolean: return "a boolean";
+        case nlohmann::json::value_t::null:
+            return "null";
+        case nlohmann::json::value_t::object:
+            return "an object";
+        case nlohmann::json::value_t::array:
+            return "an array";
+        case nlohmann::json::value_t::string:
+            return "a string";
+        case nlohmann::json::value_t::boolean:
+            return "a boolean";
         case nlohmann::json::value_t::number_integer:
         case nlohmann::json::value_t::number_unsigned:
-        case nlohmann::json::value_t::number_float: return "a number";
-        default: return "a value";
+        case nlohmann::json::value_t::number_float:
+            return "a number";
+        default:
+            return "a value";
     }
 }
 
@@ -30,10 +37,18 @@ void JsonNode::fail(const std::string& message) const {
     throw InputError({file_, 0, 0, path_.empty() ? std::string("(top level)") : path_}, message);
 }
 
-bool JsonNode::isObject() const { return value_->is_object(); }
-bool JsonNode::isArray() const { return value_->is_array(); }
-bool JsonNode::isNumber() const { return value_->is_number(); }
-bool JsonNode::has(const char* key) const { return value_->is_object() && value_->contains(key); }
+bool JsonNode::isObject() const {
+    return value_->is_object();
+}
+bool JsonNode::isArray() const {
+    return value_->is_array();
+}
+bool JsonNode::isNumber() const {
+    return value_->is_number();
+}
+bool JsonNode::has(const char* key) const {
+    return value_->is_object() && value_->contains(key);
+}
 
 JsonNode JsonNode::operator[](const char* key) const {
     if (!value_->is_object()) fail(std::string("expected an object, found ") + kindOf(*value_));
@@ -107,14 +122,16 @@ std::string JsonNode::string() const {
 }
 
 bool JsonNode::boolean() const {
-    if (!value_->is_boolean()) fail(std::string("expected true or false, found ") + kindOf(*value_));
+    if (!value_->is_boolean())
+        fail(std::string("expected true or false, found ") + kindOf(*value_));
     return value_->get<bool>();
 }
 
 glm::vec3 JsonNode::vec3() const {
     if (!value_->is_array() || value_->size() != 3)
         fail(std::string("expected an array of 3 numbers, found ") +
-             (value_->is_array() ? "an array of " + std::to_string(value_->size()) : kindOf(*value_)));
+             (value_->is_array() ? "an array of " + std::to_string(value_->size())
+                                 : kindOf(*value_)));
     return glm::vec3(static_cast<float>(at(0).number()), static_cast<float>(at(1).number()),
                      static_cast<float>(at(2).number()));
 }
@@ -155,7 +172,8 @@ nlohmann::json parseJsonFile(const std::string& path) {
         // e.byte is 1-based, at or just past the offending character.
         std::string what = e.what();
         if (auto pos = what.find("syntax error"); pos != std::string::npos) what = what.substr(pos);
-        throw InputError(locationOfByte(path, text, e.byte > 0 ? e.byte - 1 : 0), "invalid JSON: " + what);
+        throw InputError(locationOfByte(path, text, e.byte > 0 ? e.byte - 1 : 0),
+                         "invalid JSON: " + what);
     } catch (const nlohmann::json::out_of_range& e) {
         // "number overflow parsing '1e999'": point at the first occurrence of the literal.
         std::string what = e.what();
@@ -165,7 +183,8 @@ nlohmann::json parseJsonFile(const std::string& path) {
             const std::string literal = what.substr(q + 1, what.rfind('\'') - q - 1);
             if (auto at = text.find(literal); at != std::string::npos) byte = at;
         }
-        throw InputError(locationOfByte(path, text, byte), "invalid JSON: " + what + " (numbers must be finite floats)");
+        throw InputError(locationOfByte(path, text, byte),
+                         "invalid JSON: " + what + " (numbers must be finite floats)");
     }
 }
 

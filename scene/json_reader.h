@@ -15,7 +15,7 @@
 namespace mpshade {
 
 class JsonNode {
-public:
+  public:
     JsonNode(const nlohmann::json& value, std::string file, std::string path)
         : value_(&value), file_(std::move(file)), path_(std::move(path)) {}
 
@@ -30,8 +30,8 @@ public:
 
     JsonNode operator[](const char* key) const;  // required member of an object
     std::optional<JsonNode> optional(const char* key) const;
-    size_t size() const;                          // array length (requires an array)
-    JsonNode at(size_t index) const;              // array element
+    size_t size() const;              // array length (requires an array)
+    JsonNode at(size_t index) const;  // array element
 
     // Fails unless this is an object whose keys are all in `allowed`.
     void allowKeys(std::initializer_list<const char*> allowed) const;
@@ -46,7 +46,7 @@ public:
 
     [[noreturn]] void fail(const std::string& message) const;
 
-private:
+  private:
     const nlohmann::json* value_;
     std::string file_;
     std::string path_;

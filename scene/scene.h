@@ -18,18 +18,18 @@
 namespace mpshade {
 
 struct RenderSettings {
-    int width = 640;           // pixels, 1..16384
-    int height = 360;          // pixels, 1..16384
-    float fps = 30.0f;         // frames per second, > 0
-    float duration = 1.0f;     // seconds, > 0
-    int samplesPerPixel = 4;   // 1..1024
+    int width = 640;             // pixels, 1..16384
+    int height = 360;            // pixels, 1..16384
+    float fps = 30.0f;           // frames per second, > 0
+    float duration = 1.0f;       // seconds, > 0
+    int samplesPerPixel = 4;     // 1..1024
     glm::vec3 background{0.0f};  // linear RGB behind everything
 };
 
 struct Camera {
-    float fovY = 40.0f;  // vertical field of view, degrees, in (0, 180)
-    float zNear = 0.05f;  // > 0
-    float zFar = 200.0f;  // > zNear
+    float fovY = 40.0f;                    // vertical field of view, degrees, in (0, 180)
+    float zNear = 0.05f;                   // > 0
+    float zFar = 200.0f;                   // > zNear
     Keyframes<glm::vec3> eye, target, up;  // up defaults to +y
 };
 
@@ -46,8 +46,8 @@ struct Light {
 
 struct ParamValue {
     std::string name;
-    int components = 1;             // 1 (float, int) or 3
-    Keyframes<glm::vec3> value;     // one key when constant; components beyond `components` unused
+    int components = 1;          // 1 (float, int) or 3
+    Keyframes<glm::vec3> value;  // one key when constant; components beyond `components` unused
 };
 
 struct ObjectTransform {

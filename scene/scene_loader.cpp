@@ -53,7 +53,9 @@ void addKey(Keyframes<T>& frames, const JsonNode& key, const char* field, float 
     }
 }
 
-glm::vec3 vec3Of(const JsonNode& n) { return n.vec3(); }
+glm::vec3 vec3Of(const JsonNode& n) {
+    return n.vec3();
+}
 glm::vec3 colorOf(const JsonNode& n) {
     glm::vec3 c = n.vec3();
     if (c.x < 0 || c.y < 0 || c.z < 0) n.fail("color components must be non-negative");
@@ -72,7 +74,8 @@ glm::vec4 rotationOf(const JsonNode& n) {
     return r;
 }
 float scaleOf(const JsonNode& n) {
-    if (n.isArray()) n.fail("scale must be one positive number (mpshade supports uniform scale only)");
+    if (n.isArray())
+        n.fail("scale must be one positive number (mpshade supports uniform scale only)");
     return static_cast<float>(n.positive());
 }
 
@@ -85,8 +88,9 @@ Keyframes<T> constant(T value) {
 }
 
 class SceneLoader {
-public:
-    explicit SceneLoader(const std::string& path) : path_(path), dir_(fs::path(path).parent_path()) {}
+  public:
+    explicit SceneLoader(const std::string& path)
+        : path_(path), dir_(fs::path(path).parent_path()) {}
 
     Scene loadAll() {
         const nlohmann::json doc = parseJsonFile(path_);
@@ -106,7 +110,7 @@ public:
         return std::move(scene_);
     }
 
-private:
+  private:
     std::string resolve(const std::string& relative) const {
         fs::path p(relative);
         return (p.is_absolute() ? p : dir_ / p).lexically_normal().string();
@@ -117,7 +121,8 @@ private:
         if (rel.empty()) node.fail("expected a file path, found an empty string");
         const std::string full = resolve(rel);
         std::error_code ec;
-        if (!fs::is_regular_file(full, ec)) node.fail("file '" + rel + "' not found (looked for " + full + ")");
+        if (!fs::is_regular_file(full, ec))
+            node.fail("file '" + rel + "' not found (looked for " + full + ")");
         return full;
     }
 
@@ -129,7 +134,8 @@ private:
             return load();
         } catch (const InputError& e) {
             if (e.where().file == node.file()) throw;
-            throw InputError(e.where(), e.message() + " (loading " + node.path() + " of " + node.file() + ")");
+            throw InputError(e.where(),
+                             e.message() + " (loading " + node.path() + " of " + node.file() + ")");
         }
     }
 
@@ -143,7 +149,8 @@ private:
         if (auto n = s.optional("samples_per_pixel")) r.samplesPerPixel = n->integer(1, 1024);
         if (auto n = s.optional("background")) r.background = colorOf(*n);
         if (r.fps > 1000.0f) s["fps"].fail("fps must be at most 1000");
-        if (r.duration * r.fps > 1.0e6f) s["duration"].fail("duration * fps exceeds a million frames");
+        if (r.duration * r.fps > 1.0e6f)
+            s["duration"].fail("duration * fps exceeds a million frames");
     }
 
     void camera(const JsonNode& c) {
@@ -151,11 +158,14 @@ private:
         Camera& cam = scene_.camera;
         if (auto n = c.optional("fov_y")) {
             cam.fovY = static_cast<float>(n->number());
-            if (!(cam.fovY > 0.0f && cam.fovY < 180.0f)) n->fail("fov_y must be in (0, 180) degrees");
+            if (!(cam.fovY > 0.0f && cam.fovY < 180.0f))
+                n->fail("fov_y must be in (0, 180) degrees");
         }
         if (auto n = c.optional("near")) cam.zNear = static_cast<float>(n->positive());
         if (auto n = c.optional("far")) cam.zFar = static_cast<float>(n->positive());
-        if (!(cam.zFar > cam.zNear)) c.fail("far (" + shortNumber(cam.zFar) + ") must exceed near (" + shortNumber(cam.zNear) + ")");
+        if (!(cam.zFar > cam.zNear))
+            c.fail("far (" + shortNumber(cam.zFar) + ") must exceed near (" +
+                   shortNumber(cam.zNear) + ")");
         if (auto k = c.optional("keys")) {
             readKeys(*k, {"eye", "target", "up"}, [&](const JsonNode& key, float t) {
                 addKey(cam.eye, key, "eye", t, vec3Of);
@@ -181,7 +191,8 @@ private:
         // The view direction must be defined at every key time.
         for (float t : cam.eye.times) {
             const glm::vec3 d = cam.target.at(t) - cam.eye.at(t);
-            if (!(d.x * d.x + d.y * d.y + d.z * d.z > 0.0f)) c.fail("eye and target coincide at t = " + shortNumber(t));
+            if (!(d.x * d.x + d.y * d.y + d.z * d.z > 0.0f))
+                c.fail("eye and target coincide at t = " + shortNumber(t));
         }
     }
 
@@ -202,11 +213,13 @@ private:
             l.allowKeys({"type", "color", "intensity", "position", "keys"});
             fields = {"color", "intensity", "position"};
         } else {
-            l["type"].fail("unknown light type '" + type + "' (expected ambient, distant or point)");
+            l["type"].fail("unknown light type '" + type +
+                           "' (expected ambient, distant or point)");
         }
         auto intensityOf = [](const JsonNode& n) { return static_cast<float>(n.nonNegative()); };
         if (auto k = l.optional("keys")) {
-            const bool hasDir = light.kind == LightKind::Distant, hasPos = light.kind == LightKind::Point;
+            const bool hasDir = light.kind == LightKind::Distant,
+                       hasPos = light.kind == LightKind::Point;
             std::initializer_list<const char*> ambientFields{"color", "intensity"};
             std::initializer_list<const char*> distantFields{"color", "intensity", "direction"};
             std::initializer_list<const char*> pointFields{"color", "intensity", "position"};
@@ -231,8 +244,10 @@ private:
         if (light.kind == LightKind::Distant) direct("direction", light.direction, directionOf);
         if (light.color.empty()) light.color = constant(glm::vec3(1.0f));
         if (light.intensity.empty()) light.intensity = constant(1.0f);
-        if (light.kind == LightKind::Point && light.position.empty()) l.fail("a point light needs a 'position'");
-        if (light.kind == LightKind::Distant && light.direction.empty()) l.fail("a distant light needs a 'direction'");
+        if (light.kind == LightKind::Point && light.position.empty())
+            l.fail("a point light needs a 'position'");
+        if (light.kind == LightKind::Distant && light.direction.empty())
+            l.fail("a distant light needs a 'direction'");
         scene_.lights.push_back(std::move(light));
     }
 
@@ -258,13 +273,15 @@ private:
         typeName = type;
         if (type == "sphere") {
             g.allowKeys({"type", "radius"});
-            return std::make_shared<const Surface>(Sphere{static_cast<float>(g["radius"].positive())});
+            return std::make_shared<const Surface>(
+                Sphere{static_cast<float>(g["radius"].positive())});
         }
         if (type == "torus") {
             g.allowKeys({"type", "major", "minor"});
             const float major = static_cast<float>(g["major"].positive());
             const float minor = static_cast<float>(g["minor"].positive());
-            if (!(minor < major)) g["minor"].fail("minor must be smaller than major (a self-intersecting torus)");
+            if (!(minor < major))
+                g["minor"].fail("minor must be smaller than major (a self-intersecting torus)");
             return std::make_shared<const Surface>(Torus{major, minor});
         }
         if (type == "plane") {
@@ -272,7 +289,8 @@ private:
             JsonNode size = g["size"];
             if (!size.isArray() || size.size() != 2) size.fail("expected [width, depth]");
             return std::make_shared<const Surface>(
-                Plane{static_cast<float>(size.at(0).positive()), static_cast<float>(size.at(1).positive())});
+                Plane{static_cast<float>(size.at(0).positive()),
+                      static_cast<float>(size.at(1).positive())});
         }
         if (type == "bezier") {
             g.allowKeys({"type", "file"});
@@ -285,16 +303,20 @@ private:
             SubdivScheme scheme = SubdivScheme::Catmark;
             if (auto s = g.optional("scheme")) {
                 const std::string name = s->string();
-                if (name == "loop") scheme = SubdivScheme::Loop;
-                else if (name != "catmark") s->fail("unknown scheme '" + name + "' (expected catmark or loop)");
+                if (name == "loop")
+                    scheme = SubdivScheme::Loop;
+                else if (name != "catmark")
+                    s->fail("unknown scheme '" + name + "' (expected catmark or loop)");
             }
-            return surfaceFor("subdiv:" + std::to_string(static_cast<int>(scheme)) + ":" + file,
-                              [&] { return Surface(SubdivSurface(loadObjCage(file), scheme, file)); });
+            return surfaceFor(
+                "subdiv:" + std::to_string(static_cast<int>(scheme)) + ":" + file,
+                [&] { return Surface(SubdivSurface(loadObjCage(file), scheme, file)); });
         }
         if (type == "mesh") {
             g.allowKeys({"type", "file"});
             const std::string file = existingFile(g["file"]);
-            return surfaceFor("mesh:" + file, [&] { return Surface(PolygonMesh(readObjPolygons(file))); });
+            return surfaceFor("mesh:" + file,
+                              [&] { return Surface(PolygonMesh(readObjPolygons(file))); });
         }
         if (type == "points") {
             g.allowKeys({"type", "file"});
@@ -314,7 +336,8 @@ private:
                 if (v.isNumber()) return glm::vec3(static_cast<float>(v.number()));
                 return v.vec3();
             }
-            if (decl.type == ValueType::Int) return glm::vec3(static_cast<float>(v.integer(-16777216, 16777216)));
+            if (decl.type == ValueType::Int)
+                return glm::vec3(static_cast<float>(v.integer(-16777216, 16777216)));
             return glm::vec3(static_cast<float>(v.number()));
         };
         if (n.isObject()) {
@@ -336,14 +359,18 @@ private:
         obj.name = o["name"].string();
         if (obj.name.empty()) o["name"].fail("an object name must not be empty");
         for (const auto& other : scene_.objects)
-            if (other.name == obj.name) o["name"].fail("another object is already named '" + obj.name + "'");
-        obj.surface = withContext(o["geometry"], [&] { return geometry(o["geometry"], obj.geometryType); });
+            if (other.name == obj.name)
+                o["name"].fail("another object is already named '" + obj.name + "'");
+        obj.surface =
+            withContext(o["geometry"], [&] { return geometry(o["geometry"], obj.geometryType); });
         obj.shaderName = o["shader"].string();
         auto sh = scene_.shaders.find(obj.shaderName);
-        if (sh == scene_.shaders.end()) o["shader"].fail("no shader named '" + obj.shaderName + "' in 'shaders'");
+        if (sh == scene_.shaders.end())
+            o["shader"].fail("no shader named '" + obj.shaderName + "' in 'shaders'");
         obj.shader = sh->second;
         if (auto params = o.optional("params")) {
-            if (!params->isObject()) params->fail("expected an object mapping parameter names to values");
+            if (!params->isObject())
+                params->fail("expected an object mapping parameter names to values");
             for (auto it = params->raw().begin(); it != params->raw().end(); ++it) {
                 JsonNode value(*it, params->file(), params->path() + "." + it.key());
                 const ParamDecl* decl = nullptr;
@@ -351,8 +378,10 @@ private:
                     if (d.name == it.key()) decl = &d;
                 if (!decl) {
                     std::string list;
-                    for (const auto& d : obj.shader->params) list += (list.empty() ? "" : ", ") + d.name;
-                    value.fail("shader '" + obj.shaderName + "' has no parameter '" + it.key() + "' (it has: " + list + ")");
+                    for (const auto& d : obj.shader->params)
+                        list += (list.empty() ? "" : ", ") + d.name;
+                    value.fail("shader '" + obj.shaderName + "' has no parameter '" + it.key() +
+                               "' (it has: " + list + ")");
                 }
                 obj.params.push_back(param(value, *decl));
             }
@@ -368,19 +397,25 @@ private:
         if (auto t = o.optional("transform")) {
             t->allowKeys({"translate", "rotate", "scale"});
             // Keyed fields override the static transform.
-            if (auto n = t->optional("translate"); n && tr.translate.empty()) tr.translate = constant(n->vec3());
-            if (auto n = t->optional("rotate"); n && tr.rotate.empty()) tr.rotate = constant(rotationOf(*n));
-            if (auto n = t->optional("scale"); n && tr.scale.empty()) tr.scale = constant(scaleOf(*n));
+            if (auto n = t->optional("translate"); n && tr.translate.empty())
+                tr.translate = constant(n->vec3());
+            if (auto n = t->optional("rotate"); n && tr.rotate.empty())
+                tr.rotate = constant(rotationOf(*n));
+            if (auto n = t->optional("scale"); n && tr.scale.empty())
+                tr.scale = constant(scaleOf(*n));
         }
         if (tr.translate.empty()) tr.translate = constant(glm::vec3(0.0f));
         if (tr.rotate.empty()) tr.rotate = constant(glm::vec4(0, 1, 0, 0));
         if (tr.scale.empty()) tr.scale = constant(1.0f);
         if (auto r = o.optional("representation")) {
             const std::string rep = r->string();
-            if (rep == "shadermap") obj.representation = Representation::ShaderMap;
-            else if (rep != "facets") r->fail("unknown representation '" + rep + "' (expected facets or shadermap)");
+            if (rep == "shadermap")
+                obj.representation = Representation::ShaderMap;
+            else if (rep != "facets")
+                r->fail("unknown representation '" + rep + "' (expected facets or shadermap)");
         }
-        if (auto r = o.optional("shadermap_resolution")) obj.shadermapResolution = r->integer(1, 65536);
+        if (auto r = o.optional("shadermap_resolution"))
+            obj.shadermapResolution = r->integer(1, 65536);
         if (auto r = o.optional("range")) {
             r->allowKeys({"distance_factor", "angle"});
             if (auto d = r->optional("distance_factor")) {
@@ -389,7 +424,8 @@ private:
             }
             if (auto a = r->optional("angle")) {
                 obj.range.angle = static_cast<float>(a->number());
-                if (!(obj.range.angle > 0.0f && obj.range.angle <= 180.0f)) a->fail("angle must be in (0, 180] degrees");
+                if (!(obj.range.angle > 0.0f && obj.range.angle <= 180.0f))
+                    a->fail("angle must be in (0, 180] degrees");
             }
         }
         scene_.objects.push_back(std::move(obj));
@@ -407,6 +443,8 @@ int Scene::frameCount() const {
     return std::max(1, static_cast<int>(std::ceil(settings.duration * settings.fps - 1e-4f)));
 }
 
-Scene loadScene(const std::string& path) { return SceneLoader(path).loadAll(); }
+Scene loadScene(const std::string& path) {
+    return SceneLoader(path).loadAll();
+}
 
 }  // namespace mpshade

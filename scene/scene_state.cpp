@@ -34,7 +34,8 @@ CameraState cameraAt(const Scene& scene, float t, int width, int height) {
     glm::vec3 right = glm::cross(c.forward, up);
     if (!(glm::length(right) > 1e-6f)) {
         // Looking straight along `up`: any perpendicular will do.
-        right = glm::cross(c.forward, std::fabs(c.forward.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 0, 1));
+        right = glm::cross(c.forward,
+                           std::fabs(c.forward.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 0, 1));
     }
     c.right = glm::normalize(right);
     c.up = glm::cross(c.right, c.forward);
@@ -74,7 +75,8 @@ void animatedParamsAt(const SceneObject& object, const IrProgram& program, float
     }
 }
 
-void lightsAt(const Scene& scene, const ObjectState& object, float t, std::vector<LightSample>& out) {
+void lightsAt(const Scene& scene, const ObjectState& object, float t,
+              std::vector<LightSample>& out) {
     out.clear();
     for (const Light& light : scene.lights) {
         LightSample s;

@@ -33,7 +33,7 @@ CameraState cameraAt(const Scene& scene, float t, int width, int height);
 struct ObjectState {
     glm::mat4 objectToWorld{1.0f};
     glm::mat4 worldToObject{1.0f};
-    float scale = 1.0f;  // uniform
+    float scale = 1.0f;   // uniform
     glm::vec3 eye{0.0f};  // object space
 };
 
@@ -44,6 +44,7 @@ void animatedParamsAt(const SceneObject& object, const IrProgram& program, float
                       std::vector<float>& block);
 
 // All scene lights at time t, in the object's coordinates (indexed as the scene's lights).
-void lightsAt(const Scene& scene, const ObjectState& object, float t, std::vector<LightSample>& out);
+void lightsAt(const Scene& scene, const ObjectState& object, float t,
+              std::vector<LightSample>& out);
 
 }  // namespace mpshade

@@ -11,8 +11,8 @@ ObjectVariability variabilityOf(const Scene& scene, const SceneObject& object) {
         const bool animated = light.animated();
         v.lightAnimated.push_back(animated);
         // An ambient light has no position: only its color can change.
-        v.lightMovesRelative.push_back(light.kind == LightKind::Ambient ? animated
-                                                                        : animated || v.transformAnimated);
+        v.lightMovesRelative.push_back(
+            light.kind == LightKind::Ambient ? animated : animated || v.transformAnimated);
     }
     for (const ParamValue& p : object.params)
         if (p.value.varies()) v.animatedParams.push_back(p.name);

@@ -12,7 +12,7 @@
 namespace mpshade {
 
 struct ObjectVariability {
-    bool cameraMoves = false;     // eye or target keyed: I and E vary
+    bool cameraMoves = false;  // eye or target keyed: I and E vary
     bool transformAnimated = false;
     std::vector<bool> lightMovesRelative;  // per scene light
     std::vector<bool> lightAnimated;       // per scene light: any field keyed

@@ -15,23 +15,23 @@ struct Expr {
     enum class Kind { Number, Name, Unary, Binary, Call, Index };
     Kind kind;
     int line = 0, column = 0;
-    double number = 0.0;  // Number
-    bool isInt = false;   // Number: an integer literal
-    std::string name;     // Name, Call
-    TokenKind op = TokenKind::End;  // Unary, Binary
+    double number = 0.0;                      // Number
+    bool isInt = false;                       // Number: an integer literal
+    std::string name;                         // Name, Call
+    TokenKind op = TokenKind::End;            // Unary, Binary
     std::vector<std::unique_ptr<Expr>> args;  // operands; Index: [base, index]
-    ValueType type = ValueType::Void;          // filled in by the type checker
+    ValueType type = ValueType::Void;         // filled in by the type checker
 };
 
 struct Stmt {
     enum class Kind { Decl, Assign, ExprStmt, If, For, Block };
     Kind kind;
     int line = 0, column = 0;
-    ValueType declType = ValueType::Void;  // Decl
-    std::string name;                      // Decl
+    ValueType declType = ValueType::Void;    // Decl
+    std::string name;                        // Decl
     TokenKind assignOp = TokenKind::Assign;  // Assign: = += -= *= /=
-    std::unique_ptr<Expr> target;  // Assign: a Name or an Index of a Name
-    std::unique_ptr<Expr> value;   // Decl initializer, Assign value, ExprStmt, If/For condition
+    std::unique_ptr<Expr> target;            // Assign: a Name or an Index of a Name
+    std::unique_ptr<Expr> value;       // Decl initializer, Assign value, ExprStmt, If/For condition
     std::unique_ptr<Stmt> init, step;  // For
     std::vector<std::unique_ptr<Stmt>> body;      // Block; If then-part; For body
     std::vector<std::unique_ptr<Stmt>> elseBody;  // If

@@ -5,14 +5,15 @@
 namespace mpshade {
 namespace {
 const char* const kBuiltinNames[] = {
-    "abs", "floor", "ceil", "fract", "sqrt", "exp", "log", "sin", "cos", "tan", "asin", "acos",
-    "atan", "sign", "min", "max", "mod", "pow", "atan2", "step", "clamp", "mix", "smoothstep",
-    "dot", "cross", "length", "distance", "normalize", "reflect", "faceforward",
-    "noise", "snoise", "cellnoise", "fbm", "turbulence",
-    "ambient", "diffuse", "specular", "phong", "occlusion",
-    "bake", "dynamic",
-    "color", "point", "vector", "normal", "float", "int"};
-static_assert(sizeof(kBuiltinNames) / sizeof(kBuiltinNames[0]) == static_cast<size_t>(Builtin::None));
+    "abs",     "floor",       "ceil",     "fract",  "sqrt",      "exp",      "log",
+    "sin",     "cos",         "tan",      "asin",   "acos",      "atan",     "sign",
+    "min",     "max",         "mod",      "pow",    "atan2",     "step",     "clamp",
+    "mix",     "smoothstep",  "dot",      "cross",  "length",    "distance", "normalize",
+    "reflect", "faceforward", "noise",    "snoise", "cellnoise", "fbm",      "turbulence",
+    "ambient", "diffuse",     "specular", "phong",  "occlusion", "bake",     "dynamic",
+    "color",   "point",       "vector",   "normal", "float",     "int"};
+static_assert(sizeof(kBuiltinNames) / sizeof(kBuiltinNames[0]) ==
+              static_cast<size_t>(Builtin::None));
 
 const struct {
     const char* name;
@@ -27,13 +28,20 @@ static_assert(sizeof(kGlobals) / sizeof(kGlobals[0]) == static_cast<size_t>(Glob
 
 const char* typeName(ValueType t) {
     switch (t) {
-        case ValueType::Float: return "float";
-        case ValueType::Int: return "int";
-        case ValueType::Color: return "color";
-        case ValueType::Point: return "point";
-        case ValueType::Vector: return "vector";
-        case ValueType::Normal: return "normal";
-        case ValueType::Void: return "void";
+        case ValueType::Float:
+            return "float";
+        case ValueType::Int:
+            return "int";
+        case ValueType::Color:
+            return "color";
+        case ValueType::Point:
+            return "point";
+        case ValueType::Vector:
+            return "vector";
+        case ValueType::Normal:
+            return "normal";
+        case ValueType::Void:
+            return "void";
     }
     return "?";
 }
@@ -59,7 +67,11 @@ bool findGlobal(const std::string& name, GlobalId& id, ValueType& type) {
     return false;
 }
 
-const char* globalName(GlobalId id) { return kGlobals[static_cast<size_t>(id)].name; }
-ValueType globalType(GlobalId id) { return kGlobals[static_cast<size_t>(id)].type; }
+const char* globalName(GlobalId id) {
+    return kGlobals[static_cast<size_t>(id)].name;
+}
+ValueType globalType(GlobalId id) {
+    return kGlobals[static_cast<size_t>(id)].type;
+}
 
 }  // namespace mpshade

@@ -72,7 +72,8 @@ ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
         const int32_t* args = program.argsOf(inst);
         for (int a = 0; a < inst.nargs; ++a) e.in[a] = reg[static_cast<size_t>(args[a])];
         // Outputs never share a register with this instruction's own inputs.
-        for (int o = 0; o < inst.nout; ++o) e.out[o] = reg[static_cast<size_t>(inst.result + o)] = allocate();
+        for (int o = 0; o < inst.nout; ++o)
+            e.out[o] = reg[static_cast<size_t>(inst.result + o)] = allocate();
         for (int a = 0; a < inst.nargs; ++a) {
             int& last = lastUse[static_cast<size_t>(args[a])];
             if (last == static_cast<int>(k) && !constantReg[static_cast<size_t>(e.in[a])]) {
@@ -113,26 +114,51 @@ void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                     const float* const* src = nullptr;
                     const float* scalarSrc = nullptr;
                     switch (id) {
-                        case GlobalId::P: src = in.P; break;
-                        case GlobalId::N: src = in.N; break;
-                        case GlobalId::Ng: src = in.Ng; break;
-                        case GlobalId::dPdu: src = in.dPdu; break;
-                        case GlobalId::dPdv: src = in.dPdv; break;
-                        case GlobalId::I: src = in.I; break;
-                        case GlobalId::u: scalarSrc = in.u; break;
-                        case GlobalId::v: scalarSrc = in.v; break;
-                        case GlobalId::s: scalarSrc = in.s; break;
-                        case GlobalId::t: scalarSrc = in.t; break;
-                        case GlobalId::E:
-                            for (int k = 0; k < 3; ++k) std::fill_n(R(e.out[k]), m, uniforms.eye[k]);
+                        case GlobalId::P:
+                            src = in.P;
                             break;
-                        case GlobalId::time: std::fill_n(o, m, uniforms.time); break;
-                        case GlobalId::Count: break;
+                        case GlobalId::N:
+                            src = in.N;
+                            break;
+                        case GlobalId::Ng:
+                            src = in.Ng;
+                            break;
+                        case GlobalId::dPdu:
+                            src = in.dPdu;
+                            break;
+                        case GlobalId::dPdv:
+                            src = in.dPdv;
+                            break;
+                        case GlobalId::I:
+                            src = in.I;
+                            break;
+                        case GlobalId::u:
+                            scalarSrc = in.u;
+                            break;
+                        case GlobalId::v:
+                            scalarSrc = in.v;
+                            break;
+                        case GlobalId::s:
+                            scalarSrc = in.s;
+                            break;
+                        case GlobalId::t:
+                            scalarSrc = in.t;
+                            break;
+                        case GlobalId::E:
+                            for (int k = 0; k < 3; ++k)
+                                std::fill_n(R(e.out[k]), m, uniforms.eye[k]);
+                            break;
+                        case GlobalId::time:
+                            std::fill_n(o, m, uniforms.time);
+                            break;
+                        case GlobalId::Count:
+                            break;
                     }
                     if (src) {
                         for (int k = 0; k < 3; ++k) {
                             MPSHADE_CHECK(src[k] != nullptr);
-                            std::memcpy(R(e.out[k]), src[k] + start, sizeof(float) * static_cast<size_t>(m));
+                            std::memcpy(R(e.out[k]), src[k] + start,
+                                        sizeof(float) * static_cast<size_t>(m));
                         }
                     } else if (scalarSrc) {
                         std::memcpy(o, scalarSrc + start, sizeof(float) * static_cast<size_t>(m));
@@ -141,34 +167,55 @@ void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                 }
                 case Op::Param:
                     for (int k = 0; k < e.nout; ++k)
-                        std::fill_n(R(e.out[k]), m, uniforms.params[static_cast<size_t>(e.imm + k)]);
+                        std::fill_n(R(e.out[k]), m,
+                                    uniforms.params[static_cast<size_t>(e.imm + k)]);
                     break;
                 case Op::LightAmbient:
                     for (int k = 0; k < 3; ++k)
-                        std::fill_n(R(e.out[k]), m, uniforms.lights[static_cast<size_t>(e.imm)].color[k]);
+                        std::fill_n(R(e.out[k]), m,
+                                    uniforms.lights[static_cast<size_t>(e.imm)].color[k]);
                     break;
-#define MPSHADE_UNARY(X) case Op::X: unaryLoop<Op::X>(o, a, m); break;
-                MPSHADE_UNARY(Neg) MPSHADE_UNARY(Abs) MPSHADE_UNARY(Floor) MPSHADE_UNARY(Ceil)
-                MPSHADE_UNARY(Fract) MPSHADE_UNARY(Sqrt) MPSHADE_UNARY(Exp) MPSHADE_UNARY(Log)
-                MPSHADE_UNARY(Sin) MPSHADE_UNARY(Cos) MPSHADE_UNARY(Tan) MPSHADE_UNARY(Asin)
-                MPSHADE_UNARY(Acos) MPSHADE_UNARY(Atan) MPSHADE_UNARY(Sign) MPSHADE_UNARY(Trunc)
-                MPSHADE_UNARY(Not) MPSHADE_UNARY(Bake) MPSHADE_UNARY(Dynamic)
+#define MPSHADE_UNARY(X)           \
+    case Op::X:                    \
+        unaryLoop<Op::X>(o, a, m); \
+        break;
+                    MPSHADE_UNARY(Neg)
+                    MPSHADE_UNARY(Abs) MPSHADE_UNARY(Floor) MPSHADE_UNARY(Ceil) MPSHADE_UNARY(Fract)
+                        MPSHADE_UNARY(Sqrt) MPSHADE_UNARY(Exp) MPSHADE_UNARY(Log) MPSHADE_UNARY(Sin)
+                            MPSHADE_UNARY(Cos) MPSHADE_UNARY(Tan) MPSHADE_UNARY(Asin) MPSHADE_UNARY(
+                                Acos) MPSHADE_UNARY(Atan) MPSHADE_UNARY(Sign) MPSHADE_UNARY(Trunc)
+                                MPSHADE_UNARY(Not) MPSHADE_UNARY(Bake) MPSHADE_UNARY(Dynamic)
 #undef MPSHADE_UNARY
-#define MPSHADE_BINARY(X) case Op::X: binaryLoop<Op::X>(o, a, b, m); break;
-                MPSHADE_BINARY(Add) MPSHADE_BINARY(Sub) MPSHADE_BINARY(Mul) MPSHADE_BINARY(Div)
-                MPSHADE_BINARY(IDiv) MPSHADE_BINARY(Min) MPSHADE_BINARY(Max) MPSHADE_BINARY(Mod)
-                MPSHADE_BINARY(Pow) MPSHADE_BINARY(Atan2) MPSHADE_BINARY(Step) MPSHADE_BINARY(Lt)
-                MPSHADE_BINARY(Le) MPSHADE_BINARY(Gt) MPSHADE_BINARY(Ge) MPSHADE_BINARY(Eq)
-                MPSHADE_BINARY(Ne) MPSHADE_BINARY(And) MPSHADE_BINARY(Or)
+#define MPSHADE_BINARY(X)              \
+    case Op::X:                        \
+        binaryLoop<Op::X>(o, a, b, m); \
+        break;
+                                    MPSHADE_BINARY(Add) MPSHADE_BINARY(Sub) MPSHADE_BINARY(Mul)
+                                        MPSHADE_BINARY(Div) MPSHADE_BINARY(IDiv) MPSHADE_BINARY(Min)
+                                            MPSHADE_BINARY(Max) MPSHADE_BINARY(Mod) MPSHADE_BINARY(
+                                                Pow) MPSHADE_BINARY(Atan2) MPSHADE_BINARY(Step)
+                                                MPSHADE_BINARY(Lt) MPSHADE_BINARY(Le)
+                                                    MPSHADE_BINARY(Gt) MPSHADE_BINARY(Ge)
+                                                        MPSHADE_BINARY(Eq) MPSHADE_BINARY(Ne)
+                                                            MPSHADE_BINARY(And) MPSHADE_BINARY(Or)
 #undef MPSHADE_BINARY
-#define MPSHADE_TERNARY(X) case Op::X: ternaryLoop<Op::X>(o, a, b, c, m); break;
-                MPSHADE_TERNARY(Clamp) MPSHADE_TERNARY(Mix) MPSHADE_TERNARY(Smoothstep)
-                MPSHADE_TERNARY(Select)
+#define MPSHADE_TERNARY(X)                 \
+    case Op::X:                            \
+        ternaryLoop<Op::X>(o, a, b, c, m); \
+        break;
+                                                                MPSHADE_TERNARY(Clamp)
+                                                                    MPSHADE_TERNARY(Mix)
+                                                                        MPSHADE_TERNARY(Smoothstep)
+                                                                            MPSHADE_TERNARY(Select)
 #undef MPSHADE_TERNARY
-                case Op::Noise: case Op::Snoise: case Op::Cellnoise: case Op::Fbm: case Op::Turbulence:
-                    for (int l = 0; l < m; ++l) o[l] = scalar::pattern(e.op, e.imm, a[l], b[l], c[l]);
+                                                                                case Op::Noise
+                        : case Op::Snoise : case Op::Cellnoise : case Op::Fbm : case Op::Turbulence
+                        : for (int l = 0; l < m; ++l) o[l] =
+                              scalar::pattern(e.op, e.imm, a[l], b[l], c[l]);
                     break;
-                case Op::Diffuse: case Op::Specular: case Op::Phong: {
+                case Op::Diffuse:
+                case Op::Specular:
+                case Op::Phong: {
                     const LightSample& light = uniforms.lights[static_cast<size_t>(e.imm)];
                     const float* arg[10];
                     for (int k = 0; k < e.nin; ++k) arg[k] = R(e.in[k]);
@@ -179,11 +226,13 @@ void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                 case Op::Occlusion: {
                     const float* arg[6];
                     for (int k = 0; k < 6; ++k) arg[k] = R(e.in[k]);
-                    counters.occlusionRays += occlusionLanes(uniforms.occluder, uniforms.occlusionBias,
-                                                             e.imm, arg, o, m);
+                    counters.occlusionRays +=
+                        occlusionLanes(uniforms.occluder, uniforms.occlusionBias, e.imm, arg, o, m);
                     break;
                 }
-                case Op::Const: case Op::Count: break;
+                case Op::Const:
+                case Op::Count:
+                    break;
             }
         }
         for (int k = 0; k < 3; ++k) {

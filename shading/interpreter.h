@@ -23,19 +23,19 @@ class SurfaceRayScene;
 // One light as the shader sees it this frame, in the shaded object's own coordinates.
 struct LightSample {
     LightKind kind = LightKind::Distant;
-    glm::vec3 color{0.0f};     // color * intensity (point lights: at unit distance)
-    glm::vec3 position{0.0f};  // Point
+    glm::vec3 color{0.0f};                // color * intensity (point lights: at unit distance)
+    glm::vec3 position{0.0f};             // Point
     glm::vec3 toLight{0.0f, 1.0f, 0.0f};  // Distant: unit direction towards the light
 };
 
 // Per object, per frame.
 struct ShadingUniforms {
     float time = 0.0f;
-    glm::vec3 eye{0.0f};             // E, object space
-    std::span<const float> params;   // the animated parameter block (IrProgram::paramFloats)
+    glm::vec3 eye{0.0f};                  // E, object space
+    std::span<const float> params;        // the animated parameter block (IrProgram::paramFloats)
     std::span<const LightSample> lights;  // indexed as the binding's lights
     const SurfaceRayScene* occluder = nullptr;  // the object's own geometry; null: no occlusion
-    float occlusionBias = 1e-4f;     // ray origin offset along N, object units
+    float occlusionBias = 1e-4f;                // ray origin offset along N, object units
 };
 
 // Per point, structure of arrays; each pointer addresses n floats. Object space.
@@ -72,7 +72,7 @@ struct ExecInst {
 };
 
 class ShaderKernel {
-public:
+  public:
     static constexpr int kLanes = 128;
 
     explicit ShaderKernel(const IrProgram& program);
@@ -87,7 +87,7 @@ public:
              const ShadingOutputs& out, std::vector<float>& workspace,
              ShadingCounters& counters) const;
 
-private:
+  private:
     IrProgram program_;
     std::vector<ExecInst> code_;
     std::vector<std::pair<int32_t, float>> constants_;  // register, value

@@ -7,15 +7,20 @@
 namespace mpshade {
 
 const char* opName(Op op) {
-    static const char* const kNames[] = {
-        "const", "global", "param", "light_ambient",
-        "neg", "abs", "floor", "ceil", "fract", "sqrt", "exp", "log", "sin", "cos", "tan", "asin",
-        "acos", "atan", "sign", "trunc", "not", "bake", "dynamic",
-        "add", "sub", "mul", "div", "idiv", "min", "max", "mod", "pow", "atan2", "step", "lt", "le",
-        "gt", "ge", "eq", "ne", "and", "or",
-        "clamp", "mix", "smoothstep", "select",
-        "noise", "snoise", "cellnoise", "fbm", "turbulence",
-        "diffuse", "specular", "phong", "occlusion"};
+    static const char* const kNames[] = {"const",      "global", "param",      "light_ambient",
+                                         "neg",        "abs",    "floor",      "ceil",
+                                         "fract",      "sqrt",   "exp",        "log",
+                                         "sin",        "cos",    "tan",        "asin",
+                                         "acos",       "atan",   "sign",       "trunc",
+                                         "not",        "bake",   "dynamic",    "add",
+                                         "sub",        "mul",    "div",        "idiv",
+                                         "min",        "max",    "mod",        "pow",
+                                         "atan2",      "step",   "lt",         "le",
+                                         "gt",         "ge",     "eq",         "ne",
+                                         "and",        "or",     "clamp",      "mix",
+                                         "smoothstep", "select", "noise",      "snoise",
+                                         "cellnoise",  "fbm",    "turbulence", "diffuse",
+                                         "specular",   "phong",  "occlusion"};
     static_assert(sizeof(kNames) / sizeof(kNames[0]) == static_cast<size_t>(Op::Count));
     return kNames[static_cast<size_t>(op)];
 }
@@ -72,8 +77,10 @@ void eliminateDeadCode(IrProgram& program) {
         Inst inst = program.insts[k];
         const int32_t* oldArgs = program.argsOf(inst);
         inst.firstArg = static_cast<int32_t>(args.size());
-        for (int a = 0; a < inst.nargs; ++a) args.push_back(renumber[static_cast<size_t>(oldArgs[a])]);
-        for (int o = 0; o < inst.nout; ++o) renumber[static_cast<size_t>(inst.result + o)] = next + o;
+        for (int a = 0; a < inst.nargs; ++a)
+            args.push_back(renumber[static_cast<size_t>(oldArgs[a])]);
+        for (int o = 0; o < inst.nout; ++o)
+            renumber[static_cast<size_t>(inst.result + o)] = next + o;
         inst.result = next;
         next += inst.nout;
         insts.push_back(inst);

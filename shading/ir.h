@@ -25,14 +25,56 @@ enum class Op : uint8_t {
     Param,         // imm = animated parameter slot; nout = components
     LightAmbient,  // imm = light index; nout = 3 (an animated ambient light's color)
     // Unary
-    Neg, Abs, Floor, Ceil, Fract, Sqrt, Exp, Log, Sin, Cos, Tan, Asin, Acos, Atan, Sign, Trunc, Not,
-    Bake, Dynamic,  // identity; marks a factoring override
+    Neg,
+    Abs,
+    Floor,
+    Ceil,
+    Fract,
+    Sqrt,
+    Exp,
+    Log,
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Sign,
+    Trunc,
+    Not,
+    Bake,
+    Dynamic,  // identity; marks a factoring override
     // Binary
-    Add, Sub, Mul, Div, IDiv, Min, Max, Mod, Pow, Atan2, Step, Lt, Le, Gt, Ge, Eq, Ne, And, Or,
+    Add,
+    Sub,
+    Mul,
+    Div,
+    IDiv,
+    Min,
+    Max,
+    Mod,
+    Pow,
+    Atan2,
+    Step,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+    Ne,
+    And,
+    Or,
     // Ternary
-    Clamp, Mix, Smoothstep, Select,  // Select(cond, a, b) = cond != 0 ? a : b
+    Clamp,
+    Mix,
+    Smoothstep,
+    Select,  // Select(cond, a, b) = cond != 0 ? a : b
     // Pattern: args x, y, z; imm = octaves (Fbm, Turbulence)
-    Noise, Snoise, Cellnoise, Fbm, Turbulence,
+    Noise,
+    Snoise,
+    Cellnoise,
+    Fbm,
+    Turbulence,
     // Lighting by one light: imm = light index; nout = 3.
     Diffuse,   // args P(3) N(3)
     Specular,  // args P(3) N(3) V(3) roughness

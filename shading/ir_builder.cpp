@@ -44,12 +44,16 @@ int IrBuilder::emit(Op op, const std::vector<int>& args, int nout, int imm) {
     if (isPureArithmetic(op) && allConst && nout == 1) {
         ++stats_.folded;
         switch (args.size()) {
-            case 1: return constant(scalar::unary(op, c[0]));
-            case 2: return constant(scalar::binary(op, c[0], c[1]));
+            case 1:
+                return constant(scalar::unary(op, c[0]));
+            case 2:
+                return constant(scalar::binary(op, c[0], c[1]));
             case 3:
                 if (op >= Op::Noise) return constant(scalar::pattern(op, imm, c[0], c[1], c[2]));
                 return constant(scalar::ternary(op, c[0], c[1], c[2]));
-            default: --stats_.folded; break;
+            default:
+                --stats_.folded;
+                break;
         }
     }
     // Identities that hold for every float, NaN and Inf included.

@@ -19,7 +19,7 @@ struct FoldStats {
 };
 
 class IrBuilder {
-public:
+  public:
     explicit IrBuilder(IrProgram& program) : program_(program) {}
 
     void setLocation(int line, int column) {
@@ -33,7 +33,7 @@ public:
     bool constantValue(int value, float& out) const;
     const FoldStats& stats() const { return stats_; }
 
-private:
+  private:
     IrProgram& program_;
     int line_ = 0, column_ = 0;
     FoldStats stats_;

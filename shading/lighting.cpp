@@ -63,7 +63,8 @@ glm::vec3 shadeLightOne(Op op, const LightSample& light, const glm::vec3& P, con
     return Cl * scalar::safePow(std::fmax(0.0f, glm::dot(R, L)), param);
 }
 
-void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb, int m) {
+void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb,
+                int m) {
     for (int l = 0; l < m; ++l) {
         const glm::vec3 P(args[0][l], args[1][l], args[2][l]);
         const glm::vec3 N(args[3][l], args[4][l], args[5][l]);
@@ -107,7 +108,8 @@ uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,
             const float r = std::sqrt(u1), phi = 2.0f * kPi * u2;
             const glm::vec3 dir = r * std::cos(phi) * T + r * std::sin(phi) * B +
                                   std::sqrt(std::fmax(0.0f, 1.0f - u1)) * N;
-            if (!occluder->occluded(origin, dir, 0.0f, std::numeric_limits<float>::infinity())) ++open;
+            if (!occluder->occluded(origin, dir, 0.0f, std::numeric_limits<float>::infinity()))
+                ++open;
         }
         traced += static_cast<uint64_t>(rays);
         out[l] = static_cast<float>(open) / static_cast<float>(rays);

@@ -19,7 +19,8 @@
 namespace mpshade {
 
 // args: P(3) N(3) [V(3) param]; each a run of m lanes. Writes rgb[3][m].
-void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb, int m);
+void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb,
+                int m);
 
 // args: P(3) N(3). Writes the open fraction per lane; returns the rays traced.
 uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,

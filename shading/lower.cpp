@@ -15,7 +15,7 @@ struct Val {
 };
 
 class Lowerer {
-public:
+  public:
     Lowerer(const ShaderAst& ast, const ShaderBinding& binding, const LoweringLimits& limits,
             IrProgram& program)
         : ast_(ast), binding_(binding), limits_(limits), program_(program), b_(program) {}
@@ -40,7 +40,7 @@ public:
 
     const FoldStats& stats() const { return b_.stats(); }
 
-private:
+  private:
     [[noreturn]] void fail(int line, int col, const std::string& msg) const {
         throw InputError({ast_.file, line, col, {}}, msg);
     }
@@ -52,7 +52,8 @@ private:
         Val v;
         v.type = p.type;
         auto it = binding_.params.find(p.name);
-        const ParamBinding::Kind kind = it == binding_.params.end() ? ParamBinding::Kind::Default : it->second.kind;
+        const ParamBinding::Kind kind =
+            it == binding_.params.end() ? ParamBinding::Kind::Default : it->second.kind;
         if (kind == ParamBinding::Kind::Constant) {
             for (int k = 0; k < v.n(); ++k) {
                 float value = it->second.value[k];
@@ -136,8 +137,9 @@ private:
         if (!b_.constantValue(v.c[0], value))
             fail(e.line, e.column, std::string(what) + " must be a constant");
         if (value != std::floor(value) || value < lo || value > hi)
-            fail(e.line, e.column, std::string(what) + " must be a whole number in [" +
-                                       std::to_string(lo) + ", " + std::to_string(hi) + "]");
+            fail(e.line, e.column,
+                 std::string(what) + " must be a whole number in [" + std::to_string(lo) + ", " +
+                     std::to_string(hi) + "]");
         return static_cast<int>(value);
     }
 
@@ -156,16 +158,19 @@ private:
             case Expr::Kind::Unary: {
                 Val a = expr(*e.args[0]);
                 at(e.line, e.column);
-                if (e.op == TokenKind::Bang) return scalarVal(b_.emit(Op::Not, {a.c[0]}), ValueType::Int);
+                if (e.op == TokenKind::Bang)
+                    return scalarVal(b_.emit(Op::Not, {a.c[0]}), ValueType::Int);
                 return componentwise(Op::Neg, {a}, a.type);
             }
-            case Expr::Kind::Binary: return binaryExpr(e);
+            case Expr::Kind::Binary:
+                return binaryExpr(e);
             case Expr::Kind::Index: {
                 Val base = expr(*e.args[0]);
                 const int k = constantInt(*e.args[1], "a component index", 0, 2);
                 return scalarVal(base.c[k]);
             }
-            case Expr::Kind::Call: return call(e);
+            case Expr::Kind::Call:
+                return call(e);
         }
         return {};
     }
@@ -174,27 +179,38 @@ private:
         Val a = expr(*e.args[0]), b = expr(*e.args[1]);
         at(e.line, e.column);
         switch (e.op) {
-            case TokenKind::Plus: return componentwise(Op::Add, {a, b}, e.type);
-            case TokenKind::Minus: return componentwise(Op::Sub, {a, b}, e.type);
-            case TokenKind::Star: return componentwise(Op::Mul, {a, b}, e.type);
+            case TokenKind::Plus:
+                return componentwise(Op::Add, {a, b}, e.type);
+            case TokenKind::Minus:
+                return componentwise(Op::Sub, {a, b}, e.type);
+            case TokenKind::Star:
+                return componentwise(Op::Mul, {a, b}, e.type);
             case TokenKind::Slash:
                 return componentwise(e.type == ValueType::Int ? Op::IDiv : Op::Div, {a, b}, e.type);
-            case TokenKind::Less: return scalarVal(b_.emit(Op::Lt, {a.c[0], b.c[0]}), ValueType::Int);
-            case TokenKind::LessEq: return scalarVal(b_.emit(Op::Le, {a.c[0], b.c[0]}), ValueType::Int);
-            case TokenKind::Greater: return scalarVal(b_.emit(Op::Gt, {a.c[0], b.c[0]}), ValueType::Int);
-            case TokenKind::GreaterEq: return scalarVal(b_.emit(Op::Ge, {a.c[0], b.c[0]}), ValueType::Int);
-            case TokenKind::AndAnd: return scalarVal(b_.emit(Op::And, {a.c[0], b.c[0]}), ValueType::Int);
-            case TokenKind::OrOr: return scalarVal(b_.emit(Op::Or, {a.c[0], b.c[0]}), ValueType::Int);
+            case TokenKind::Less:
+                return scalarVal(b_.emit(Op::Lt, {a.c[0], b.c[0]}), ValueType::Int);
+            case TokenKind::LessEq:
+                return scalarVal(b_.emit(Op::Le, {a.c[0], b.c[0]}), ValueType::Int);
+            case TokenKind::Greater:
+                return scalarVal(b_.emit(Op::Gt, {a.c[0], b.c[0]}), ValueType::Int);
+            case TokenKind::GreaterEq:
+                return scalarVal(b_.emit(Op::Ge, {a.c[0], b.c[0]}), ValueType::Int);
+            case TokenKind::AndAnd:
+                return scalarVal(b_.emit(Op::And, {a.c[0], b.c[0]}), ValueType::Int);
+            case TokenKind::OrOr:
+                return scalarVal(b_.emit(Op::Or, {a.c[0], b.c[0]}), ValueType::Int);
             case TokenKind::EqEq:
             case TokenKind::NotEq: {
                 int eq = b_.emit(Op::Eq, {a.c[0], b.c[0]});
                 if (isTriple(a.type)) {
-                    for (int k = 1; k < 3; ++k) eq = b_.emit(Op::And, {eq, b_.emit(Op::Eq, {a.c[k], b.c[k]})});
+                    for (int k = 1; k < 3; ++k)
+                        eq = b_.emit(Op::And, {eq, b_.emit(Op::Eq, {a.c[k], b.c[k]})});
                 }
                 if (e.op == TokenKind::NotEq) eq = b_.emit(Op::Not, {eq});
                 return scalarVal(eq, ValueType::Int);
             }
-            default: fail(e.line, e.column, "unexpected operator");
+            default:
+                fail(e.line, e.column, "unexpected operator");
         }
     }
 
@@ -215,39 +231,67 @@ private:
         const Builtin fn = findBuiltin(e.name);
         std::vector<Val> a;
         // Octave and ray counts are checked as constants, not lowered as values.
-        const size_t valueArgs =
-            (fn == Builtin::Fbm || fn == Builtin::Turbulence) ? 1 : (fn == Builtin::Occlusion ? 2 : e.args.size());
+        const size_t valueArgs = (fn == Builtin::Fbm || fn == Builtin::Turbulence)
+                                     ? 1
+                                     : (fn == Builtin::Occlusion ? 2 : e.args.size());
         for (size_t k = 0; k < valueArgs; ++k) a.push_back(expr(*e.args[k]));
         at(e.line, e.column);
         const ValueType rt = e.type;
         switch (fn) {
-            case Builtin::Abs: return componentwise(Op::Abs, a, rt);
-            case Builtin::Floor: return componentwise(Op::Floor, a, rt);
-            case Builtin::Ceil: return componentwise(Op::Ceil, a, rt);
-            case Builtin::Fract: return componentwise(Op::Fract, a, rt);
-            case Builtin::Sqrt: return componentwise(Op::Sqrt, a, rt);
-            case Builtin::Exp: return componentwise(Op::Exp, a, rt);
-            case Builtin::Log: return componentwise(Op::Log, a, rt);
-            case Builtin::Sin: return componentwise(Op::Sin, a, rt);
-            case Builtin::Cos: return componentwise(Op::Cos, a, rt);
-            case Builtin::Tan: return componentwise(Op::Tan, a, rt);
-            case Builtin::Asin: return componentwise(Op::Asin, a, rt);
-            case Builtin::Acos: return componentwise(Op::Acos, a, rt);
-            case Builtin::Atan: return componentwise(Op::Atan, a, rt);
-            case Builtin::Sign: return componentwise(Op::Sign, a, rt);
-            case Builtin::Min: return componentwise(Op::Min, a, rt);
-            case Builtin::Max: return componentwise(Op::Max, a, rt);
-            case Builtin::Mod: return componentwise(Op::Mod, a, rt);
-            case Builtin::Pow: return componentwise(Op::Pow, a, rt);
-            case Builtin::Atan2: return componentwise(Op::Atan2, a, rt);
-            case Builtin::Step: return componentwise(Op::Step, a, rt);
-            case Builtin::Clamp: return componentwise(Op::Clamp, a, rt);
-            case Builtin::Mix: return componentwise(Op::Mix, a, rt);
-            case Builtin::Smoothstep: return componentwise(Op::Smoothstep, a, rt);
-            case Builtin::Bake: return componentwise(Op::Bake, a, rt);
-            case Builtin::Dynamic: return componentwise(Op::Dynamic, a, rt);
-            case Builtin::Dot: return scalarVal(dot(a[0], a[1]));
-            case Builtin::Length: return scalarVal(b_.emit(Op::Sqrt, {dot(a[0], a[0])}));
+            case Builtin::Abs:
+                return componentwise(Op::Abs, a, rt);
+            case Builtin::Floor:
+                return componentwise(Op::Floor, a, rt);
+            case Builtin::Ceil:
+                return componentwise(Op::Ceil, a, rt);
+            case Builtin::Fract:
+                return componentwise(Op::Fract, a, rt);
+            case Builtin::Sqrt:
+                return componentwise(Op::Sqrt, a, rt);
+            case Builtin::Exp:
+                return componentwise(Op::Exp, a, rt);
+            case Builtin::Log:
+                return componentwise(Op::Log, a, rt);
+            case Builtin::Sin:
+                return componentwise(Op::Sin, a, rt);
+            case Builtin::Cos:
+                return componentwise(Op::Cos, a, rt);
+            case Builtin::Tan:
+                return componentwise(Op::Tan, a, rt);
+            case Builtin::Asin:
+                return componentwise(Op::Asin, a, rt);
+            case Builtin::Acos:
+                return componentwise(Op::Acos, a, rt);
+            case Builtin::Atan:
+                return componentwise(Op::Atan, a, rt);
+            case Builtin::Sign:
+                return componentwise(Op::Sign, a, rt);
+            case Builtin::Min:
+                return componentwise(Op::Min, a, rt);
+            case Builtin::Max:
+                return componentwise(Op::Max, a, rt);
+            case Builtin::Mod:
+                return componentwise(Op::Mod, a, rt);
+            case Builtin::Pow:
+                return componentwise(Op::Pow, a, rt);
+            case Builtin::Atan2:
+                return componentwise(Op::Atan2, a, rt);
+            case Builtin::Step:
+                return componentwise(Op::Step, a, rt);
+            case Builtin::Clamp:
+                return componentwise(Op::Clamp, a, rt);
+            case Builtin::Mix:
+                return componentwise(Op::Mix, a, rt);
+            case Builtin::Smoothstep:
+                return componentwise(Op::Smoothstep, a, rt);
+            case Builtin::Bake:
+                return componentwise(Op::Bake, a, rt);
+            case Builtin::Dynamic:
+                return componentwise(Op::Dynamic, a, rt);
+            case Builtin::Dot:
+                return scalarVal(dot(a[0], a[1]));
+            case Builtin::Length:
+                return scalarVal(b_.emit(Op::Sqrt, {dot(a[0], a[0])}));
             case Builtin::Distance: {
                 Val d = componentwise(Op::Sub, {a[0], a[1]}, a[0].type);
                 return scalarVal(b_.emit(Op::Sqrt, {dot(d, d)}));
@@ -275,13 +319,18 @@ private:
             }
             case Builtin::Faceforward: {
                 // N facing against I, judged by the geometric normal (as OSL's 2-argument form).
-                const int facing = b_.emit(Op::Lt, {dot(a[1], global(GlobalId::Ng)), b_.constant(0.0f)});
+                const int facing =
+                    b_.emit(Op::Lt, {dot(a[1], global(GlobalId::Ng)), b_.constant(0.0f)});
                 Val neg = componentwise(Op::Neg, {a[0]}, rt);
                 return componentwise(Op::Select, {scalarVal(facing), a[0], neg}, rt);
             }
-            case Builtin::Noise: case Builtin::Snoise: case Builtin::Cellnoise:
-            case Builtin::Fbm: case Builtin::Turbulence: {
-                static const Op kOps[] = {Op::Noise, Op::Snoise, Op::Cellnoise, Op::Fbm, Op::Turbulence};
+            case Builtin::Noise:
+            case Builtin::Snoise:
+            case Builtin::Cellnoise:
+            case Builtin::Fbm:
+            case Builtin::Turbulence: {
+                static const Op kOps[] = {Op::Noise, Op::Snoise, Op::Cellnoise, Op::Fbm,
+                                          Op::Turbulence};
                 const Op op = kOps[static_cast<int>(fn) - static_cast<int>(Builtin::Noise)];
                 int octaves = 0;
                 if (fn == Builtin::Fbm || fn == Builtin::Turbulence)
@@ -315,7 +364,8 @@ private:
             }
             case Builtin::Diffuse: {
                 Val P = global(GlobalId::P);
-                return lightSum(Op::Diffuse, {P.c[0], P.c[1], P.c[2], a[0].c[0], a[0].c[1], a[0].c[2]});
+                return lightSum(Op::Diffuse,
+                                {P.c[0], P.c[1], P.c[2], a[0].c[0], a[0].c[1], a[0].c[2]});
             }
             case Builtin::Specular:
             case Builtin::Phong: {
@@ -327,31 +377,38 @@ private:
             case Builtin::Occlusion: {
                 const int rays = constantInt(*e.args[2], "the occlusion ray count", 1, 1024);
                 at(e.line, e.column);
-                return scalarVal(b_.emit(Op::Occlusion,
-                                         {a[0].c[0], a[0].c[1], a[0].c[2], a[1].c[0], a[1].c[1], a[1].c[2]},
-                                         1, rays));
+                return scalarVal(b_.emit(
+                    Op::Occlusion,
+                    {a[0].c[0], a[0].c[1], a[0].c[2], a[1].c[0], a[1].c[1], a[1].c[2]}, 1, rays));
             }
-            case Builtin::MakeColor: case Builtin::MakePoint: case Builtin::MakeVector:
+            case Builtin::MakeColor:
+            case Builtin::MakePoint:
+            case Builtin::MakeVector:
             case Builtin::MakeNormal: {
                 Val out;
                 out.type = rt;
                 for (int k = 0; k < 3; ++k)
-                    out.c[k] = a.size() == 3 ? a[k].c[0] : (isTriple(a[0].type) ? a[0].c[k] : a[0].c[0]);
+                    out.c[k] =
+                        a.size() == 3 ? a[k].c[0] : (isTriple(a[0].type) ? a[0].c[k] : a[0].c[0]);
                 return out;
             }
-            case Builtin::MakeFloat: return scalarVal(a[0].c[0]);
+            case Builtin::MakeFloat:
+                return scalarVal(a[0].c[0]);
             case Builtin::MakeInt:
-                return scalarVal(a[0].type == ValueType::Int ? a[0].c[0] : b_.emit(Op::Trunc, {a[0].c[0]}),
-                                 ValueType::Int);
-            case Builtin::None: break;
+                return scalarVal(
+                    a[0].type == ValueType::Int ? a[0].c[0] : b_.emit(Op::Trunc, {a[0].c[0]}),
+                    ValueType::Int);
+            case Builtin::None:
+                break;
         }
         fail(e.line, e.column, "unknown function '" + e.name + "'");
     }
 
     void checkSize(const Stmt& s) {
         if (static_cast<int>(program_.insts.size()) > limits_.maxInstructions)
-            fail(s.line, s.column, "the shader exceeds " + std::to_string(limits_.maxInstructions) +
-                                       " instructions after unrolling its loops");
+            fail(s.line, s.column,
+                 "the shader exceeds " + std::to_string(limits_.maxInstructions) +
+                     " instructions after unrolling its loops");
     }
 
     void assign(const Stmt& s) {
@@ -393,10 +450,18 @@ private:
     void stmt(const Stmt& s) {
         checkSize(s);
         switch (s.kind) {
-            case Stmt::Kind::Block: stmts(s.body); break;
-            case Stmt::Kind::Decl: scopes_.back()[s.name] = convert(expr(*s.value), s.declType); break;
-            case Stmt::Kind::Assign: assign(s); break;
-            case Stmt::Kind::ExprStmt: expr(*s.value); break;
+            case Stmt::Kind::Block:
+                stmts(s.body);
+                break;
+            case Stmt::Kind::Decl:
+                scopes_.back()[s.name] = convert(expr(*s.value), s.declType);
+                break;
+            case Stmt::Kind::Assign:
+                assign(s);
+                break;
+            case Stmt::Kind::ExprStmt:
+                expr(*s.value);
+                break;
             case Stmt::Kind::If: {
                 const int cond = expr(*s.value).c[0];
                 float c;
@@ -416,7 +481,8 @@ private:
                         const Val& thenVal = afterThen[d].at(name);
                         for (int k = 0; k < elseVal.n(); ++k)
                             if (thenVal.c[k] != elseVal.c[k])
-                                elseVal.c[k] = b_.emit(Op::Select, {cond, thenVal.c[k], elseVal.c[k]});
+                                elseVal.c[k] =
+                                    b_.emit(Op::Select, {cond, thenVal.c[k], elseVal.c[k]});
                     }
                 }
                 break;
@@ -429,11 +495,13 @@ private:
                     float c;
                     if (!b_.constantValue(cond, c))
                         fail(s.value->line, s.value->column,
-                             "the loop condition must be constant after folding (loops are unrolled)");
+                             "the loop condition must be constant after folding (loops are "
+                             "unrolled)");
                     if (c == 0.0f) break;
                     if (iteration >= limits_.maxLoopIterations)
-                        fail(s.line, s.column, "the loop runs more than " +
-                                                   std::to_string(limits_.maxLoopIterations) + " iterations");
+                        fail(s.line, s.column,
+                             "the loop runs more than " +
+                                 std::to_string(limits_.maxLoopIterations) + " iterations");
                     stmts(s.body);
                     stmt(*s.step);
                 }

@@ -11,7 +11,7 @@
 namespace mpshade {
 
 struct LoweringLimits {
-    int maxLoopIterations = 4096;    // per loop statement
+    int maxLoopIterations = 4096;     // per loop statement
     int maxInstructions = 1'000'000;  // after unrolling
 };
 

@@ -25,8 +25,12 @@ struct Permutation {
 };
 const Permutation kPerm;
 
-inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
-inline float lerp(float t, float a, float b) { return a + t * (b - a); }
+inline float fade(float t) {
+    return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f);
+}
+inline float lerp(float t, float a, float b) {
+    return a + t * (b - a);
+}
 
 // Perlin 2002's gradient: one of 12 cube-edge directions chosen by the hash.
 inline float grad(int hash, float x, float y, float z) {
@@ -84,7 +88,9 @@ float snoise3(float x, float y, float z) {
     return std::fmin(std::fmax(r, -1.0f), 1.0f);
 }
 
-float noise3(float x, float y, float z) { return 0.5f + 0.5f * snoise3(x, y, z); }
+float noise3(float x, float y, float z) {
+    return 0.5f + 0.5f * snoise3(x, y, z);
+}
 
 float cellnoise3(float x, float y, float z) {
     if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return 0.0f;

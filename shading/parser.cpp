@@ -6,9 +6,12 @@ namespace mpshade {
 namespace {
 
 bool typeFromName(const std::string& s, ValueType& t) {
-    static const struct { const char* name; ValueType type; } kTypes[] = {
-        {"float", ValueType::Float}, {"int", ValueType::Int},       {"color", ValueType::Color},
-        {"point", ValueType::Point}, {"vector", ValueType::Vector}, {"normal", ValueType::Normal}};
+    static const struct {
+        const char* name;
+        ValueType type;
+    } kTypes[] = {{"float", ValueType::Float},   {"int", ValueType::Int},
+                  {"color", ValueType::Color},   {"point", ValueType::Point},
+                  {"vector", ValueType::Vector}, {"normal", ValueType::Normal}};
     for (const auto& k : kTypes) {
         if (s == k.name) {
             t = k.type;
@@ -19,7 +22,7 @@ bool typeFromName(const std::string& s, ValueType& t) {
 }
 
 class Parser {
-public:
+  public:
     Parser(const std::string& file, std::vector<Token> tokens)
         : file_(file), tokens_(std::move(tokens)) {}
 
@@ -49,7 +52,7 @@ public:
         return ast;
     }
 
-private:
+  private:
     const Token& peek(int ahead = 0) const {
         size_t k = pos_ + static_cast<size_t>(ahead);
         return tokens_[k < tokens_.size() ? k : tokens_.size() - 1];
@@ -75,8 +78,9 @@ private:
         const Token& typeTok = expect(TokenKind::Identifier, "a parameter type");
         ParamDecl p;
         if (!typeFromName(typeTok.text, p.type))
-            fail(typeTok, "expected a parameter type (float, int, color, point, vector, normal), found " +
-                              spell(typeTok));
+            fail(typeTok,
+                 "expected a parameter type (float, int, color, point, vector, normal), found " +
+                     spell(typeTok));
         const Token& name = expect(TokenKind::Identifier, "the parameter's name");
         p.name = name.text;
         p.line = name.line;
@@ -98,7 +102,9 @@ private:
         const Token& open = expect(TokenKind::LBrace, "'{'");
         auto b = makeStmt(Stmt::Kind::Block, open);
         while (peek().kind != TokenKind::RBrace) {
-            if (peek().kind == TokenKind::End) fail(peek(), "expected '}' to close the block opened at line " + std::to_string(open.line) + ", found end of file");
+            if (peek().kind == TokenKind::End)
+                fail(peek(), "expected '}' to close the block opened at line " +
+                                 std::to_string(open.line) + ", found end of file");
             b->body.push_back(statement());
         }
         next();
@@ -129,7 +135,8 @@ private:
             const Token& opTok = next();
             if (e->kind != Expr::Kind::Name &&
                 !(e->kind == Expr::Kind::Index && e->args[0]->kind == Expr::Kind::Name))
-                fail(opTok, "the left side of " + spell(opTok) + " must be a variable or a component of one");
+                fail(opTok, "the left side of " + spell(opTok) +
+                                " must be a variable or a component of one");
             auto s = makeStmt(Stmt::Kind::Assign, first);
             s->assignOp = k;
             s->target = std::move(e);
@@ -173,7 +180,8 @@ private:
         if (first.kind == TokenKind::Identifier &&
             (first.text == "while" || first.text == "do" || first.text == "return" ||
              first.text == "break" || first.text == "continue"))
-            fail(first, "'" + first.text + "' is not part of the shading language (v1 has if, for and blocks)");
+            fail(first, "'" + first.text +
+                            "' is not part of the shading language (v1 has if, for and blocks)");
         auto s = simpleStatement();
         expect(TokenKind::Semicolon, "';' after the statement");
         return s;
@@ -191,14 +199,26 @@ private:
 
     static int precedence(TokenKind k) {
         switch (k) {
-            case TokenKind::OrOr: return 1;
-            case TokenKind::AndAnd: return 2;
-            case TokenKind::EqEq: case TokenKind::NotEq: return 3;
-            case TokenKind::Less: case TokenKind::LessEq: case TokenKind::Greater:
-            case TokenKind::GreaterEq: return 4;
-            case TokenKind::Plus: case TokenKind::Minus: return 5;
-            case TokenKind::Star: case TokenKind::Slash: return 6;
-            default: return -1;
+            case TokenKind::OrOr:
+                return 1;
+            case TokenKind::AndAnd:
+                return 2;
+            case TokenKind::EqEq:
+            case TokenKind::NotEq:
+                return 3;
+            case TokenKind::Less:
+            case TokenKind::LessEq:
+            case TokenKind::Greater:
+            case TokenKind::GreaterEq:
+                return 4;
+            case TokenKind::Plus:
+            case TokenKind::Minus:
+                return 5;
+            case TokenKind::Star:
+            case TokenKind::Slash:
+                return 6;
+            default:
+                return -1;
         }
     }
 

@@ -10,7 +10,8 @@
 
 namespace mpshade {
 
-std::shared_ptr<const ShaderAst> compileShaderText(const std::string& file, const std::string& text) {
+std::shared_ptr<const ShaderAst> compileShaderText(const std::string& file,
+                                                   const std::string& text) {
     auto ast = std::make_shared<ShaderAst>(parseShader(file, text));
     typecheckShader(*ast);
     return ast;
@@ -24,7 +25,8 @@ std::shared_ptr<const ShaderAst> loadShaderFile(const std::string& path) {
     return compileShaderText(path, text.str());
 }
 
-std::shared_ptr<const ShaderKernel> buildKernel(const ShaderAst& ast, const ShaderBinding& binding) {
+std::shared_ptr<const ShaderKernel> buildKernel(const ShaderAst& ast,
+                                                const ShaderBinding& binding) {
     return std::make_shared<const ShaderKernel>(lowerShader(ast, binding));
 }
 

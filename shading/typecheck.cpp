@@ -60,23 +60,42 @@ ValueType builtinResultType(Builtin b, const std::vector<ValueType>& args, std::
         return true;
     };
     switch (b) {
-        case Builtin::Abs: case Builtin::Floor: case Builtin::Ceil: case Builtin::Fract:
-        case Builtin::Sqrt: case Builtin::Exp: case Builtin::Log: case Builtin::Sin:
-        case Builtin::Cos: case Builtin::Tan: case Builtin::Asin: case Builtin::Acos:
-        case Builtin::Atan: case Builtin::Sign:
+        case Builtin::Abs:
+        case Builtin::Floor:
+        case Builtin::Ceil:
+        case Builtin::Fract:
+        case Builtin::Sqrt:
+        case Builtin::Exp:
+        case Builtin::Log:
+        case Builtin::Sin:
+        case Builtin::Cos:
+        case Builtin::Tan:
+        case Builtin::Asin:
+        case Builtin::Acos:
+        case Builtin::Atan:
+        case Builtin::Sign:
             if (!arity(1)) return ValueType::Void;
             return isTriple(args[0]) ? args[0] : ValueType::Float;
-        case Builtin::Min: case Builtin::Max: case Builtin::Mod: case Builtin::Pow:
-        case Builtin::Atan2: case Builtin::Step:
+        case Builtin::Min:
+        case Builtin::Max:
+        case Builtin::Mod:
+        case Builtin::Pow:
+        case Builtin::Atan2:
+        case Builtin::Step:
             if (!arity(2)) return ValueType::Void;
             return firstTriple(args);
-        case Builtin::Clamp: case Builtin::Mix: case Builtin::Smoothstep:
+        case Builtin::Clamp:
+        case Builtin::Mix:
+        case Builtin::Smoothstep:
             if (!arity(3)) return ValueType::Void;
             return firstTriple(args);
-        case Builtin::Dot: case Builtin::Distance:
+        case Builtin::Dot:
+        case Builtin::Distance:
             if (!arity(2) || !needTriple(0) || !needTriple(1)) return ValueType::Void;
             return ValueType::Float;
-        case Builtin::Cross: case Builtin::Reflect: case Builtin::Faceforward:
+        case Builtin::Cross:
+        case Builtin::Reflect:
+        case Builtin::Faceforward:
             if (!arity(2) || !needTriple(0) || !needTriple(1)) return ValueType::Void;
             return args[0];
         case Builtin::Length:
@@ -85,10 +104,13 @@ ValueType builtinResultType(Builtin b, const std::vector<ValueType>& args, std::
         case Builtin::Normalize:
             if (!arity(1) || !needTriple(0)) return ValueType::Void;
             return args[0];
-        case Builtin::Noise: case Builtin::Snoise: case Builtin::Cellnoise:
+        case Builtin::Noise:
+        case Builtin::Snoise:
+        case Builtin::Cellnoise:
             if (!arity(1)) return ValueType::Void;
             return ValueType::Float;
-        case Builtin::Fbm: case Builtin::Turbulence:
+        case Builtin::Fbm:
+        case Builtin::Turbulence:
             if (!arity(2) || !needScalar(1)) return ValueType::Void;
             return ValueType::Float;
         case Builtin::Ambient:
@@ -100,20 +122,27 @@ ValueType builtinResultType(Builtin b, const std::vector<ValueType>& args, std::
         case Builtin::Diffuse:
             if (!arity(1) || !needTriple(0)) return ValueType::Void;
             return ValueType::Color;
-        case Builtin::Specular: case Builtin::Phong:
-            if (!arity(3) || !needTriple(0) || !needTriple(1) || !needScalar(2)) return ValueType::Void;
+        case Builtin::Specular:
+        case Builtin::Phong:
+            if (!arity(3) || !needTriple(0) || !needTriple(1) || !needScalar(2))
+                return ValueType::Void;
             return ValueType::Color;
         case Builtin::Occlusion:
-            if (!arity(3) || !needTriple(0) || !needTriple(1) || !needScalar(2)) return ValueType::Void;
+            if (!arity(3) || !needTriple(0) || !needTriple(1) || !needScalar(2))
+                return ValueType::Void;
             return ValueType::Float;
-        case Builtin::Bake: case Builtin::Dynamic:
+        case Builtin::Bake:
+        case Builtin::Dynamic:
             if (!arity(1)) return ValueType::Void;
             return args[0];
-        case Builtin::MakeColor: case Builtin::MakePoint: case Builtin::MakeVector:
+        case Builtin::MakeColor:
+        case Builtin::MakePoint:
+        case Builtin::MakeVector:
         case Builtin::MakeNormal: {
             static const ValueType kResult[] = {ValueType::Color, ValueType::Point,
                                                 ValueType::Vector, ValueType::Normal};
-            const ValueType result = kResult[static_cast<int>(b) - static_cast<int>(Builtin::MakeColor)];
+            const ValueType result =
+                kResult[static_cast<int>(b) - static_cast<int>(Builtin::MakeColor)];
             if (args.size() == 1 && (isScalar(args[0]) || isTriple(args[0]))) return result;
             if (args.size() == 3 && isScalar(args[0]) && isScalar(args[1]) && isScalar(args[2]))
                 return result;
@@ -121,10 +150,12 @@ ValueType builtinResultType(Builtin b, const std::vector<ValueType>& args, std::
                   "' takes three floats, or one float or 3-component value";
             return ValueType::Void;
         }
-        case Builtin::MakeFloat: case Builtin::MakeInt:
+        case Builtin::MakeFloat:
+        case Builtin::MakeInt:
             if (!arity(1) || !needScalar(0)) return ValueType::Void;
             return b == Builtin::MakeFloat ? ValueType::Float : ValueType::Int;
-        case Builtin::None: break;
+        case Builtin::None:
+            break;
     }
     why = "unknown function";
     return ValueType::Void;
@@ -133,7 +164,7 @@ ValueType builtinResultType(Builtin b, const std::vector<ValueType>& args, std::
 namespace {
 
 class TypeChecker {
-public:
+  public:
     explicit TypeChecker(ShaderAst& ast) : ast_(ast) {}
 
     void run() {
@@ -143,16 +174,19 @@ public:
             if (findGlobal(p.name, g, gt) || p.name == "Ci" || p.name == "Oi")
                 fail(p.line, p.column, "parameter '" + p.name + "' has the name of a global");
             if (findBuiltin(p.name) != Builtin::None)
-                fail(p.line, p.column, "parameter '" + p.name + "' has the name of a built-in function");
+                fail(p.line, p.column,
+                     "parameter '" + p.name + "' has the name of a built-in function");
             // Defaults see no globals and no other parameters: they are constants.
             scopes_.assign(1, {});
             ValueType t = expr(*p.defaultValue);
             if (!assignable(t, p.type))
                 fail(p.defaultValue->line, p.defaultValue->column,
-                     std::string("default of '") + p.name + "' is " + typeName(t) + ", expected " + typeName(p.type));
+                     std::string("default of '") + p.name + "' is " + typeName(t) + ", expected " +
+                         typeName(p.type));
             for (const auto& q : ast_.params) {
                 if (&q == &p) break;
-                if (q.name == p.name) fail(p.line, p.column, "parameter '" + p.name + "' is declared twice");
+                if (q.name == p.name)
+                    fail(p.line, p.column, "parameter '" + p.name + "' is declared twice");
             }
         }
         scopes_.assign(1, {});
@@ -164,7 +198,7 @@ public:
             fail(ast_.line, ast_.column, "shader '" + ast_.name + "' never assigns Ci");
     }
 
-private:
+  private:
     [[noreturn]] void fail(int line, int col, const std::string& msg) const {
         throw InputError({ast_.file, line, col, {}}, msg);
     }
@@ -187,7 +221,8 @@ private:
         if (findGlobal(s.name, g, gt) || s.name == "Ci" || s.name == "Oi")
             fail(s.line, s.column, "'" + s.name + "' is a global and cannot be redeclared");
         if (findBuiltin(s.name) != Builtin::None)
-            fail(s.line, s.column, "'" + s.name + "' is a built-in function and cannot name a variable");
+            fail(s.line, s.column,
+                 "'" + s.name + "' is a built-in function and cannot name a variable");
         if (scopes_.back().count(s.name))
             fail(s.line, s.column, "'" + s.name + "' is already declared in this scope");
         scopes_.back()[s.name] = s.declType;
@@ -213,7 +248,8 @@ private:
                 const Expr& target = *s.target;
                 const Expr& var = target.kind == Expr::Kind::Index ? *target.args[0] : target;
                 ValueType vt;
-                if (!lookup(var.name, vt)) fail(var.line, var.column, "unknown variable '" + var.name + "'");
+                if (!lookup(var.name, vt))
+                    fail(var.line, var.column, "unknown variable '" + var.name + "'");
                 GlobalId g;
                 ValueType gt;
                 if (findGlobal(var.name, g, gt) && !isShadowed(var.name))
@@ -231,8 +267,9 @@ private:
                 }
                 if (!assignable(value, targetType))
                     fail(s.value->line, s.value->column,
-                         std::string("cannot assign a ") + typeName(value) + " to " + typeName(targetType) +
-                             " '" + var.name + "'" + hint(value, targetType));
+                         std::string("cannot assign a ") + typeName(value) + " to " +
+                             typeName(targetType) + " '" + var.name + "'" +
+                             hint(value, targetType));
                 break;
             }
             case Stmt::Kind::ExprStmt:
@@ -276,7 +313,9 @@ private:
     void condition(Expr& e, const char* what) {
         ValueType t = expr(e);
         if (!isScalar(t))
-            fail(e.line, e.column, std::string("the condition of '") + what + "' must be a float or int, not " + typeName(t));
+            fail(e.line, e.column,
+                 std::string("the condition of '") + what + "' must be a float or int, not " +
+                     typeName(t));
     }
 
     static ValueType arithmeticType(ValueType a, ValueType b, std::string& why) {
@@ -301,7 +340,8 @@ private:
                 ValueType t;
                 if (!lookup(e.name, t)) {
                     if (findBuiltin(e.name) != Builtin::None)
-                        fail(e.line, e.column, "'" + e.name + "' is a function; call it with '(...)'");
+                        fail(e.line, e.column,
+                             "'" + e.name + "' is a function; call it with '(...)'");
                     fail(e.line, e.column, "unknown variable '" + e.name + "'");
                 }
                 return t;
@@ -309,7 +349,9 @@ private:
             case Expr::Kind::Unary: {
                 ValueType t = expr(*e.args[0]);
                 if (e.op == TokenKind::Bang) {
-                    if (!isScalar(t)) fail(e.line, e.column, std::string("'!' needs a float or int, not ") + typeName(t));
+                    if (!isScalar(t))
+                        fail(e.line, e.column,
+                             std::string("'!' needs a float or int, not ") + typeName(t));
                     return ValueType::Int;
                 }
                 if (!isScalar(t) && !isTriple(t)) fail(e.line, e.column, "'-' needs a value");
@@ -318,22 +360,33 @@ private:
             case Expr::Kind::Binary: {
                 ValueType a = expr(*e.args[0]), b = expr(*e.args[1]);
                 switch (e.op) {
-                    case TokenKind::Plus: case TokenKind::Minus: case TokenKind::Star: case TokenKind::Slash: {
+                    case TokenKind::Plus:
+                    case TokenKind::Minus:
+                    case TokenKind::Star:
+                    case TokenKind::Slash: {
                         std::string why;
                         ValueType t = arithmeticType(a, b, why);
                         if (t == ValueType::Void) fail(e.line, e.column, why);
                         return t;
                     }
-                    case TokenKind::Less: case TokenKind::LessEq: case TokenKind::Greater:
+                    case TokenKind::Less:
+                    case TokenKind::LessEq:
+                    case TokenKind::Greater:
                     case TokenKind::GreaterEq:
                         if (!isScalar(a) || !isScalar(b))
-                            fail(e.line, e.column, std::string("cannot order ") + typeName(a) + " and " + typeName(b) + "; compare components");
+                            fail(e.line, e.column,
+                                 std::string("cannot order ") + typeName(a) + " and " +
+                                     typeName(b) + "; compare components");
                         return ValueType::Int;
-                    case TokenKind::EqEq: case TokenKind::NotEq:
+                    case TokenKind::EqEq:
+                    case TokenKind::NotEq:
                         if (!((isScalar(a) && isScalar(b)) || (isTriple(a) && isTriple(b))))
-                            fail(e.line, e.column, std::string("cannot compare ") + typeName(a) + " and " + typeName(b));
+                            fail(e.line, e.column,
+                                 std::string("cannot compare ") + typeName(a) + " and " +
+                                     typeName(b));
                         return ValueType::Int;
-                    case TokenKind::AndAnd: case TokenKind::OrOr:
+                    case TokenKind::AndAnd:
+                    case TokenKind::OrOr:
                         if (!isScalar(a) || !isScalar(b))
                             fail(e.line, e.column, "'&&' and '||' need float or int operands");
                         return ValueType::Int;
@@ -345,7 +398,9 @@ private:
                 ValueType base = expr(*e.args[0]);
                 ValueType idx = expr(*e.args[1]);
                 if (!isTriple(base))
-                    fail(e.line, e.column, std::string("only 3-component values can be indexed, not ") + typeName(base));
+                    fail(e.line, e.column,
+                         std::string("only 3-component values can be indexed, not ") +
+                             typeName(base));
                 if (idx != ValueType::Int)
                     fail(e.args[1]->line, e.args[1]->column, "a component index must be an int");
                 return ValueType::Float;
@@ -354,7 +409,8 @@ private:
                 Builtin b = findBuiltin(e.name);
                 if (b == Builtin::None) {
                     ValueType t;
-                    if (lookup(e.name, t)) fail(e.line, e.column, "'" + e.name + "' is a variable, not a function");
+                    if (lookup(e.name, t))
+                        fail(e.line, e.column, "'" + e.name + "' is a variable, not a function");
                     fail(e.line, e.column, "unknown function '" + e.name + "'");
                 }
                 std::vector<ValueType> args;
@@ -375,6 +431,8 @@ private:
 
 }  // namespace
 
-void typecheckShader(ShaderAst& ast) { TypeChecker(ast).run(); }
+void typecheckShader(ShaderAst& ast) {
+    TypeChecker(ast).run();
+}
 
 }  // namespace mpshade

@@ -21,7 +21,8 @@ struct CliRun {
 };
 
 CliRun mpshade(const std::string& args) {
-    const std::string command = "cd '" MPSHADE_SOURCE_DIR "' && '" MPSHADE_BINARY "' " + args + " 2>&1";
+    const std::string command =
+        "cd '" MPSHADE_SOURCE_DIR "' && '" MPSHADE_BINARY "' " + args + " 2>&1";
     FILE* pipe = popen(command.c_str(), "r");
     CliRun run{-1, ""};
     if (!pipe) return run;
@@ -40,7 +41,8 @@ std::string tempDir(const std::string& name) {
 
 TEST(Cli, RendersTheVaseToReadableFrames) {
     const std::string out = tempDir("vase");
-    const CliRun run = mpshade("render examples/vase/scene.json --mode reference --frames 0:2 --size 160x90 --out " + out);
+    const CliRun run = mpshade(
+        "render examples/vase/scene.json --mode reference --frames 0:2 --size 160x90 --out " + out);
     ASSERT_EQ(run.exitCode, 0) << run.output;
     for (const char* frame : {"frame_0000", "frame_0001"}) {
         OIIO::ImageBuf exr(out + "/" + frame + ".exr");
@@ -73,7 +75,8 @@ TEST(Cli, RendersTheVaseToReadableFrames) {
 
 TEST(Cli, SppAndSeedOverrideTheScene) {
     const std::string out = tempDir("spp");
-    const CliRun run = mpshade("render examples/teapot/scene.json --frames 5 --size 40x30 --spp 2 --seed 3 --out " + out);
+    const CliRun run = mpshade(
+        "render examples/teapot/scene.json --frames 5 --size 40x30 --spp 2 --seed 3 --out " + out);
     ASSERT_EQ(run.exitCode, 0) << run.output;
     EXPECT_TRUE(std::filesystem::exists(out + "/frame_0005.exr"));
     std::ifstream statsFile(out + "/stats.json");
@@ -90,11 +93,13 @@ struct BadRun {
 TEST(Cli, BadInputExitsTwoNamingThePlace) {
     const BadRun cases[] = {
         {"render tests/data/bad_scenes/negative_radius.json --out /tmp/x",
-         "mpshade: tests/data/bad_scenes/negative_radius.json: objects[0].geometry.radius: error: expected a positive number, found -1\n"},
+         "mpshade: tests/data/bad_scenes/negative_radius.json: objects[0].geometry.radius: error: "
+         "expected a positive number, found -1\n"},
         {"render tests/data/bad_scenes/syntax_error.json --out /tmp/x",
          "mpshade: tests/data/bad_scenes/syntax_error.json:2:30: error: invalid JSON"},
         {"render tests/data/bad_scenes/bad_shader.json --out /tmp/x",
-         "mpshade: tests/data/bad_shaders/missing_semicolon.sl:3:5: error: expected ';' after the statement, found 'Ci'"},
+         "mpshade: tests/data/bad_shaders/missing_semicolon.sl:3:5: error: expected ';' after the "
+         "statement, found 'Ci'"},
         {"render tests/data/bad_scenes/malformed_obj.json --out /tmp/x",
          "mpshade: tests/data/meshes/bad_number.obj:2:7: error: expected a number, found 'zero'"},
         {"render examples/vase/scene.json --frames 0:999 --out /tmp/x",
@@ -107,8 +112,10 @@ TEST(Cli, BadInputExitsTwoNamingThePlace) {
          "mpshade: --size: error: expected WxH with each in 1..16384, found '0x10'\n"},
         {"render examples/vase/scene.json --mode fast --out /tmp/x",
          "mpshade: --mode: error: unknown mode 'fast' (available: reference)\n"},
-        {"render examples/vase/scene.json --spp 0 --out /tmp/x", "mpshade: --spp: error: expected 1..1024, found 0\n"},
-        {"render nowhere.json --out /tmp/x", "mpshade: nowhere.json: error: cannot open scene file\n"},
+        {"render examples/vase/scene.json --spp 0 --out /tmp/x",
+         "mpshade: --spp: error: expected 1..1024, found 0\n"},
+        {"render nowhere.json --out /tmp/x",
+         "mpshade: nowhere.json: error: cannot open scene file\n"},
         {"render examples/vase/scene.json", "mpshade: error: --out is required"},
         {"paint", "mpshade: error: "},
     };
@@ -121,7 +128,8 @@ TEST(Cli, BadInputExitsTwoNamingThePlace) {
 
 TEST(Cli, EveryBadSceneExitsTwo) {
     int count = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(MPSHADE_SOURCE_DIR "/tests/data/bad_scenes")) {
+    for (const auto& entry :
+         std::filesystem::directory_iterator(MPSHADE_SOURCE_DIR "/tests/data/bad_scenes")) {
         const std::string rel = "tests/data/bad_scenes/" + entry.path().filename().string();
         const CliRun run = mpshade("render " + rel + " --out " + tempDir("bad"));
         EXPECT_EQ(run.exitCode, 2) << rel << "\n" << run.output;

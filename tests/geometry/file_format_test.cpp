@@ -31,7 +31,8 @@ InputError expectInputError(F&& f) {
 }
 
 TEST(ObjReader, ReadsPositionsTexcoordsNormalsAndNegativeIndices) {
-    const auto path = writeTemp("ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf -3/1/1 -2/1/1 -1/1/1\n");
+    const auto path = writeTemp(
+        "ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf -3/1/1 -2/1/1 -1/1/1\n");
     const PolygonMeshData mesh = readObjPolygons(path);
     ASSERT_EQ(mesh.faceSizes.size(), 1u);
     EXPECT_EQ(mesh.corners[0].position, 0);
@@ -47,11 +48,13 @@ TEST(ObjReader, NamesLineAndColumnOfBadInput) {
         const char* message;
     } cases[] = {
         {"v 0 0 0\nv 1 x 0\n", 2, 5, "expected a number, found 'x'"},
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", 4, 7, "vertex index 4 is out of range (3 defined so far)"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", 4, 7,
+         "vertex index 4 is out of range (3 defined so far)"},
         {"v 0 0 0\nv 1 0 0\nf 1 2\n", 3, 6, "a face needs at least 3 corners, this one has 2"},
         {"v 0 0 nan\n", 1, 7, "coordinate 'nan' is not a finite float"},
         {"v 0 0 1e40\n", 1, 7, "coordinate '1e40' is not a finite float"},
-        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", 4, 7, "vertex index 0 is out of range (3 defined so far)"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", 4, 7,
+         "vertex index 0 is out of range (3 defined so far)"},
         {"v 0 0 0\nbogus 1\n", 2, 1, "unknown OBJ record 'bogus'"},
         {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/a 2 3\n", 4, 3, "malformed texture coordinate index 'a'"},
     };
@@ -67,26 +70,33 @@ TEST(ObjReader, NamesLineAndColumnOfBadInput) {
 }
 
 TEST(ObjReader, RejectsMissingAndEmptyFiles) {
-    EXPECT_EQ(expectInputError([] { readObjPolygons("/nonexistent/x.obj"); }).message(), "cannot open OBJ file");
+    EXPECT_EQ(expectInputError([] { readObjPolygons("/nonexistent/x.obj"); }).message(),
+              "cannot open OBJ file");
     const auto path = writeTemp("empty.obj", "# nothing\nv 0 0 0\n");
-    EXPECT_EQ(expectInputError([&] { readObjPolygons(path); }).message(), "the OBJ file has no faces");
+    EXPECT_EQ(expectInputError([&] { readObjPolygons(path); }).message(),
+              "the OBJ file has no faces");
 }
 
 TEST(PolygonMesh, DropsZeroAreaFaces) {
-    const auto path = writeTemp("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
+    const auto path =
+        writeTemp("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
     const PolygonMesh mesh(readObjPolygons(path));
     EXPECT_EQ(mesh.chartCount(), 1);
     EXPECT_EQ(mesh.droppedFaces(), 1);
 }
 
 TEST(BezierFile, NamesLineOfBadInput) {
-    const auto path = writeTemp("bad.patches", "1\n1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16\n16\n0 0 zero\n");
+    const auto path =
+        writeTemp("bad.patches", "1\n1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16\n16\n0 0 zero\n");
     const InputError e = expectInputError([&] { loadBezierPatches(path); });
     EXPECT_EQ(e.where().line, 4);
     EXPECT_EQ(e.message(), "expected a coordinate, found 'zero'");
-    const auto range = writeTemp("range.patches", "1\n1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,99\n16\n" +
-                                                      std::string(16 * 6, ' ') + "\n");
-    EXPECT_NE(expectInputError([&] { loadBezierPatches(range); }).message().find("expected a coordinate"), std::string::npos);
+    const auto range =
+        writeTemp("range.patches", "1\n1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,99\n16\n" +
+                                       std::string(16 * 6, ' ') + "\n");
+    EXPECT_NE(
+        expectInputError([&] { loadBezierPatches(range); }).message().find("expected a coordinate"),
+        std::string::npos);
     const auto truncated = writeTemp("trunc.patches", "2\n1,2,3\n");
     EXPECT_EQ(expectInputError([&] { loadBezierPatches(truncated); }).message(),
               "unexpected end of file, expected a control point index");

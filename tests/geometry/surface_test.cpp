@@ -7,8 +7,8 @@
 #include <random>
 #include <tuple>
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include "geometry/ray_scene.h"
 #include "geometry/surface.h"
@@ -30,19 +30,27 @@ std::vector<NamedSurface> allSurfaces() {
     s.push_back({"sphere", std::make_shared<const Surface>(Sphere{1.5f})});
     s.push_back({"torus", std::make_shared<const Surface>(Torus{1.0f, 0.3f})});
     s.push_back({"plane", std::make_shared<const Surface>(Plane{4.0f, 2.0f})});
-    s.push_back({"teapot", std::make_shared<const Surface>(loadBezierPatches(sourcePath("examples/teapot/teapot.patches")))});
+    s.push_back({"teapot", std::make_shared<const Surface>(
+                               loadBezierPatches(sourcePath("examples/teapot/teapot.patches")))});
     s.push_back({"vase_catmark", std::make_shared<const Surface>(SubdivSurface(
-                                     loadObjCage(sourcePath("examples/vase/meshes/vase.obj")), SubdivScheme::Catmark, "vase"))});
+                                     loadObjCage(sourcePath("examples/vase/meshes/vase.obj")),
+                                     SubdivScheme::Catmark, "vase"))});
     s.push_back({"octahedron_loop", std::make_shared<const Surface>(SubdivSurface(
-                                        loadObjCage(sourcePath("tests/data/meshes/octahedron.obj")), SubdivScheme::Loop, "octa"))});
-    s.push_back({"cube_mesh", std::make_shared<const Surface>(PolygonMesh(readObjPolygons(sourcePath("tests/data/meshes/cube.obj"))))});
-    s.push_back({"pentagon_mesh", std::make_shared<const Surface>(PolygonMesh(readObjPolygons(sourcePath("tests/data/meshes/pentagon.obj")))), true});
-    s.push_back({"points", std::make_shared<const Surface>(loadPointCloud(sourcePath("tests/data/meshes/points.txt")))});
+                                        loadObjCage(sourcePath("tests/data/meshes/octahedron.obj")),
+                                        SubdivScheme::Loop, "octa"))});
+    s.push_back({"cube_mesh", std::make_shared<const Surface>(PolygonMesh(
+                                  readObjPolygons(sourcePath("tests/data/meshes/cube.obj"))))});
+    s.push_back({"pentagon_mesh",
+                 std::make_shared<const Surface>(
+                     PolygonMesh(readObjPolygons(sourcePath("tests/data/meshes/pentagon.obj")))),
+                 true});
+    s.push_back({"points", std::make_shared<const Surface>(
+                               loadPointCloud(sourcePath("tests/data/meshes/points.txt")))});
     return s;
 }
 
 class SurfaceProperties : public ::testing::TestWithParam<int> {
-protected:
+  protected:
     static const std::vector<NamedSurface>& surfaces() {
         static const std::vector<NamedSurface> s = allSurfaces();
         return s;
@@ -58,13 +66,15 @@ TEST_P(SurfaceProperties, NormalsAreUnitAndAgreeWithDerivatives) {
     ASSERT_GT(charts, 0);
     int oriented = 0, checked = 0;
     for (int i = 0; i < 2000; ++i) {
-        const ChartPoint at{static_cast<int>(rng() % static_cast<unsigned>(charts)), uni(rng), uni(rng)};
+        const ChartPoint at{static_cast<int>(rng() % static_cast<unsigned>(charts)), uni(rng),
+                            uni(rng)};
         const SurfaceSample s = evaluate(surface(), at);
         ASSERT_NEAR(glm::length(s.N), 1.0f, 1e-4f) << named().name;
         ASSERT_NEAR(glm::length(s.Ng), 1.0f, 1e-4f) << named().name;
         ASSERT_GE(glm::dot(s.N, s.Ng), 0.0f) << named().name;
         const glm::vec3 c = glm::cross(s.dPdu, s.dPdv);
-        if (glm::length(c) > 1e-4f * glm::length(s.dPdu) * glm::length(s.dPdv) && !named().hasVertexNormals) {
+        if (glm::length(c) > 1e-4f * glm::length(s.dPdu) * glm::length(s.dPdv) &&
+            !named().hasVertexNormals) {
             ++checked;
             if (glm::dot(c, s.Ng) > 0.0f) ++oriented;
         }
@@ -79,14 +89,19 @@ TEST_P(SurfaceProperties, DerivativesMatchFiniteDifferences) {
     const float h = 1e-3f;
     const float scale = surfaceBounds(surface()).diagonal();
     for (int i = 0; i < 500; ++i) {
-        const ChartPoint at{static_cast<int>(rng() % static_cast<unsigned>(charts)), uni(rng), uni(rng)};
+        const ChartPoint at{static_cast<int>(rng() % static_cast<unsigned>(charts)), uni(rng),
+                            uni(rng)};
         const SurfaceSample s = evaluate(surface(), at);
         const glm::vec3 du = (evaluate(surface(), {at.chart, at.u + h, at.v}).P -
-                              evaluate(surface(), {at.chart, at.u - h, at.v}).P) / (2.0f * h);
+                              evaluate(surface(), {at.chart, at.u - h, at.v}).P) /
+                             (2.0f * h);
         const glm::vec3 dv = (evaluate(surface(), {at.chart, at.u, at.v + h}).P -
-                              evaluate(surface(), {at.chart, at.u, at.v - h}).P) / (2.0f * h);
-        ASSERT_LE(glm::length(du - s.dPdu), 2e-3f * scale + 2e-2f * glm::length(s.dPdu)) << named().name << " chart " << at.chart;
-        ASSERT_LE(glm::length(dv - s.dPdv), 2e-3f * scale + 2e-2f * glm::length(s.dPdv)) << named().name << " chart " << at.chart;
+                              evaluate(surface(), {at.chart, at.u, at.v - h}).P) /
+                             (2.0f * h);
+        ASSERT_LE(glm::length(du - s.dPdu), 2e-3f * scale + 2e-2f * glm::length(s.dPdu))
+            << named().name << " chart " << at.chart;
+        ASSERT_LE(glm::length(dv - s.dPdv), 2e-3f * scale + 2e-2f * glm::length(s.dPdv))
+            << named().name << " chart " << at.chart;
     }
 }
 
@@ -103,11 +118,12 @@ TEST_P(SurfaceProperties, ChartsCoverTheUnitSquareWithoutOverlap) {
                 const ChartPoint at{chart, (i + 0.5f) / n, (j + 0.5f) / n};
                 const glm::vec3 p = evaluate(surface(), at).P;
                 ASSERT_TRUE(std::isfinite(p.x + p.y + p.z));
-                auto key = std::make_tuple(std::lround(p.x / cell), std::lround(p.y / cell), std::lround(p.z / cell));
+                auto key = std::make_tuple(std::lround(p.x / cell), std::lround(p.y / cell),
+                                           std::lround(p.z / cell));
                 auto [it, inserted] = seen.emplace(key, at);
-                EXPECT_TRUE(inserted) << named().name << ": chart " << chart << " (" << at.u << ", " << at.v
-                                      << ") lands on chart " << it->second.chart << " (" << it->second.u << ", "
-                                      << it->second.v << ")";
+                EXPECT_TRUE(inserted) << named().name << ": chart " << chart << " (" << at.u << ", "
+                                      << at.v << ") lands on chart " << it->second.chart << " ("
+                                      << it->second.u << ", " << it->second.v << ")";
             }
         }
     }
@@ -124,7 +140,8 @@ TEST_P(SurfaceProperties, RayHitsEvaluateBackToTheHitPoint) {
     for (int i = 0; i < 3000; ++i) {
         glm::vec3 dir(gauss(rng), gauss(rng), gauss(rng));
         dir = glm::normalize(dir);
-        const glm::vec3 target = b.center() + glm::vec3(uni(rng), uni(rng), uni(rng)) * (b.hi - b.lo);
+        const glm::vec3 target =
+            b.center() + glm::vec3(uni(rng), uni(rng), uni(rng)) * (b.hi - b.lo);
         const glm::vec3 org = target - dir * (2.0f * scale);
         SurfaceHit hit;
         if (!rays.intersect(org, dir, 0.0f, 1e30f, hit)) continue;
@@ -138,7 +155,8 @@ TEST_P(SurfaceProperties, RayHitsEvaluateBackToTheHitPoint) {
         ASSERT_LE(glm::length(p - (org + hit.t * dir)), 1e-4f * scale) << named().name;
     }
     EXPECT_GT(hits, 50) << named().name;
-    EXPECT_GE(refined, hits * 95 / 100) << named().name << ": Newton refinement should converge almost always";
+    EXPECT_GE(refined, hits * 95 / 100)
+        << named().name << ": Newton refinement should converge almost always";
 }
 
 std::string surfaceName(const ::testing::TestParamInfo<int>& param) {
@@ -183,7 +201,8 @@ TEST(TeapotGeometry, CollapsedEdgesStillHaveNormals) {
 }
 
 TEST(SubdivGeometry, NgonFacesSplitIntoSubfaceCharts) {
-    const SubdivSurface vase(loadObjCage(sourcePath("examples/vase/meshes/vase.obj")), SubdivScheme::Catmark, "vase");
+    const SubdivSurface vase(loadObjCage(sourcePath("examples/vase/meshes/vase.obj")),
+                             SubdivScheme::Catmark, "vase");
     // 88 quads, and two octagons of 8 sub-faces each.
     EXPECT_EQ(vase.chartCount(), 88 + 16);
     EXPECT_EQ(vase.chartFace(88), 88);
@@ -192,7 +211,8 @@ TEST(SubdivGeometry, NgonFacesSplitIntoSubfaceCharts) {
 
 TEST(SubdivGeometry, LimitSurfaceLiesInsideTheCage) {
     // A Catmull-Clark limit surface shrinks away from the convex cage's vertices.
-    const SubdivSurface octa(loadObjCage(sourcePath("tests/data/meshes/octahedron.obj")), SubdivScheme::Loop, "octa");
+    const SubdivSurface octa(loadObjCage(sourcePath("tests/data/meshes/octahedron.obj")),
+                             SubdivScheme::Loop, "octa");
     for (int chart = 0; chart < octa.chartCount(); ++chart) {
         const glm::vec3 p = octa.evaluate(chart, 0.0f, 0.0f).P;
         EXPECT_LT(glm::length(p), 1.0f - 1e-3f);

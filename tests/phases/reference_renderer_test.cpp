@@ -13,7 +13,8 @@
 namespace mpshade {
 namespace {
 
-std::string writeScene(const std::string& name, const std::string& json, const std::string& shader) {
+std::string writeScene(const std::string& name, const std::string& json,
+                       const std::string& shader) {
     const std::string dir = ::testing::TempDir() + "mpshade_render_test_" + name + "/";
     std::filesystem::create_directories(dir);
     std::ofstream(dir + "s.sl") << shader;
@@ -29,7 +30,8 @@ const char* kBallScene = R"({
 })";
 
 TEST(ReferenceRenderer, SphereCoverageMatchesItsSilhouette) {
-    const Scene scene = loadScene(writeScene("coverage", kBallScene, "surface s() { Ci = color(1, 0, 0); }"));
+    const Scene scene =
+        loadScene(writeScene("coverage", kBallScene, "surface s() { Ci = color(1, 0, 0); }"));
     const ReferenceRenderer renderer(scene);
     RenderOptions options;
     FrameStats stats;
@@ -72,7 +74,8 @@ TEST(ReferenceRenderer, TranslucentLayersCompositeFrontToBack) {
         { "name": "back", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
           "params": { "c": [0, 1, 0] } } ]
     })";
-    const Scene scene = loadScene(writeScene("layers", json, "surface s(color c = 0) { Ci = c; Oi = 0.5; }"));
+    const Scene scene =
+        loadScene(writeScene("layers", json, "surface s(color c = 0) { Ci = c; Oi = 0.5; }"));
     const ReferenceRenderer renderer(scene);
     FrameStats stats;
     const Image image = renderer.renderFrame(0, {}, stats);
@@ -106,7 +109,8 @@ TEST(ReferenceRenderer, IsDeterministicForASeed) {
 }
 
 TEST(ReferenceRenderer, NonFiniteShaderResultsAreCountedAndZeroed) {
-    const Scene scene = loadScene(writeScene("nan", kBallScene, "surface s() { Ci = color(exp(1000 * u) - exp(1000 * u)); }"));
+    const Scene scene = loadScene(writeScene(
+        "nan", kBallScene, "surface s() { Ci = color(exp(1000 * u) - exp(1000 * u)); }"));
     const ReferenceRenderer renderer(scene);
     FrameStats stats;
     const Image image = renderer.renderFrame(0, {}, stats);

@@ -3,8 +3,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include "geometry/error.h"
 #include "scene/scene.h"
@@ -27,46 +27,72 @@ struct BadScene {
 
 const BadScene kBadScenes[] = {
     {"missing_camera", "", "(top level)", 0, 0, "missing required key 'camera'"},
-    {"extra_key", "", "objects[0].colour", 0, 0, "unknown key 'colour' (expected one of: name, geometry, shader, params, transform, keys, representation, shadermap_resolution, range)"},
+    {"extra_key", "", "objects[0].colour", 0, 0,
+     "unknown key 'colour' (expected one of: name, geometry, shader, params, transform, keys, "
+     "representation, shadermap_resolution, range)"},
     {"wrong_type", "", "objects[0].geometry.radius", 0, 0, "expected a number, found a string"},
-    {"negative_radius", "", "objects[0].geometry.radius", 0, 0, "expected a positive number, found -1"},
-    {"missing_obj", "", "objects[0].geometry.file", 0, 0, "file '../meshes/nope.obj' not found (looked for " },
-    {"malformed_obj", "tests/data/meshes/bad_number.obj", "", 2, 7, "expected a number, found 'zero' (loading objects[0].geometry of "},
-    {"bad_obj_index", "tests/data/meshes/bad_index.obj", "", 4, 7, "vertex index 4 is out of range (3 defined so far) (loading objects[0].geometry of "},
-    {"unsorted_keys", "", "camera.keys[1].t", 0, 0, "keys must be sorted by strictly increasing t (previous key has t = 1)"},
+    {"negative_radius", "", "objects[0].geometry.radius", 0, 0,
+     "expected a positive number, found -1"},
+    {"missing_obj", "", "objects[0].geometry.file", 0, 0,
+     "file '../meshes/nope.obj' not found (looked for "},
+    {"malformed_obj", "tests/data/meshes/bad_number.obj", "", 2, 7,
+     "expected a number, found 'zero' (loading objects[0].geometry of "},
+    {"bad_obj_index", "tests/data/meshes/bad_index.obj", "", 4, 7,
+     "vertex index 4 is out of range (3 defined so far) (loading objects[0].geometry of "},
+    {"unsorted_keys", "", "camera.keys[1].t", 0, 0,
+     "keys must be sorted by strictly increasing t (previous key has t = 1)"},
     {"empty_scene", "", "objects", 0, 0, "the scene has no objects"},
     {"zero_size", "", "settings.width", 0, 0, "expected a whole number in [1, 16384], found 0"},
     {"zero_plane", "", "objects[0].geometry.size[0]", 0, 0, "expected a positive number, found 0"},
     {"unknown_shader", "", "objects[0].shader", 0, 0, "no shader named 'marble' in 'shaders'"},
-    {"unknown_param", "", "objects[0].params.Kss", 0, 0, "shader 'plastic' has no parameter 'Kss' (it has: Cs, Kd, Ks, roughness)"},
-    {"param_type", "", "objects[0].params.Cs", 0, 0, "expected an array of 3 numbers, found a string"},
-    {"unknown_geometry", "", "objects[0].geometry.type", 0, 0, "unknown geometry type 'cone' (expected sphere, torus, plane, bezier, subdiv, mesh or points)"},
+    {"unknown_param", "", "objects[0].params.Kss", 0, 0,
+     "shader 'plastic' has no parameter 'Kss' (it has: Cs, Kd, Ks, roughness)"},
+    {"param_type", "", "objects[0].params.Cs", 0, 0,
+     "expected an array of 3 numbers, found a string"},
+    {"unknown_geometry", "", "objects[0].geometry.type", 0, 0,
+     "unknown geometry type 'cone' (expected sphere, torus, plane, bezier, subdiv, mesh or "
+     "points)"},
     {"eye_is_target", "", "camera", 0, 0, "eye and target coincide at t = 0"},
-    {"bad_light", "", "lights[2].type", 0, 0, "unknown light type 'spot' (expected ambient, distant or point)"},
+    {"bad_light", "", "lights[2].type", 0, 0,
+     "unknown light type 'spot' (expected ambient, distant or point)"},
     {"negative_color", "", "lights[0].color", 0, 0, "color components must be non-negative"},
-    {"bad_shader", "tests/data/bad_shaders/missing_semicolon.sl", "", 3, 5, "expected ';' after the statement, found 'Ci' (loading shaders.plastic of "},
-    {"bad_points", "tests/data/meshes/bad_points.txt", "", 2, 0, "the normal is zero (loading objects[0].geometry of "},
-    {"loop_quads", "tests/data/meshes/cube.obj", "", 0, 0, "face 0 has 4 sides; the loop scheme takes triangles only (loading objects[0].geometry of "},
+    {"bad_shader", "tests/data/bad_shaders/missing_semicolon.sl", "", 3, 5,
+     "expected ';' after the statement, found 'Ci' (loading shaders.plastic of "},
+    {"bad_points", "tests/data/meshes/bad_points.txt", "", 2, 0,
+     "the normal is zero (loading objects[0].geometry of "},
+    {"loop_quads", "tests/data/meshes/cube.obj", "", 0, 0,
+     "face 0 has 4 sides; the loop scheme takes triangles only (loading objects[0].geometry of "},
     {"empty_keys", "", "objects[0].keys", 0, 0, "expected at least one key"},
-    {"nonuniform_scale", "", "objects[0].transform.scale", 0, 0, "scale must be one positive number (mpshade supports uniform scale only)"},
+    {"nonuniform_scale", "", "objects[0].transform.scale", 0, 0,
+     "scale must be one positive number (mpshade supports uniform scale only)"},
     {"duplicate_name", "", "objects[1].name", 0, 0, "another object is already named 'ball'"},
     {"far_before_near", "", "camera", 0, 0, "far (0.01) must exceed near (0.1)"},
-    {"syntax_error", "", "", 2, 30, "invalid JSON: syntax error while parsing object key - unexpected '}'; expected string literal"},
-    {"nan_value", "", "", 79, 19, "invalid JSON: syntax error while parsing value - invalid literal; last read: '\"radius\": N'"},
-    {"inf_value", "", "", 79, 19, "invalid JSON: number overflow parsing '1e999' (numbers must be finite floats)"},
-    {"empty_file", "", "", 1, 1, "invalid JSON: syntax error while parsing value - unexpected end of input; expected '[', '{', or a literal"},
+    {"syntax_error", "", "", 2, 30,
+     "invalid JSON: syntax error while parsing object key - unexpected '}'; expected string "
+     "literal"},
+    {"nan_value", "", "", 79, 19,
+     "invalid JSON: syntax error while parsing value - invalid literal; last read: '\"radius\": "
+     "N'"},
+    {"inf_value", "", "", 79, 19,
+     "invalid JSON: number overflow parsing '1e999' (numbers must be finite floats)"},
+    {"empty_file", "", "", 1, 1,
+     "invalid JSON: syntax error while parsing value - unexpected end of input; expected '[', '{', "
+     "or a literal"},
     {"not_an_object", "", "(top level)", 0, 0, "a scene must be a JSON object"},
 };
 
 TEST(BadScenes, GoldenErrors) {
     size_t checked = 0;
     for (const BadScene& bad : kBadScenes) {
-        const std::string path = sourcePath(std::string("tests/data/bad_scenes/") + bad.name + ".json");
+        const std::string path =
+            sourcePath(std::string("tests/data/bad_scenes/") + bad.name + ".json");
         try {
             loadScene(path);
             ADD_FAILURE() << bad.name << " was accepted";
         } catch (const InputError& e) {
-            const std::string expectedFile = *bad.file ? std::filesystem::path(sourcePath(bad.file)).lexically_normal().string() : path;
+            const std::string expectedFile =
+                *bad.file ? std::filesystem::path(sourcePath(bad.file)).lexically_normal().string()
+                          : path;
             EXPECT_EQ(e.where().file, expectedFile) << bad.name;
             EXPECT_EQ(e.where().jsonPath, bad.jsonPath) << bad.name;
             EXPECT_EQ(e.where().line, bad.line) << bad.name;
@@ -77,7 +103,9 @@ TEST(BadScenes, GoldenErrors) {
     }
     // Every file of the corpus is in the table.
     size_t files = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(sourcePath("tests/data/bad_scenes"))) files += entry.path().extension() == ".json";
+    for (const auto& entry :
+         std::filesystem::directory_iterator(sourcePath("tests/data/bad_scenes")))
+        files += entry.path().extension() == ".json";
     EXPECT_EQ(files, checked);
 }
 
@@ -116,7 +144,8 @@ INSTANTIATE_TEST_SUITE_P(All, ExampleScenes,
 std::string writeScene(const std::string& name, const std::string& json) {
     const std::string dir = ::testing::TempDir() + "mpshade_scene_test/";
     std::filesystem::create_directories(dir);
-    std::ofstream(dir + "s.sl") << "surface s(float k = 1, color c = 0) { Ci = c * k + diffuse(N) + color(time); }";
+    std::ofstream(dir + "s.sl")
+        << "surface s(float k = 1, color c = 0) { Ci = c * k + diffuse(N) + color(time); }";
     std::ofstream(dir + name) << json;
     return dir + name;
 }
@@ -189,7 +218,8 @@ TEST(SceneState, LightsInObjectSpaceKeepWorldFalloff) {
     // (the object is rotated 90 degrees about z), with the world's 1/d^2 kept.
     EXPECT_NEAR(glm::length(lights[0].position - glm::vec3(1, 0, 0)), 0.0f, 1e-5f);
     const float worldIrradiance = 16.0f / (2.0f * 2.0f);
-    EXPECT_NEAR(lights[0].color.x / glm::dot(lights[0].position, lights[0].position), worldIrradiance, 1e-4f);
+    EXPECT_NEAR(lights[0].color.x / glm::dot(lights[0].position, lights[0].position),
+                worldIrradiance, 1e-4f);
     EXPECT_NEAR(glm::length(lights[1].toLight - glm::vec3(1, 0, 0)), 0.0f, 1e-5f);
 }
 

@@ -4,8 +4,8 @@
 #include <functional>
 #include <random>
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include "shading/noise.h"
 #include "shading/shader_harness.h"
@@ -20,7 +20,9 @@ struct Case {
     std::function<float(float, float, float)> expected;
 };
 
-float safeDiv(float a, float b) { return b == 0.0f ? 0.0f : a / b; }
+float safeDiv(float a, float b) {
+    return b == 0.0f ? 0.0f : a / b;
+}
 
 const Case kCases[] = {
     {"abs(u)", [](float u, float, float) { return std::fabs(u); }},
@@ -33,14 +35,18 @@ const Case kCases[] = {
     {"sin(u)", [](float u, float, float) { return std::sin(u); }},
     {"cos(u)", [](float u, float, float) { return std::cos(u); }},
     {"tan(u)", [](float u, float, float) { return std::tan(u); }},
-    {"asin(u)", [](float u, float, float) { return std::asin(std::fmin(std::fmax(u, -1.0f), 1.0f)); }},
-    {"acos(u)", [](float u, float, float) { return std::acos(std::fmin(std::fmax(u, -1.0f), 1.0f)); }},
+    {"asin(u)",
+     [](float u, float, float) { return std::asin(std::fmin(std::fmax(u, -1.0f), 1.0f)); }},
+    {"acos(u)",
+     [](float u, float, float) { return std::acos(std::fmin(std::fmax(u, -1.0f), 1.0f)); }},
     {"atan(u)", [](float u, float, float) { return std::atan(u); }},
     {"sign(u)", [](float u, float, float) { return u > 0 ? 1.0f : (u < 0 ? -1.0f : 0.0f); }},
     {"min(u, v)", [](float u, float v, float) { return std::fmin(u, v); }},
     {"max(u, v)", [](float u, float v, float) { return std::fmax(u, v); }},
-    {"mod(u, v)", [](float u, float v, float) { return v == 0 ? 0.0f : u - v * std::floor(u / v); }},
-    {"pow(u, v)", [](float u, float v, float) {
+    {"mod(u, v)",
+     [](float u, float v, float) { return v == 0 ? 0.0f : u - v * std::floor(u / v); }},
+    {"pow(u, v)",
+     [](float u, float v, float) {
          if (u == 0) return 0.0f;
          if (u < 0 && v != std::floor(v)) return 0.0f;
          return std::pow(u, v);
@@ -49,7 +55,8 @@ const Case kCases[] = {
     {"step(u, v)", [](float u, float v, float) { return v < u ? 0.0f : 1.0f; }},
     {"clamp(u, v, s)", [](float u, float v, float s) { return std::fmin(std::fmax(u, v), s); }},
     {"mix(u, v, s)", [](float u, float v, float s) { return u * (1 - s) + v * s; }},
-    {"smoothstep(v, v + 1.0, u)", [](float u, float v, float) {
+    {"smoothstep(v, v + 1.0, u)",
+     [](float u, float v, float) {
          float t = std::fmin(std::fmax((u - v) / ((v + 1.0f) - v), 0.0f), 1.0f);
          return t * t * (3 - 2 * t);
      }},
@@ -57,33 +64,46 @@ const Case kCases[] = {
     {"u * v - s", [](float u, float v, float s) { return u * v - s; }},
     {"-u + v", [](float u, float v, float) { return -u + v; }},
     {"float(u < v)", [](float u, float v, float) { return u < v ? 1.0f : 0.0f; }},
-    {"float(u >= v && v != s)", [](float u, float v, float s) { return (u >= v && v != s) ? 1.0f : 0.0f; }},
-    {"float(u > v || !(s <= u))", [](float u, float v, float s) { return (u > v || !(s <= u)) ? 1.0f : 0.0f; }},
+    {"float(u >= v && v != s)",
+     [](float u, float v, float s) { return (u >= v && v != s) ? 1.0f : 0.0f; }},
+    {"float(u > v || !(s <= u))",
+     [](float u, float v, float s) { return (u > v || !(s <= u)) ? 1.0f : 0.0f; }},
     {"float(int(u))", [](float u, float, float) { return std::trunc(u); }},
-    {"float(int(u) / int(v))", [](float u, float v, float) { return std::trunc(safeDiv(std::trunc(u), std::trunc(v))); }},
-    {"dot(vector(u, v, s), vector(v, s, u))", [](float u, float v, float s) { return u * v + v * s + s * u; }},
-    {"cross(vector(u, v, s), vector(v, s, u))[0]", [](float u, float v, float s) { return v * u - s * s; }},
-    {"length(vector(u, v, s))", [](float u, float v, float s) { return std::sqrt(u * u + v * v + s * s); }},
-    {"distance(point(u, v, s), point(0.5))", [](float u, float v, float s) {
+    {"float(int(u) / int(v))",
+     [](float u, float v, float) { return std::trunc(safeDiv(std::trunc(u), std::trunc(v))); }},
+    {"dot(vector(u, v, s), vector(v, s, u))",
+     [](float u, float v, float s) { return u * v + v * s + s * u; }},
+    {"cross(vector(u, v, s), vector(v, s, u))[0]",
+     [](float u, float v, float s) { return v * u - s * s; }},
+    {"length(vector(u, v, s))",
+     [](float u, float v, float s) { return std::sqrt(u * u + v * v + s * s); }},
+    {"distance(point(u, v, s), point(0.5))",
+     [](float u, float v, float s) {
          return std::sqrt((u - .5f) * (u - .5f) + (v - .5f) * (v - .5f) + (s - .5f) * (s - .5f));
      }},
-    {"normalize(vector(u, v, s))[1]", [](float u, float v, float s) {
+    {"normalize(vector(u, v, s))[1]",
+     [](float u, float v, float s) {
          float l = std::sqrt(u * u + v * v + s * s);
          return l == 0 ? 0.0f : v / l;
      }},
-    {"reflect(vector(u, v, s), normal(0, 1, 0))[1]", [](float, float v, float) { return v - 2 * v; }},
+    {"reflect(vector(u, v, s), normal(0, 1, 0))[1]",
+     [](float, float v, float) { return v - 2 * v; }},
     {"noise(point(u, v, s))", [](float u, float v, float s) { return noise3(u, v, s); }},
     {"snoise(point(u, v, s))", [](float u, float v, float s) { return snoise3(u, v, s); }},
     {"snoise(u)", [](float u, float, float) { return snoise3(u, 0, 0); }},
     {"cellnoise(point(u, v, s))", [](float u, float v, float s) { return cellnoise3(u, v, s); }},
-    {"fbm(point(u, v, s), 5)", [](float u, float v, float s) {
+    {"fbm(point(u, v, s), 5)",
+     [](float u, float v, float s) {
          float sum = 0, amp = 1, f = 1;
-         for (int i = 0; i < 5; ++i, amp *= 0.5f, f *= 2.0f) sum += amp * snoise3(u * f, v * f, s * f);
+         for (int i = 0; i < 5; ++i, amp *= 0.5f, f *= 2.0f)
+             sum += amp * snoise3(u * f, v * f, s * f);
          return sum;
      }},
-    {"turbulence(point(u, v, s), 3)", [](float u, float v, float s) {
+    {"turbulence(point(u, v, s), 3)",
+     [](float u, float v, float s) {
          float sum = 0, amp = 1, f = 1;
-         for (int i = 0; i < 3; ++i, amp *= 0.5f, f *= 2.0f) sum += amp * std::fabs(snoise3(u * f, v * f, s * f));
+         for (int i = 0; i < 3; ++i, amp *= 0.5f, f *= 2.0f)
+             sum += amp * std::fabs(snoise3(u * f, v * f, s * f));
          return sum;
      }},
     {"bake(u) + dynamic(v)", [](float u, float v, float) { return u + v; }},
@@ -101,12 +121,19 @@ std::string substitute(std::string expr, float u, float v, float s) {
     std::string out;
     for (size_t i = 0; i < expr.size(); ++i) {
         const char c = expr[i];
-        const bool word = (i > 0 && (std::isalnum(static_cast<unsigned char>(expr[i - 1])) || expr[i - 1] == '_')) ||
-                          (i + 1 < expr.size() && (std::isalnum(static_cast<unsigned char>(expr[i + 1])) || expr[i + 1] == '_'));
-        if (!word && c == 'u') out += literal(u);
-        else if (!word && c == 'v') out += literal(v);
-        else if (!word && c == 's') out += literal(s);
-        else out += c;
+        const bool word =
+            (i > 0 &&
+             (std::isalnum(static_cast<unsigned char>(expr[i - 1])) || expr[i - 1] == '_')) ||
+            (i + 1 < expr.size() &&
+             (std::isalnum(static_cast<unsigned char>(expr[i + 1])) || expr[i + 1] == '_'));
+        if (!word && c == 'u')
+            out += literal(u);
+        else if (!word && c == 'v')
+            out += literal(v);
+        else if (!word && c == 's')
+            out += literal(s);
+        else
+            out += c;
     }
     return out;
 }
@@ -129,10 +156,12 @@ TEST(Builtins, InterpreterAndFolderMatchTheFormula) {
             const ShadingPoint& p = points[i];
             const float expected = c.expected(p.u, p.v, p.s);
             const float tolerance = 2e-6f * std::fmax(1.0f, std::fabs(expected));
-            ASSERT_NEAR(result.Ci[i].x, expected, tolerance) << c.expr << " at u=" << p.u << " v=" << p.v << " s=" << p.s;
+            ASSERT_NEAR(result.Ci[i].x, expected, tolerance)
+                << c.expr << " at u=" << p.u << " v=" << p.v << " s=" << p.s;
             if (i % 30 == 0) {
                 // The same expression on literals is folded at compile time.
-                const std::string folded = std::string("surface t() { Ci = color(") + substitute(c.expr, p.u, p.v, p.s) + "); }";
+                const std::string folded = std::string("surface t() { Ci = color(") +
+                                           substitute(c.expr, p.u, p.v, p.s) + "); }";
                 const auto f = test::runShader(folded, {p});
                 ASSERT_EQ(f.counters.instructions, 0u) << folded << " should fold to a constant";
                 ASSERT_EQ(f.Ci[0].x, result.Ci[i].x) << folded;
@@ -156,7 +185,9 @@ TEST(Builtins, FaceforwardUsesTheGeometricNormal) {
 TEST(Builtins, TripleArithmeticBroadcastsScalars) {
     ShadingPoint p;
     p.P = glm::vec3(1, 2, 3);
-    const auto r = test::runShader("surface t() { color c = color(P[0], P[1], P[2]); Ci = c * 2 + 1; Ci[1] = -1; Ci /= 2; }", {p});
+    const auto r = test::runShader(
+        "surface t() { color c = color(P[0], P[1], P[2]); Ci = c * 2 + 1; Ci[1] = -1; Ci /= 2; }",
+        {p});
     EXPECT_EQ(r.Ci[0], glm::vec3(1.5f, -0.5f, 3.5f));
     EXPECT_EQ(r.Oi[0], glm::vec3(1.0f));
 }
@@ -188,7 +219,8 @@ TEST(Builtins, NaNPolicyKeepsFiniteInputsFinite) {
     pts[1].u = -1.0f;
     pts[2].u = -8.0f;
     const auto r = test::runShader(
-        "surface t() { Ci = color(1 / u + sqrt(u) + log(u) * 0 + pow(u, 0.5) + asin(u * 9), mod(1, u * 0), normalize(vector(0))[0]); }",
+        "surface t() { Ci = color(1 / u + sqrt(u) + log(u) * 0 + pow(u, 0.5) + asin(u * 9), mod(1, "
+        "u * 0), normalize(vector(0))[0]); }",
         pts);
     for (const auto& c : r.Ci) {
         EXPECT_TRUE(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z));

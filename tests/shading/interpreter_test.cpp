@@ -23,25 +23,39 @@ glm::vec3 evaluateIr(const IrProgram& ir, const ShadingPoint& p) {
         auto arg = [&](int k) { return value[static_cast<size_t>(a[k])]; };
         float& out = value[static_cast<size_t>(inst.result)];
         switch (inst.op) {
-            case Op::Const: out = inst.constant; break;
+            case Op::Const:
+                out = inst.constant;
+                break;
             case Op::Global: {
                 const auto id = static_cast<GlobalId>(inst.imm);
-                const glm::vec3* triple = id == GlobalId::P ? &p.P : id == GlobalId::N ? &p.N : id == GlobalId::I ? &p.I : nullptr;
+                const glm::vec3* triple = id == GlobalId::P   ? &p.P
+                                          : id == GlobalId::N ? &p.N
+                                          : id == GlobalId::I ? &p.I
+                                                              : nullptr;
                 if (triple) {
-                    for (int k = 0; k < 3; ++k) value[static_cast<size_t>(inst.result + k)] = (*triple)[k];
+                    for (int k = 0; k < 3; ++k)
+                        value[static_cast<size_t>(inst.result + k)] = (*triple)[k];
                 } else {
-                    out = id == GlobalId::u ? p.u : id == GlobalId::v ? p.v : id == GlobalId::s ? p.s : p.t;
+                    out = id == GlobalId::u   ? p.u
+                          : id == GlobalId::v ? p.v
+                          : id == GlobalId::s ? p.s
+                                              : p.t;
                 }
                 break;
             }
             default:
-                if (inst.nargs == 1) out = scalar::unary(inst.op, arg(0));
-                else if (inst.nargs == 2) out = scalar::binary(inst.op, arg(0), arg(1));
-                else if (inst.op >= Op::Noise && inst.op <= Op::Turbulence) out = scalar::pattern(inst.op, inst.imm, arg(0), arg(1), arg(2));
-                else out = scalar::ternary(inst.op, arg(0), arg(1), arg(2));
+                if (inst.nargs == 1)
+                    out = scalar::unary(inst.op, arg(0));
+                else if (inst.nargs == 2)
+                    out = scalar::binary(inst.op, arg(0), arg(1));
+                else if (inst.op >= Op::Noise && inst.op <= Op::Turbulence)
+                    out = scalar::pattern(inst.op, inst.imm, arg(0), arg(1), arg(2));
+                else
+                    out = scalar::ternary(inst.op, arg(0), arg(1), arg(2));
         }
     }
-    return {value[static_cast<size_t>(ir.ci[0])], value[static_cast<size_t>(ir.ci[1])], value[static_cast<size_t>(ir.ci[2])]};
+    return {value[static_cast<size_t>(ir.ci[0])], value[static_cast<size_t>(ir.ci[1])],
+            value[static_cast<size_t>(ir.ci[2])]};
 }
 
 std::string randomProgram(std::mt19937& rng, int statements) {
@@ -56,19 +70,31 @@ std::string randomProgram(std::mt19937& rng, int statements) {
         const std::string name = "t" + std::to_string(i);
         std::string e;
         switch (rng() % 6) {
-            case 0: case 1: e = pick() + " " + kBinary[rng() % 4] + " " + pick(); break;
-            case 2: e = std::string(kFns[rng() % 5]) + "(" + pick() + ")"; break;
-            case 3: e = std::string(kFns2[rng() % 5]) + "(" + pick() + ", " + pick() + ")"; break;
-            case 4: e = "mix(" + pick() + ", " + pick() + ", " + pick() + ")"; break;
-            case 5: e = "snoise(point(" + pick() + ", " + pick() + ", 0.5))"; break;
+            case 0:
+            case 1:
+                e = pick() + " " + kBinary[rng() % 4] + " " + pick();
+                break;
+            case 2:
+                e = std::string(kFns[rng() % 5]) + "(" + pick() + ")";
+                break;
+            case 3:
+                e = std::string(kFns2[rng() % 5]) + "(" + pick() + ", " + pick() + ")";
+                break;
+            case 4:
+                e = "mix(" + pick() + ", " + pick() + ", " + pick() + ")";
+                break;
+            case 5:
+                e = "snoise(point(" + pick() + ", " + pick() + ", 0.5))";
+                break;
         }
         src << "    float " << name << " = " << e << ";\n";
         if (rng() % 5 == 0) {
-            src << "    if (" << pick() << " > " << pick() << ") { " << name << " = " << pick() << " * 2; } else { "
-                << name << " -= 1; }\n";
+            src << "    if (" << pick() << " > " << pick() << ") { " << name << " = " << pick()
+                << " * 2; } else { " << name << " -= 1; }\n";
         }
         if (rng() % 9 == 0) {
-            src << "    for (int k = 0; k < 3; k += 1) { " << name << " += " << pick() << " * k; }\n";
+            src << "    for (int k = 0; k < 3; k += 1) { " << name << " += " << pick()
+                << " * k; }\n";
         }
         vars.push_back(name);
     }
@@ -98,7 +124,8 @@ TEST(Interpreter, MatchesOneValueAtATimeEvaluationOnRandomPrograms) {
                 if (std::isnan(expected[k])) {
                     ASSERT_TRUE(std::isnan(result.Ci[i][k])) << src;
                 } else {
-                    ASSERT_EQ(result.Ci[i][k], expected[k]) << src << "\npoint " << i << "\n" << ir.dump();
+                    ASSERT_EQ(result.Ci[i][k], expected[k]) << src << "\npoint " << i << "\n"
+                                                            << ir.dump();
                 }
             }
         }

@@ -23,12 +23,18 @@ const BadShader kBadShaders[] = {
     {"", 1, 1, "expected 'surface' to begin the shader, found end of file"},
     {"shader s() { Ci = 1; }", 1, 1, "expected 'surface' to begin the shader, found 'shader'"},
     {"surface () {}", 1, 9, "expected the shader's name, found '('"},
-    {"surface s(float a) { Ci = 1; }", 1, 18, "expected '=' and a default value for parameter 'a', found ')'"},
-    {"surface s(string a = 1) { Ci = 1; }", 1, 11, "expected a parameter type (float, int, color, point, vector, normal), found 'string'"},
-    {"surface s() {\n  float a = 1.0\n  Ci = color(a);\n}", 3, 3, "expected ';' after the statement, found 'Ci'"},
-    {"surface s() {\n  Ci = color(1, 2;\n}", 2, 18, "expected ')' or ',' in the call to 'color', found ';'"},
-    {"surface s() {\n  Ci = 1;\n", 3, 1, "expected '}' to close the block opened at line 1, found end of file"},
-    {"surface s() { Ci = 1; } extra", 1, 25, "expected end of file after the shader body, found 'extra'"},
+    {"surface s(float a) { Ci = 1; }", 1, 18,
+     "expected '=' and a default value for parameter 'a', found ')'"},
+    {"surface s(string a = 1) { Ci = 1; }", 1, 11,
+     "expected a parameter type (float, int, color, point, vector, normal), found 'string'"},
+    {"surface s() {\n  float a = 1.0\n  Ci = color(a);\n}", 3, 3,
+     "expected ';' after the statement, found 'Ci'"},
+    {"surface s() {\n  Ci = color(1, 2;\n}", 2, 18,
+     "expected ')' or ',' in the call to 'color', found ';'"},
+    {"surface s() {\n  Ci = 1;\n", 3, 1,
+     "expected '}' to close the block opened at line 1, found end of file"},
+    {"surface s() { Ci = 1; } extra", 1, 25,
+     "expected end of file after the shader body, found 'extra'"},
     {"surface s() { Ci = 1 @ 2; }", 1, 22, "unexpected character '@'"},
     {"surface s() { /* open", 1, 15, "unterminated /* comment"},
     {"surface s() { Ci = 1.5e; }", 1, 20, "malformed number: exponent has no digits"},
@@ -37,28 +43,41 @@ const BadShader kBadShaders[] = {
     {"surface s() { Ci = nois(P); }", 1, 20, "unknown function 'nois'"},
     {"surface s() { Ci = noise; }", 1, 20, "'noise' is a function; call it with '(...)'"},
     {"surface s() { Ci = noise(P, P); }", 1, 20, "'noise' takes 1 argument, not 2"},
-    {"surface s() { Ci = dot(1.0, P); }", 1, 20, "argument 1 of 'dot' must be a color, point, vector or normal, not float"},
-    {"surface s() { float a = 1; Ci = color(a); int b = a; }", 1, 51, "cannot initialize int 'b' with a float (use int(x) to truncate)"},
-    {"surface s() { color c = P; Ci = c; }", 1, 25, "cannot initialize color 'c' with a point (convert explicitly with color(x))"},
+    {"surface s() { Ci = dot(1.0, P); }", 1, 20,
+     "argument 1 of 'dot' must be a color, point, vector or normal, not float"},
+    {"surface s() { float a = 1; Ci = color(a); int b = a; }", 1, 51,
+     "cannot initialize int 'b' with a float (use int(x) to truncate)"},
+    {"surface s() { color c = P; Ci = c; }", 1, 25,
+     "cannot initialize color 'c' with a point (convert explicitly with color(x))"},
     {"surface s() { P = 1; Ci = 1; }", 1, 15, "'P' is a read-only global"},
-    {"surface s() { float a = 1; float a = 2; Ci = 1; }", 1, 34, "'a' is already declared in this scope"},
+    {"surface s() { float a = 1; float a = 2; Ci = 1; }", 1, 34,
+     "'a' is already declared in this scope"},
     {"surface s() { float N = 1; Ci = 1; }", 1, 21, "'N' is a global and cannot be redeclared"},
     {"surface s() { Oi = 1; }", 1, 9, "shader 's' never assigns Ci"},
-    {"surface s() { Ci = 1; if (P) { Ci = 0; } }", 1, 27, "the condition of 'if' must be a float or int, not point"},
-    {"surface s() { Ci = 1; if (P < 1) { Ci = 0; } }", 1, 29, "cannot order point and int; compare components"},
-    {"surface s() { Ci = color(u)[3]; }", 1, 29, "a component index must be a whole number in [0, 2]"},
+    {"surface s() { Ci = 1; if (P) { Ci = 0; } }", 1, 27,
+     "the condition of 'if' must be a float or int, not point"},
+    {"surface s() { Ci = 1; if (P < 1) { Ci = 0; } }", 1, 29,
+     "cannot order point and int; compare components"},
+    {"surface s() { Ci = color(u)[3]; }", 1, 29,
+     "a component index must be a whole number in [0, 2]"},
     {"surface s() { float i = 1; Ci = color(u)[i]; }", 1, 42, "a component index must be an int"},
-    {"surface s() { Ci = fbm(P, 20); }", 1, 27, "the octave count must be a whole number in [1, 16]"},
-    {"surface s() { Ci = occlusion(P, N, int(u)); }", 1, 36, "the occlusion ray count must be a constant"},
-    {"surface s() { float a = 0; for (int i = 0; i < u; i += 1) { a += 1; } Ci = a; }", 1, 46, "the loop condition must be constant after folding (loops are unrolled)"},
-    {"surface s() { float a = 0; for (int i = 0; i < 10; i += 0) { a += 1; } Ci = a; }", 1, 28, "the loop runs more than 4096 iterations"},
-    {"surface s() { while (1) {} Ci = 1; }", 1, 15, "'while' is not part of the shading language (v1 has if, for and blocks)"},
+    {"surface s() { Ci = fbm(P, 20); }", 1, 27,
+     "the octave count must be a whole number in [1, 16]"},
+    {"surface s() { Ci = occlusion(P, N, int(u)); }", 1, 36,
+     "the occlusion ray count must be a constant"},
+    {"surface s() { float a = 0; for (int i = 0; i < u; i += 1) { a += 1; } Ci = a; }", 1, 46,
+     "the loop condition must be constant after folding (loops are unrolled)"},
+    {"surface s() { float a = 0; for (int i = 0; i < 10; i += 0) { a += 1; } Ci = a; }", 1, 28,
+     "the loop runs more than 4096 iterations"},
+    {"surface s() { while (1) {} Ci = 1; }", 1, 15,
+     "'while' is not part of the shading language (v1 has if, for and blocks)"},
     {"surface s(float a = u) { Ci = a; }", 1, 21, "the default of 'a' must be a constant"},
     {"surface s(float a = 1, float a = 2) { Ci = a; }", 1, 30, "parameter 'a' is declared twice"},
     {"surface s(float P = 1) { Ci = 1; }", 1, 17, "parameter 'P' has the name of a global"},
     {"surface s() { Ci = 1 + ; }", 1, 24, "expected an expression, found ';'"},
     {"surface s() { Ci = 16777217; }", 1, 20, "integer '16777217' is out of range (at most 2^24)"},
-    {"surface s() { 1 = 2; Ci = 1; }", 1, 17, "the left side of '=' must be a variable or a component of one"},
+    {"surface s() { 1 = 2; Ci = 1; }", 1, 17,
+     "the left side of '=' must be a variable or a component of one"},
 };
 
 TEST(LanguageErrors, GoldenMessages) {
@@ -72,7 +91,9 @@ TEST(LanguageErrors, GoldenMessages) {
             EXPECT_EQ(e.where().line, bad.line) << bad.source;
             EXPECT_EQ(e.where().column, bad.column) << bad.source;
             EXPECT_EQ(e.where().file, "bad.sl");
-            EXPECT_EQ(std::string(e.what()).rfind("bad.sl:" + std::to_string(bad.line) + ":", 0), 0u) << e.what();
+            EXPECT_EQ(std::string(e.what()).rfind("bad.sl:" + std::to_string(bad.line) + ":", 0),
+                      0u)
+                << e.what();
         }
     }
 }
@@ -88,7 +109,8 @@ TEST(LanguageErrors, MissingFile) {
 
 TEST(Language, EveryExampleShaderCompiles) {
     int count = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(test::sourcePath("examples/shaders"))) {
+    for (const auto& entry :
+         std::filesystem::directory_iterator(test::sourcePath("examples/shaders"))) {
         if (entry.path().extension() != ".sl") continue;
         auto ast = loadShaderFile(entry.path().string());
         // With an ambient and a distant light, so lighting does not fold away.
@@ -104,7 +126,8 @@ TEST(Language, EveryExampleShaderCompiles) {
 }
 
 TEST(Language, CommentsAndPrecedence) {
-    auto ast = compileShaderText("ok.sl", "// line\nsurface s() { /* block\n */ Ci = 1 + 2 * 3 - 4 / 2; }");
+    auto ast = compileShaderText("ok.sl",
+                                 "// line\nsurface s() { /* block\n */ Ci = 1 + 2 * 3 - 4 / 2; }");
     const IrProgram ir = lowerShader(*ast, {});
     // 1 + 2 * 3 - 4 / 2 = 1 + 6 - 2 = 5 (integer division), folded to one constant.
     ASSERT_EQ(ir.insts.size(), 2u) << ir.dump();  // the constant 5 and Oi's constant 1

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <random>
 
-#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include "geometry/ray_scene.h"
 #include "shading/lighting.h"
@@ -27,7 +27,8 @@ TEST(Noise, ZeroOnTheLatticeAndWithinRange) {
         ASSERT_GE(c, 0.0f);
         ASSERT_LT(c, 1.0f);
         // Constant over the unit cell.
-        ASSERT_EQ(c, cellnoise3(std::floor(x) + 0.01f, std::floor(y) + 0.99f, std::floor(z) + 0.5f));
+        ASSERT_EQ(c,
+                  cellnoise3(std::floor(x) + 0.01f, std::floor(y) + 0.99f, std::floor(z) + 0.5f));
         ASSERT_FLOAT_EQ(noise3(x, y, z), 0.5f + 0.5f * n);
     }
 }
@@ -48,7 +49,8 @@ TEST(Noise, IsContinuousAndNotTrivial) {
 TEST(Noise, GoldenValuesAreStable) {
     // The noise is part of every image's identity: these values must never change.
     EXPECT_FLOAT_EQ(snoise3(0.5f, 0.25f, 0.125f), snoise3(0.5f, 0.25f, 0.125f + 256.0f));
-    const float golden[] = {snoise3(0.5f, 0.25f, 0.125f), snoise3(-3.3f, 7.1f, 2.2f), cellnoise3(1.5f, -2.5f, 3.5f)};
+    const float golden[] = {snoise3(0.5f, 0.25f, 0.125f), snoise3(-3.3f, 7.1f, 2.2f),
+                            cellnoise3(1.5f, -2.5f, 3.5f)};
     for (float g : golden) EXPECT_TRUE(std::isfinite(g));
     EXPECT_NE(golden[0], golden[1]);
 }
@@ -103,7 +105,8 @@ TEST(Lighting, ShaderSumsLightsAndFoldsFixedAmbient) {
     ShadingUniforms uniforms;
     uniforms.lights = lights;
     test::ShadingPoint p;
-    const auto r = test::runShader("surface l() { Ci = ambient() + diffuse(N); }", {p}, binding, uniforms);
+    const auto r =
+        test::runShader("surface l() { Ci = ambient() + diffuse(N); }", {p}, binding, uniforms);
     EXPECT_NEAR(r.Ci[0].x, 0.25f + 1.0f + 0.5f * std::sqrt(0.5f), 1e-6f);
 }
 
@@ -118,7 +121,8 @@ TEST(Occlusion, OpenOutsideClosedInside) {
     outside.N = glm::vec3(0, 1, 0);
     inside.P = glm::vec3(0, 0, 0);
     inside.N = glm::vec3(0, 1, 0);
-    const auto r = test::runShader("surface o() { Ci = color(occlusion(P, N, 64)); }", {outside, inside}, {}, uniforms);
+    const auto r = test::runShader("surface o() { Ci = color(occlusion(P, N, 64)); }",
+                                   {outside, inside}, {}, uniforms);
     EXPECT_EQ(r.Ci[0].x, 1.0f);
     EXPECT_EQ(r.Ci[1].x, 0.0f);
     EXPECT_EQ(r.counters.occlusionRays, 128u);
@@ -134,7 +138,8 @@ TEST(Occlusion, HalfOpenBesideAWall) {
     test::ShadingPoint p;
     p.P = glm::vec3(0, 0.001f, 0);
     p.N = glm::vec3(1, 0, 0);
-    const auto r = test::runShader("surface o() { Ci = color(occlusion(P, N, 256)); }", {p}, {}, uniforms);
+    const auto r =
+        test::runShader("surface o() { Ci = color(occlusion(P, N, 256)); }", {p}, {}, uniforms);
     EXPECT_NEAR(r.Ci[0].x, 0.5f, 0.03f);
 }
 
