@@ -75,6 +75,10 @@ JsonNode JsonNode::at(size_t index) const {
 }
 
 void JsonNode::allowKeys(std::initializer_list<const char*> allowed) const {
+    allowKeys(std::span<const char* const>(allowed.begin(), allowed.size()));
+}
+
+void JsonNode::allowKeys(std::span<const char* const> allowed) const {
     if (!value_->is_object()) fail(std::string("expected an object, found ") + kindOf(*value_));
     for (auto it = value_->begin(); it != value_->end(); ++it) {
         bool ok = false;

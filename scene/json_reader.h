@@ -5,6 +5,7 @@
 
 #include <initializer_list>
 #include <optional>
+#include <span>
 #include <string>
 
 #include <glm/vec3.hpp>
@@ -35,6 +36,7 @@ class JsonNode {
 
     // Fails unless this is an object whose keys are all in `allowed`.
     void allowKeys(std::initializer_list<const char*> allowed) const;
+    void allowKeys(std::span<const char* const> allowed) const;
 
     double number() const;  // finite
     double positive() const;

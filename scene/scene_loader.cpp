@@ -26,16 +26,7 @@ void readKeys(const JsonNode& keys, std::initializer_list<const char*> fields, F
         std::vector<const char*> allowed{"t"};
         allowed.insert(allowed.end(), fields.begin(), fields.end());
         if (!key.isObject()) key.fail("expected a key object { \"t\": seconds, ... }");
-        for (auto it = key.raw().begin(); it != key.raw().end(); ++it) {
-            bool ok = false;
-            for (const char* a : allowed) ok = ok || it.key() == a;
-            if (!ok) {
-                std::string list;
-                for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-                JsonNode(*it, key.file(), key.path() + "." + it.key())
-                    .fail("unknown key '" + it.key() + "' (expected one of: " + list + ")");
-            }
-        }
+        key.allowKeys(allowed);
         const float t = static_cast<float>(key["t"].number());
         if (!(t > previous))
             key["t"].fail("keys must be sorted by strictly increasing t (previous key has t = " +
