@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/factor_command.h"
 #include "app/render_command.h"
 
 int main(int argc, char** argv) {
@@ -27,6 +28,15 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
 
+    mpshade::FactorCommandOptions factor;
+    CLI::App* factorCmd = app.add_subcommand(
+        "factor", "Split a shader into its static and dynamic parts for a scene binding");
+    factorCmd->add_option("shader", factor.shader, "Shader file (.sl)")->required();
+    factorCmd->add_option("--scene", factor.scene, "Scene whose binding to use (with --object)");
+    factorCmd->add_option("--object", factor.object, "Object in the scene");
+    factorCmd->add_flag("--json", factor.json, "Machine-readable output");
+    factorCmd->add_flag("--dump", factor.dump, "Also print the IR of both parts");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -41,6 +51,7 @@ int main(int argc, char** argv) {
     }
     try {
         if (renderCmd->parsed()) return mpshade::runRenderCommand(render);
+        if (factorCmd->parsed()) return mpshade::runFactorCommand(factor);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "mpshade: internal error: %s\n", e.what());
         return 1;

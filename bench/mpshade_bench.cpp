@@ -11,6 +11,7 @@
 #include "scene/scene.h"
 #include "scene/scene_state.h"
 #include "scene/variability.h"
+#include "shading/factoring.h"
 #include "shading/shader_compiler.h"
 
 namespace mpshade {
@@ -40,61 +41,107 @@ void referenceRenderer(benchmark::State& state, const char* scenePath) {
         static_cast<double>(stats.shaderInstructions) / static_cast<double>(stats.samples);
 }
 
-// One example shader over 4096 points of the vase, bound as in the vase scene (an
-// ambient and a distant light, occlusion against the vase itself).
-void interpreter(benchmark::State& state, const char* shaderName) {
-    const Scene scene = loadScene(source("examples/vase/scene.json"));
-    const SceneObject& vase = scene.objects[0];
-    auto ast = loadShaderFile(source(std::string("examples/shaders/") + shaderName + ".sl"));
-    SceneObject bound = vase;
-    bound.params.clear();
-    auto kernel = buildKernel(*ast, bindingOf(scene, bound));
-    const SurfaceRayScene rays(*vase.surface);
-
-    constexpr size_t n = 4096;
-    std::mt19937 rng(1);
-    std::uniform_real_distribution<float> uni(0.0f, 1.0f);
-    std::vector<std::vector<float>> rows(28, std::vector<float>(n));
-    const CameraState camera = cameraAt(scene, 0.0f, 480, 270);
-    const ObjectState st = objectAt(vase, 0.0f, camera);
-    for (size_t i = 0; i < n; ++i) {
-        const ChartPoint at{
-            static_cast<int>(rng() % static_cast<unsigned>(chartCount(*vase.surface))), uni(rng),
-            uni(rng)};
-        const SurfaceSample s = evaluate(*vase.surface, at);
-        const glm::vec3 I = glm::normalize(s.P - st.eye);
-        for (int k = 0; k < 3; ++k) {
-            rows[0 + k][i] = s.P[k], rows[3 + k][i] = s.N[k], rows[6 + k][i] = s.Ng[k];
-            rows[9 + k][i] = s.dPdu[k], rows[12 + k][i] = s.dPdv[k], rows[15 + k][i] = I[k];
-        }
-        rows[18][i] = at.u, rows[19][i] = at.v, rows[20][i] = s.s, rows[21][i] = s.t;
-    }
-    ShadingInputs in;
-    for (int k = 0; k < 3; ++k) {
-        in.P[k] = rows[0 + k].data(), in.N[k] = rows[3 + k].data(), in.Ng[k] = rows[6 + k].data();
-        in.dPdu[k] = rows[9 + k].data(), in.dPdv[k] = rows[12 + k].data(),
-        in.I[k] = rows[15 + k].data();
-    }
-    in.u = rows[18].data(), in.v = rows[19].data(), in.s = rows[20].data(), in.t = rows[21].data();
-    ShadingOutputs out;
-    for (int k = 0; k < 3; ++k) out.Ci[k] = rows[22 + k].data(), out.Oi[k] = rows[25 + k].data();
+// 4096 points of the vase as its shaders see them at frame 0, structure of arrays, with
+// the vase's uniforms (an ambient and a distant light, occlusion against the vase).
+struct VasePoints {
+    static constexpr size_t n = 4096;
+    Scene scene;
+    std::unique_ptr<SurfaceRayScene> rays;
+    std::vector<std::vector<float>> rows;
     std::vector<LightSample> lights;
-    lightsAt(scene, st, 0.0f, lights);
-    std::vector<float> params;
+    ShadingInputs in;
+    ShadingOutputs out;
     ShadingUniforms uniforms;
-    uniforms.eye = st.eye;
-    uniforms.lights = lights;
-    uniforms.occluder = &rays;
-    uniforms.occlusionBias = 1e-4f * surfaceBounds(*vase.surface).diagonal();
+
+    VasePoints()
+        : scene(loadScene(source("examples/vase/scene.json"))), rows(28, std::vector<float>(n)) {
+        const SceneObject& vase = scene.objects[0];
+        rays = std::make_unique<SurfaceRayScene>(*vase.surface);
+        std::mt19937 rng(1);
+        std::uniform_real_distribution<float> uni(0.0f, 1.0f);
+        const CameraState camera = cameraAt(scene, 0.0f, 480, 270);
+        const ObjectState st = objectAt(vase, 0.0f, camera);
+        for (size_t i = 0; i < n; ++i) {
+            const ChartPoint at{
+                static_cast<int>(rng() % static_cast<unsigned>(chartCount(*vase.surface))),
+                uni(rng), uni(rng)};
+            const SurfaceSample s = evaluate(*vase.surface, at);
+            const glm::vec3 I = glm::normalize(s.P - st.eye);
+            for (int k = 0; k < 3; ++k) {
+                rows[0 + k][i] = s.P[k], rows[3 + k][i] = s.N[k], rows[6 + k][i] = s.Ng[k];
+                rows[9 + k][i] = s.dPdu[k], rows[12 + k][i] = s.dPdv[k], rows[15 + k][i] = I[k];
+            }
+            rows[18][i] = at.u, rows[19][i] = at.v, rows[20][i] = s.s, rows[21][i] = s.t;
+        }
+        for (int k = 0; k < 3; ++k) {
+            in.P[k] = rows[0 + k].data(), in.N[k] = rows[3 + k].data(),
+            in.Ng[k] = rows[6 + k].data();
+            in.dPdu[k] = rows[9 + k].data(), in.dPdv[k] = rows[12 + k].data(),
+            in.I[k] = rows[15 + k].data();
+        }
+        in.u = rows[18].data(), in.v = rows[19].data(), in.s = rows[20].data(),
+        in.t = rows[21].data();
+        for (int k = 0; k < 3; ++k)
+            out.Ci[k] = rows[22 + k].data(), out.Oi[k] = rows[25 + k].data();
+        lightsAt(scene, st, 0.0f, lights);
+        uniforms.eye = st.eye;
+        uniforms.lights = lights;
+        uniforms.occluder = rays.get();
+        uniforms.occlusionBias = 1e-4f * surfaceBounds(*vase.surface).diagonal();
+    }
+
+    // The example shader, bound as the vase binds its own shader (its parameters dropped).
+    ShaderBinding binding() const {
+        SceneObject bound = scene.objects[0];
+        bound.params.clear();
+        return bindingOf(scene, bound);
+    }
+};
+
+std::shared_ptr<const ShaderAst> exampleShader(const char* name) {
+    return loadShaderFile(source(std::string("examples/shaders/") + name + ".sl"));
+}
+
+void runKernelBench(benchmark::State& state, const ShaderKernel& kernel, VasePoints& v) {
     std::vector<float> workspace;
     ShadingCounters counters;
     enableFlushToZero();
     for (auto _ : state) {
-        kernel->run(uniforms, in, n, out, workspace, counters);
-        benchmark::DoNotOptimize(rows[22].data());
+        kernel.run(v.uniforms, v.in, VasePoints::n, v.out, workspace, counters);
+        benchmark::ClobberMemory();
     }
-    state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
-    state.counters["instr_per_lane"] = static_cast<double>(kernel->instructionCount());
+    state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * VasePoints::n));
+    state.counters["instructions"] = static_cast<double>(kernel.instructionCount());
+}
+
+// The whole unfactored shader per point: what the reference renderer runs.
+void interpreter(benchmark::State& state, const char* shaderName) {
+    VasePoints v;
+    auto kernel = buildKernel(*exampleShader(shaderName), v.binding());
+    runKernelBench(state, *kernel, v);
+}
+
+// The factored shader's two parts over the same points: the static part (per map texel or
+// facet vertex, rarely) and the dynamic part (per sample, every frame). Read the ratio of
+// the dynamic part's time to the unfactored shader's (Interpreter/<shader>).
+void factoredPart(benchmark::State& state, const char* shaderName, bool dynamicPart) {
+    VasePoints v;
+    const FactoredShader f = factorShader(*exampleShader(shaderName), v.binding());
+    const ShaderKernel staticKernel(f.staticPart), dynamicKernel(f.dynamicPart);
+    std::vector<std::vector<float>> tuple(f.staticPart.channelOutputs.size(),
+                                          std::vector<float>(VasePoints::n));
+    std::vector<float*> outChannels;
+    std::vector<const float*> inChannels;
+    for (auto& c : tuple) outChannels.push_back(c.data()), inChannels.push_back(c.data());
+    v.out.channels = outChannels.data();
+    v.in.channels = inChannels.data();
+    if (dynamicPart) {
+        std::vector<float> workspace;
+        ShadingCounters counters;
+        staticKernel.run(v.uniforms, v.in, VasePoints::n, v.out, workspace, counters);
+    }
+    runKernelBench(state, dynamicPart ? dynamicKernel : staticKernel, v);
+    state.counters["channels"] = f.chosenWidth;
 }
 
 BENCHMARK_CAPTURE(referenceRenderer, vase, "examples/vase/scene.json")
@@ -125,6 +172,24 @@ BENCHMARK_CAPTURE(interpreter, plastic, "plastic")
     ->Name("Interpreter/plastic")
     ->Unit(benchmark::kMicrosecond);
 
+}  // namespace
+}  // namespace mpshade
+
+namespace mpshade {
+namespace {
+#define MPSHADE_FACTOR_BENCH(name)                               \
+    BENCHMARK_CAPTURE(factoredPart, name##_static, #name, false) \
+        ->Name("Factored/" #name "/static")                      \
+        ->Unit(benchmark::kMicrosecond);                         \
+    BENCHMARK_CAPTURE(factoredPart, name##_dynamic, #name, true) \
+        ->Name("Factored/" #name "/dynamic")                     \
+        ->Unit(benchmark::kMicrosecond);
+MPSHADE_FACTOR_BENCH(marble)
+MPSHADE_FACTOR_BENCH(wood)
+MPSHADE_FACTOR_BENCH(brick)
+MPSHADE_FACTOR_BENCH(rust_over_paint)
+MPSHADE_FACTOR_BENCH(plastic)
+#undef MPSHADE_FACTOR_BENCH
 }  // namespace
 }  // namespace mpshade
 

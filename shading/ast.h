@@ -45,7 +45,8 @@ struct ParamDecl {
 };
 
 struct ShaderAst {
-    std::string file;  // as given by the user, for diagnostics
+    std::string file;    // as given by the user, for diagnostics
+    std::string source;  // the text, for reports that quote it
     std::string name;
     int line = 0, column = 0;
     std::vector<ParamDecl> params;

@@ -38,8 +38,12 @@ ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
         for (int a = 0; a < inst.nargs; ++a)
             lastUse[static_cast<size_t>(program.argsOf(inst)[a])] = static_cast<int>(k);
     }
-    for (int v : program.ci) lastUse[static_cast<size_t>(v)] = std::numeric_limits<int>::max();
-    for (int v : program.oi) lastUse[static_cast<size_t>(v)] = std::numeric_limits<int>::max();
+    auto keepToTheEnd = [&](int v) {
+        if (v >= 0) lastUse[static_cast<size_t>(v)] = std::numeric_limits<int>::max();
+    };
+    for (int v : program.ci) keepToTheEnd(v);
+    for (int v : program.oi) keepToTheEnd(v);
+    for (int v : program.channelOutputs) keepToTheEnd(v);
 
     std::vector<int32_t> reg(static_cast<size_t>(program.valueCount), -1);
     std::vector<char> constantReg;
@@ -87,9 +91,10 @@ ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
         code_.push_back(e);
     }
     for (int k = 0; k < 3; ++k) {
-        ci_[k] = reg[static_cast<size_t>(program.ci[k])];
-        oi_[k] = reg[static_cast<size_t>(program.oi[k])];
+        if (program.ci[k] >= 0) ci_[k] = reg[static_cast<size_t>(program.ci[k])];
+        if (program.oi[k] >= 0) oi_[k] = reg[static_cast<size_t>(program.oi[k])];
     }
+    for (int v : program.channelOutputs) channelRegs_.push_back(reg[static_cast<size_t>(v)]);
 }
 
 void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in, size_t n,
@@ -170,6 +175,11 @@ void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                         std::fill_n(R(e.out[k]), m,
                                     uniforms.params[static_cast<size_t>(e.imm + k)]);
                     break;
+                case Op::Channel:
+                    MPSHADE_CHECK(in.channels != nullptr);
+                    std::memcpy(o, in.channels[e.imm] + start,
+                                sizeof(float) * static_cast<size_t>(m));
+                    break;
                 case Op::LightAmbient:
                     for (int k = 0; k < 3; ++k)
                         std::fill_n(R(e.out[k]), m,
@@ -180,20 +190,22 @@ void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
         unaryLoop<Op::X>(o, a, m); \
         break;
                     MPSHADE_UNARY(Neg)
-                    MPSHADE_UNARY(Abs) MPSHADE_UNARY(Floor) MPSHADE_UNARY(Ceil) MPSHADE_UNARY(Fract)
-                        MPSHADE_UNARY(Sqrt) MPSHADE_UNARY(Exp) MPSHADE_UNARY(Log) MPSHADE_UNARY(Sin)
-                            MPSHADE_UNARY(Cos) MPSHADE_UNARY(Tan) MPSHADE_UNARY(Asin) MPSHADE_UNARY(
-                                Acos) MPSHADE_UNARY(Atan) MPSHADE_UNARY(Sign) MPSHADE_UNARY(Trunc)
-                                MPSHADE_UNARY(Not) MPSHADE_UNARY(Bake) MPSHADE_UNARY(Dynamic)
+                    MPSHADE_UNARY(Abs)
+                    MPSHADE_UNARY(Floor)
+                    MPSHADE_UNARY(Ceil) MPSHADE_UNARY(Fract) MPSHADE_UNARY(Sqrt) MPSHADE_UNARY(
+                        Exp) MPSHADE_UNARY(Log) MPSHADE_UNARY(Sin) MPSHADE_UNARY(Cos)
+                        MPSHADE_UNARY(Tan) MPSHADE_UNARY(Asin) MPSHADE_UNARY(Acos) MPSHADE_UNARY(
+                            Atan) MPSHADE_UNARY(Sign) MPSHADE_UNARY(Trunc) MPSHADE_UNARY(Not)
+                            MPSHADE_UNARY(Bake) MPSHADE_UNARY(Dynamic)
 #undef MPSHADE_UNARY
 #define MPSHADE_BINARY(X)              \
     case Op::X:                        \
         binaryLoop<Op::X>(o, a, b, m); \
         break;
-                                    MPSHADE_BINARY(Add) MPSHADE_BINARY(Sub) MPSHADE_BINARY(Mul)
-                                        MPSHADE_BINARY(Div) MPSHADE_BINARY(IDiv) MPSHADE_BINARY(Min)
-                                            MPSHADE_BINARY(Max) MPSHADE_BINARY(Mod) MPSHADE_BINARY(
-                                                Pow) MPSHADE_BINARY(Atan2) MPSHADE_BINARY(Step)
+                                MPSHADE_BINARY(Add) MPSHADE_BINARY(Sub) MPSHADE_BINARY(Mul)
+                                    MPSHADE_BINARY(Div) MPSHADE_BINARY(IDiv) MPSHADE_BINARY(Min)
+                                        MPSHADE_BINARY(Max) MPSHADE_BINARY(Mod) MPSHADE_BINARY(Pow)
+                                            MPSHADE_BINARY(Atan2) MPSHADE_BINARY(Step)
                                                 MPSHADE_BINARY(Lt) MPSHADE_BINARY(Le)
                                                     MPSHADE_BINARY(Gt) MPSHADE_BINARY(Ge)
                                                         MPSHADE_BINARY(Eq) MPSHADE_BINARY(Ne)
@@ -235,10 +247,13 @@ void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                     break;
             }
         }
+        const size_t bytes = sizeof(float) * static_cast<size_t>(m);
         for (int k = 0; k < 3; ++k) {
-            std::memcpy(out.Ci[k] + start, R(ci_[k]), sizeof(float) * static_cast<size_t>(m));
-            std::memcpy(out.Oi[k] + start, R(oi_[k]), sizeof(float) * static_cast<size_t>(m));
+            if (ci_[k] >= 0) std::memcpy(out.Ci[k] + start, R(ci_[k]), bytes);
+            if (oi_[k] >= 0) std::memcpy(out.Oi[k] + start, R(oi_[k]), bytes);
         }
+        for (size_t k = 0; k < channelRegs_.size(); ++k)
+            std::memcpy(out.channels[k] + start, R(channelRegs_[k]), bytes);
         counters.instructions += code_.size() * static_cast<uint64_t>(m);
     }
     counters.points += n;

@@ -50,11 +50,16 @@ struct ShadingInputs {
     const float* v = nullptr;
     const float* s = nullptr;
     const float* t = nullptr;
+    // The n-tuple, for the dynamic part of a factored shader: channels[k] has n floats.
+    const float* const* channels = nullptr;
 };
 
+// Where results go. A program writes the outputs it has: Ci and Oi, or, for the static
+// part of a factored shader, the n-tuple channels (channels[k] receives n floats).
 struct ShadingOutputs {
     float* Ci[3] = {};
     float* Oi[3] = {};
+    float* const* channels = nullptr;
 };
 
 struct ShadingCounters {
@@ -92,7 +97,8 @@ class ShaderKernel {
     std::vector<ExecInst> code_;
     std::vector<std::pair<int32_t, float>> constants_;  // register, value
     int registerCount_ = 0;
-    int ci_[3], oi_[3];
+    int ci_[3] = {-1, -1, -1}, oi_[3] = {-1, -1, -1};
+    std::vector<int32_t> channelRegs_;
 };
 
 }  // namespace mpshade

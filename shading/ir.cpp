@@ -7,20 +7,20 @@
 namespace mpshade {
 
 const char* opName(Op op) {
-    static const char* const kNames[] = {"const",      "global", "param",      "light_ambient",
-                                         "neg",        "abs",    "floor",      "ceil",
-                                         "fract",      "sqrt",   "exp",        "log",
-                                         "sin",        "cos",    "tan",        "asin",
-                                         "acos",       "atan",   "sign",       "trunc",
-                                         "not",        "bake",   "dynamic",    "add",
-                                         "sub",        "mul",    "div",        "idiv",
-                                         "min",        "max",    "mod",        "pow",
-                                         "atan2",      "step",   "lt",         "le",
-                                         "gt",         "ge",     "eq",         "ne",
-                                         "and",        "or",     "clamp",      "mix",
-                                         "smoothstep", "select", "noise",      "snoise",
-                                         "cellnoise",  "fbm",    "turbulence", "diffuse",
-                                         "specular",   "phong",  "occlusion"};
+    static const char* const kNames[] = {"const",   "global",     "param",  "light_ambient",
+                                         "channel", "neg",        "abs",    "floor",
+                                         "ceil",    "fract",      "sqrt",   "exp",
+                                         "log",     "sin",        "cos",    "tan",
+                                         "asin",    "acos",       "atan",   "sign",
+                                         "trunc",   "not",        "bake",   "dynamic",
+                                         "add",     "sub",        "mul",    "div",
+                                         "idiv",    "min",        "max",    "mod",
+                                         "pow",     "atan2",      "step",   "lt",
+                                         "le",      "gt",         "ge",     "eq",
+                                         "ne",      "and",        "or",     "clamp",
+                                         "mix",     "smoothstep", "select", "noise",
+                                         "snoise",  "cellnoise",  "fbm",    "turbulence",
+                                         "diffuse", "specular",   "phong",  "occlusion"};
     static_assert(sizeof(kNames) / sizeof(kNames[0]) == static_cast<size_t>(Op::Count));
     return kNames[static_cast<size_t>(op)];
 }
@@ -37,15 +37,17 @@ std::string IrProgram::dump() const {
         out << " = " << opName(i.op);
         if (i.op == Op::Const) out << " " << i.constant;
         if (i.op == Op::Global) out << " " << globalName(static_cast<GlobalId>(i.imm));
-        if (i.op == Op::Param || i.op == Op::LightAmbient || i.op == Op::Fbm ||
-            i.op == Op::Turbulence || i.op >= Op::Diffuse)
+        if (i.op == Op::Param || i.op == Op::LightAmbient || i.op == Op::Channel ||
+            i.op == Op::Fbm || i.op == Op::Turbulence || i.op >= Op::Diffuse)
             out << " #" << i.imm;
         for (int k = 0; k < i.nargs; ++k) out << " %" << argsOf(i)[k];
         if (i.line > 0) out << "   ; line " << i.line;
         out << "\n";
     }
-    out << "Ci = %" << ci[0] << " %" << ci[1] << " %" << ci[2] << "\n";
-    out << "Oi = %" << oi[0] << " %" << oi[1] << " %" << oi[2] << "\n";
+    if (ci[0] >= 0) out << "Ci = %" << ci[0] << " %" << ci[1] << " %" << ci[2] << "\n";
+    if (oi[0] >= 0) out << "Oi = %" << oi[0] << " %" << oi[1] << " %" << oi[2] << "\n";
+    for (size_t k = 0; k < channelOutputs.size(); ++k)
+        out << "channel " << k << " = %" << channelOutputs[k] << "\n";
     return out.str();
 }
 
@@ -56,8 +58,11 @@ void eliminateDeadCode(IrProgram& program) {
             defining[static_cast<size_t>(program.insts[k].result + o)] = static_cast<int>(k);
     std::vector<char> live(program.insts.size(), 0);
     std::vector<int> stack;
-    for (int v : program.ci) stack.push_back(v);
-    for (int v : program.oi) stack.push_back(v);
+    for (int v : program.ci)
+        if (v >= 0) stack.push_back(v);
+    for (int v : program.oi)
+        if (v >= 0) stack.push_back(v);
+    for (int v : program.channelOutputs) stack.push_back(v);
     while (!stack.empty()) {
         const int v = stack.back();
         stack.pop_back();
@@ -85,8 +90,18 @@ void eliminateDeadCode(IrProgram& program) {
         next += inst.nout;
         insts.push_back(inst);
     }
-    for (int& v : program.ci) v = renumber[static_cast<size_t>(v)];
-    for (int& v : program.oi) v = renumber[static_cast<size_t>(v)];
+    for (int& v : program.ci)
+        if (v >= 0) v = renumber[static_cast<size_t>(v)];
+    for (int& v : program.oi)
+        if (v >= 0) v = renumber[static_cast<size_t>(v)];
+    for (int& v : program.channelOutputs) v = renumber[static_cast<size_t>(v)];
+    if (!program.info.empty()) {
+        std::vector<ValueInfo> info(static_cast<size_t>(next));
+        for (size_t v = 0; v < renumber.size() && v < program.info.size(); ++v)
+            if (renumber[v] >= 0)
+                info[static_cast<size_t>(renumber[v])] = std::move(program.info[v]);
+        program.info = std::move(info);
+    }
     program.insts = std::move(insts);
     program.args = std::move(args);
     program.valueCount = next;

@@ -24,6 +24,7 @@ enum class Op : uint8_t {
     Global,        // imm = GlobalId; nout = components
     Param,         // imm = animated parameter slot; nout = components
     LightAmbient,  // imm = light index; nout = 3 (an animated ambient light's color)
+    Channel,       // imm = n-tuple channel; the dynamic part of a factored shader reads it
     // Unary
     Neg,
     Abs,
@@ -99,6 +100,14 @@ struct Inst {
     int32_t line = 0, column = 0;  // the source expression this came from
 };
 
+// What the source called a value, for reports: "Cd[1]", or a temporary's type and
+// component. Filled by lowering; kept through dead-code elimination.
+struct ValueInfo {
+    std::string name;  // variable name with component ("Cd[1]"); empty for temporaries
+    ValueType type = ValueType::Float;
+    int8_t component = -1;  // 0..2 in a 3-component value; -1 for a scalar
+};
+
 struct AnimatedParam {
     std::string name;
     int slot;        // first float of the parameter in the per-frame parameter block
@@ -111,8 +120,14 @@ struct IrProgram {
     std::vector<Inst> insts;
     std::vector<int32_t> args;
     int valueCount = 0;
+    // Outputs. A shader's program writes Ci and Oi; the static part of a factored shader
+    // writes the n-tuple channels instead (ci and oi stay -1).
     int ci[3] = {-1, -1, -1};
     int oi[3] = {-1, -1, -1};
+    std::vector<int32_t> channelOutputs;
+    int channelInputs = 0;        // n-tuple channels read by Channel instructions
+    std::vector<ValueInfo> info;  // per value (may be empty)
+    std::string source;           // the shader's text, for reports (may be empty)
     std::vector<AnimatedParam> animatedParams;
     int paramFloats = 0;  // size of the per-frame parameter block
 
@@ -121,7 +136,8 @@ struct IrProgram {
     std::string dump() const;
 };
 
-// Removes instructions no output depends on and renumbers values densely.
+// Removes instructions no output (Ci, Oi, channel outputs) depends on and renumbers
+// values densely.
 void eliminateDeadCode(IrProgram& program);
 
 }  // namespace mpshade

@@ -23,6 +23,7 @@ class Lowerer {
     void run() {
         program_.shaderName = ast_.name;
         program_.file = ast_.file;
+        program_.source = ast_.source;
         scopes_.emplace_back();
         for (const ParamDecl& p : ast_.params) scopes_[0][p.name] = bindParam(p);
         Val ci{ValueType::Color, {}}, oi{ValueType::Color, {}};
@@ -143,7 +144,27 @@ class Lowerer {
         return static_cast<int>(value);
     }
 
+    // Records what each value is, for reports; the first description of a value wins.
+    void describe(const Val& v, const std::string& name = {}) {
+        program_.info.resize(static_cast<size_t>(program_.valueCount));
+        for (int k = 0; k < v.n(); ++k) {
+            ValueInfo& info = program_.info[static_cast<size_t>(v.c[k])];
+            if (!name.empty() && info.name.empty())
+                info.name = isTriple(v.type) ? name + "[" + std::to_string(k) + "]" : name;
+            if (info.component < 0 && info.type == ValueType::Float) {
+                info.type = v.type;
+                info.component = static_cast<int8_t>(isTriple(v.type) ? k : -1);
+            }
+        }
+    }
+
     Val expr(const Expr& e) {
+        Val v = exprUntagged(e);
+        describe(v);
+        return v;
+    }
+
+    Val exprUntagged(const Expr& e) {
         at(e.line, e.column);
         switch (e.kind) {
             case Expr::Kind::Number:
@@ -221,7 +242,11 @@ class Lowerer {
         for (int k = 0; k < 3; ++k) sum.c[k] = zero;
         for (size_t l = 0; l < binding_.lights.size(); ++l) {
             if (binding_.lights[l].kind == LightKind::Ambient) continue;
-            const int first = b_.emit(op, args, 3, static_cast<int>(l));
+            // A distant light does not depend on P: do not make it look as if it did.
+            std::vector<int> lightArgs = args;
+            if (binding_.lights[l].kind == LightKind::Distant)
+                lightArgs[0] = lightArgs[1] = lightArgs[2] = zero;
+            const int first = b_.emit(op, lightArgs, 3, static_cast<int>(l));
             for (int k = 0; k < 3; ++k) sum.c[k] = b_.emit(Op::Add, {sum.c[k], first + k});
         }
         return sum;
@@ -435,10 +460,13 @@ class Lowerer {
         }
         value = convert(value, current.type);
         var = lookup(name);  // re-find: lowering the value may not add scopes, but be safe
-        if (indexed)
+        if (indexed) {
             var->c[component] = value.c[0];
-        else
+            describe(value, name + "[" + std::to_string(component) + "]");
+        } else {
             *var = value;
+            describe(value, name);
+        }
     }
 
     void stmts(const std::vector<std::unique_ptr<Stmt>>& list) {
@@ -453,9 +481,12 @@ class Lowerer {
             case Stmt::Kind::Block:
                 stmts(s.body);
                 break;
-            case Stmt::Kind::Decl:
-                scopes_.back()[s.name] = convert(expr(*s.value), s.declType);
+            case Stmt::Kind::Decl: {
+                const Val v = convert(expr(*s.value), s.declType);
+                describe(v, s.name);
+                scopes_.back()[s.name] = v;
                 break;
+            }
             case Stmt::Kind::Assign:
                 assign(s);
                 break;

@@ -13,6 +13,7 @@ namespace mpshade {
 std::shared_ptr<const ShaderAst> compileShaderText(const std::string& file,
                                                    const std::string& text) {
     auto ast = std::make_shared<ShaderAst>(parseShader(file, text));
+    ast->source = text;
     typecheckShader(*ast);
     return ast;
 }

@@ -21,6 +21,7 @@ surface brick(
     float grit = 0.15 * noise(P * 40.0);
     color Cb = brickColor * (0.75 + 0.5 * brickId) * (0.9 + grit);
     color Cd = mix(mortarColor * (0.9 + grit), Cb, inBrick);
-    normal Nf = faceforward(N, I);
-    Ci = Cd * (ambient() + diffuse(Nf)) + Ks * specular(Nf, -I, 0.5);
+    // Lighting on N, not faceforward(N, I): that would make even diffuse light depend on
+    // the view, and the factoring could no longer bake it into the static part.
+    Ci = Cd * (ambient() + diffuse(N)) + Ks * specular(N, -I, 0.5);
 }

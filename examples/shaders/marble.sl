@@ -12,7 +12,8 @@ surface marble(
     float m  = 1.0 - smoothstep(0.0, 0.3, abs(sin(P[0] * scale + 4.0 * n)));
     color Cd = mix(base, vein, m);
     float ao = occlusion(P, N, aoRays);
-    normal Nf = faceforward(N, I);
-    Ci = Cd * (ambient() * ao + diffuse(Nf)) + Ks * specular(Nf, -I, roughness);
+    // Lighting on N, not faceforward(N, I): that would make even diffuse light depend on
+    // the view, and the factoring could no longer bake it into the static part.
+    Ci = Cd * (ambient() * ao + diffuse(N)) + Ks * specular(N, -I, roughness);
     Oi = 1.0;
 }

@@ -5,6 +5,7 @@ surface plastic(
     float Ks        = 0.6,
     float roughness = 0.25)
 {
-    normal Nf = faceforward(N, I);
-    Ci = Cs * (ambient() + Kd * diffuse(Nf)) + Ks * specular(Nf, -I, roughness);
+    // Lighting on N, not faceforward(N, I): that would make even diffuse light depend on
+    // the view, and the factoring could no longer bake it into the static part.
+    Ci = Cs * (ambient() + Kd * diffuse(N)) + Ks * specular(N, -I, roughness);
 }

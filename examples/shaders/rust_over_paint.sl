@@ -20,7 +20,8 @@ surface rust_over_paint(
     float ao = occlusion(P, N, aoRays);
     float dirtMask = smoothstep(0.9, 0.4, ao);
     Cd = mix(Cd, dirt, dirtMask);
-    normal Nf = faceforward(N, I);
+    // Lighting on N, not faceforward(N, I): that would make even diffuse light depend on
+    // the view, and the factoring could no longer bake it into the static part.
     float gloss = (1.0 - rustMask) * (1.0 - dirtMask);
-    Ci = Cd * (ambient() * ao + diffuse(Nf)) + gloss * 0.6 * specular(Nf, -I, roughness);
+    Ci = Cd * (ambient() * ao + diffuse(N)) + gloss * 0.6 * specular(N, -I, roughness);
 }

@@ -13,6 +13,7 @@ surface wood(
     float ring = smoothstep(0.0, 0.8, fract(r)) - smoothstep(0.85, 1.0, fract(r));
     float fleck = 0.08 * snoise(point(Q[0] * 40.0, Q[1] * 2.0, Q[2] * 40.0));
     color Cd = mix(dark, light, clamp(ring + fleck, 0.0, 1.0));
-    normal Nf = faceforward(N, I);
-    Ci = Cd * (ambient() + diffuse(Nf)) + Ks * specular(Nf, -I, roughness);
+    // Lighting on N, not faceforward(N, I): that would make even diffuse light depend on
+    // the view, and the factoring could no longer bake it into the static part.
+    Ci = Cd * (ambient() + diffuse(N)) + Ks * specular(N, -I, roughness);
 }

@@ -140,6 +140,60 @@ TEST(Cli, EveryBadSceneExitsTwo) {
     EXPECT_GT(count, 20);
 }
 
+TEST(Cli, FactorShowsASmallTupleAndACheapDynamicPart) {
+    const CliRun run =
+        mpshade("factor examples/shaders/marble.sl --scene examples/vase/scene.json --object vase");
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("n-tuple: 3 floats"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("dynamic lines"), std::string::npos);
+    EXPECT_NE(run.output.find("I, the direction from the eye"), std::string::npos) << run.output;
+
+    const CliRun json = mpshade(
+        "factor examples/shaders/marble.sl --scene examples/vase/scene.json --object vase --json");
+    ASSERT_EQ(json.exitCode, 0) << json.output;
+    const nlohmann::json doc = nlohmann::json::parse(json.output);
+    EXPECT_EQ(doc["chosen_width"], 3);
+    EXPECT_EQ(doc["channels"].size(), 3u);
+    EXPECT_EQ(doc["channels"][0]["type"], "color");
+    const int staticCost = doc["cost"]["static"], dynamicCost = doc["cost"]["dynamic"];
+    EXPECT_LT(dynamicCost * 10, staticCost);
+    EXPECT_GT(doc["dynamic_lines"].size(), 0u);
+}
+
+TEST(Cli, FactorBindingChangesTheCut) {
+    // Without a scene the shader's light is fixed; the teapot's point light moves, so its
+    // diffuse light can no longer be stored.
+    const nlohmann::json fixed =
+        nlohmann::json::parse(mpshade("factor examples/shaders/plastic.sl --json").output);
+    const nlohmann::json moving =
+        nlohmann::json::parse(mpshade("factor examples/shaders/plastic.sl --scene "
+                                      "examples/teapot/scene.json --object teapot --json")
+                                  .output);
+    EXPECT_GT(fixed["cost"]["static"].get<int>(), moving["cost"]["static"].get<int>());
+}
+
+TEST(Cli, FactorBadInput) {
+    const BadRun cases[] = {
+        {"factor examples/shaders/marble.sl --scene examples/vase/scene.json --object urn",
+         "mpshade: --object: error: no object named 'urn' in examples/vase/scene.json (objects: "
+         "vase, floor)\n"},
+        {"factor examples/shaders/marble.sl --object vase",
+         "mpshade: --object: error: --object needs --scene\n"},
+        {"factor examples/shaders/wood.sl --scene examples/vase/scene.json --object vase",
+         "mpshade: examples/shaders/wood.sl: error: object 'vase' binds parameter 'scale', which "
+         "this shader does not declare\n"},
+        {"factor tests/data/bad_shaders/missing_semicolon.sl",
+         "mpshade: tests/data/bad_shaders/missing_semicolon.sl:3:5: error: expected ';' after the "
+         "statement, found 'Ci'\n"},
+        {"factor nowhere.sl", "mpshade: nowhere.sl: error: cannot open shader file\n"},
+    };
+    for (const BadRun& c : cases) {
+        const CliRun run = mpshade(c.args);
+        EXPECT_EQ(run.exitCode, 2) << c.args << "\n" << run.output;
+        EXPECT_EQ(run.output, c.expected) << c.args;
+    }
+}
+
 TEST(Cli, HelpAndVersion) {
     EXPECT_EQ(mpshade("--version").exitCode, 0);
     const CliRun help = mpshade("render --help");

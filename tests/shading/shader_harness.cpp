@@ -3,7 +3,9 @@
 namespace mpshade::test {
 
 ShadingResult runKernel(const ShaderKernel& kernel, const std::vector<ShadingPoint>& points,
-                        const ShadingUniforms& uniforms) {
+                        const ShadingUniforms& uniforms,
+                        const std::vector<std::vector<float>>* channelsIn,
+                        std::vector<std::vector<float>>* channelsOut) {
     const size_t n = points.size();
     std::vector<std::vector<float>> rows(28, std::vector<float>(n));
     for (size_t i = 0; i < n; ++i) {
@@ -28,8 +30,18 @@ ShadingResult runKernel(const ShaderKernel& kernel, const std::vector<ShadingPoi
         in.I[k] = rows[15 + k].data();
     }
     in.u = rows[18].data(), in.v = rows[19].data(), in.s = rows[20].data(), in.t = rows[21].data();
+    std::vector<const float*> inChannels;
+    if (channelsIn)
+        for (const auto& c : *channelsIn) inChannels.push_back(c.data());
+    in.channels = inChannels.data();
     ShadingOutputs out;
     for (int k = 0; k < 3; ++k) out.Ci[k] = rows[22 + k].data(), out.Oi[k] = rows[25 + k].data();
+    std::vector<float*> outChannels;
+    if (channelsOut) {
+        channelsOut->assign(kernel.program().channelOutputs.size(), std::vector<float>(n));
+        for (auto& c : *channelsOut) outChannels.push_back(c.data());
+    }
+    out.channels = outChannels.data();
     ShadingResult result;
     std::vector<float> workspace;
     kernel.run(uniforms, in, n, out, workspace, result.counters);

@@ -22,9 +22,13 @@ struct ShadingResult {
     ShadingCounters counters;
 };
 
-// Runs `kernel` over the points (all globals as given) with `uniforms`.
+// Runs `kernel` over the points (all globals as given) with `uniforms`. A kernel that
+// reads n-tuple channels gets them from `channelsIn` (one vector per channel); one that
+// writes channels fills `channelsOut`.
 ShadingResult runKernel(const ShaderKernel& kernel, const std::vector<ShadingPoint>& points,
-                        const ShadingUniforms& uniforms = {});
+                        const ShadingUniforms& uniforms = {},
+                        const std::vector<std::vector<float>>* channelsIn = nullptr,
+                        std::vector<std::vector<float>>* channelsOut = nullptr);
 
 // Compiles `source` with `binding` and runs it.
 ShadingResult runShader(const std::string& source, const std::vector<ShadingPoint>& points,

@@ -1,0 +1,50 @@
+// binding_time.h -- binding-time analysis: which values of a shader, specialized to one
+// object's binding, change from frame to frame (the patent's S_d) and which are fixed
+// over the range of control values (S_s).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "shading/binding.h"
+#include "shading/ir.h"
+
+namespace mpshade {
+
+enum class Stage : uint8_t {
+    Free,     // constants, and geometry the dynamic phase has anyway: never stored
+    Static,   // fixed over the range: computed in the static phase
+    Dynamic,  // changes per frame instance: computed in the dynamic phase
+};
+
+struct FactorOptions {
+    // The dynamic phase interpolates P, N, Ng, dPdu, dPdv, u, v, s, t from the geometry, so
+    // they (and cheap arithmetic on them alone) need no storage. Off: they are static
+    // inputs like any other, and what the dynamic part needs of them is stored.
+    bool geometryInDynamicPhase = true;
+    // The dynamic part may repeat static work instead of reading it from the n-tuple, but
+    // only operations whose cost (opCost) is at most this: arithmetic, not noise, lighting
+    // or occlusion.
+    int recomputeCostLimit = 2;
+    // Regroup sums and products so their static terms form one stored value (the patent's
+    // C = A1 + A2 + A3 Kspec stores A1 + A2 and A3).
+    bool reassociate = true;
+};
+
+// A rough per-lane cost of an operation, in units of one float add.
+int opCost(Op op, int imm = 0);
+
+struct BindingTimes {
+    std::vector<Stage> stage;  // per value
+    std::vector<int32_t>
+        cause;  // per dynamic value: the argument that made it dynamic; -1 at a source
+    std::vector<std::string>
+        why;  // per dynamic source value: what varies ("I (the view direction)")
+};
+
+// `binding` says which lights move relative to the object (animated parameters are
+// already Param instructions after lowering).
+BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& binding,
+                                 const FactorOptions& options);
+
+}  // namespace mpshade

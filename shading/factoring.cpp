@@ -1,0 +1,249 @@
+#include "shading/factoring.h"
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include "geometry/error.h"
+#include "shading/lower.h"
+#include "shading/min_cut.h"
+#include "shading/reassociate.h"
+
+namespace mpshade {
+
+int instructionCount(const IrProgram& program) {
+    int n = 0;
+    for (const Inst& inst : program.insts) n += inst.op != Op::Const;
+    return n;
+}
+
+int programCost(const IrProgram& program) {
+    int cost = 0;
+    for (const Inst& inst : program.insts) cost += opCost(inst.op, inst.imm);
+    return cost;
+}
+
+namespace {
+
+std::vector<int> definingInstructions(const IrProgram& p) {
+    std::vector<int> defining(static_cast<size_t>(p.valueCount), -1);
+    for (size_t k = 0; k < p.insts.size(); ++k)
+        for (int o = 0; o < p.insts[k].nout; ++o)
+            defining[static_cast<size_t>(p.insts[k].result + o)] = static_cast<int>(k);
+    return defining;
+}
+
+// Static values that a dynamic instruction reads, or that are outputs themselves.
+std::vector<char> boundary(const IrProgram& p, const BindingTimes& bt) {
+    std::vector<char> b(static_cast<size_t>(p.valueCount), 0);
+    for (const Inst& inst : p.insts) {
+        if (bt.stage[static_cast<size_t>(inst.result)] != Stage::Dynamic) continue;
+        for (int a = 0; a < inst.nargs; ++a) {
+            const int32_t v = p.argsOf(inst)[a];
+            if (bt.stage[static_cast<size_t>(v)] == Stage::Static) b[static_cast<size_t>(v)] = 1;
+        }
+    }
+    for (int v : p.ci)
+        if (bt.stage[static_cast<size_t>(v)] == Stage::Static) b[static_cast<size_t>(v)] = 1;
+    for (int v : p.oi)
+        if (bt.stage[static_cast<size_t>(v)] == Stage::Static) b[static_cast<size_t>(v)] = 1;
+    return b;
+}
+
+// The minimum vertex cut: node 2v is v's input side, 2v + 1 its output side.
+std::vector<int32_t> chooseChannels(const IrProgram& p, const BindingTimes& bt,
+                                    const FactorOptions& options) {
+    const size_t n = static_cast<size_t>(p.valueCount);
+    const std::vector<int> defining = definingInstructions(p);
+    const std::vector<char> needed = boundary(p, bt);
+    FlowGraph g;
+    for (size_t v = 0; v < 2 * n; ++v) g.addNode();
+    const int s = g.addNode(), t = g.addNode();
+    for (size_t v = 0; v < n; ++v) {
+        if (bt.stage[v] != Stage::Static) continue;
+        const Inst& inst = p.insts[static_cast<size_t>(defining[v])];
+        const int in = static_cast<int>(2 * v), out = in + 1;
+        g.addEdge(in, out, 1);  // storing v costs one float
+        // Work the dynamic part must not repeat is anchored to the static side.
+        bool anchored = opCost(inst.op, inst.imm) > options.recomputeCostLimit ||
+                        inst.op == Op::Bake || inst.op == Op::Global || inst.op == Op::Diffuse ||
+                        inst.op == Op::Specular || inst.op == Op::Phong;
+        for (int a = 0; a < inst.nargs; ++a) {
+            const size_t arg = static_cast<size_t>(p.argsOf(inst)[a]);
+            if (bt.stage[arg] == Stage::Static)
+                g.addEdge(static_cast<int>(2 * arg + 1), in, FlowGraph::kInfinite);
+            if (bt.stage[arg] == Stage::Dynamic)
+                anchored = true;  // under bake(): only the static phase can
+        }
+        if (anchored) g.addEdge(s, in, FlowGraph::kInfinite);
+        if (needed[v]) g.addEdge(out, t, FlowGraph::kInfinite);
+    }
+    g.maxFlow(s, t);
+    const std::vector<char> reaches = g.reachesSink(t);
+    std::vector<int32_t> cut;
+    for (size_t v = 0; v < n; ++v)
+        if (bt.stage[v] == Stage::Static && !reaches[2 * v] && reaches[2 * v + 1])
+            cut.push_back(static_cast<int32_t>(v));
+    return cut;
+}
+
+IrProgram staticPartOf(const IrProgram& p, const std::vector<int32_t>& channels) {
+    IrProgram s = p;
+    for (int k = 0; k < 3; ++k) s.ci[k] = s.oi[k] = -1;
+    s.channelOutputs = channels;
+    eliminateDeadCode(s);
+    return s;
+}
+
+IrProgram dynamicPartOf(const IrProgram& p, const std::vector<int32_t>& channels) {
+    std::map<int32_t, int> channelOf;
+    for (size_t k = 0; k < channels.size(); ++k) channelOf[channels[k]] = static_cast<int>(k);
+    IrProgram d;
+    d.shaderName = p.shaderName;
+    d.file = p.file;
+    d.source = p.source;
+    d.animatedParams = p.animatedParams;
+    d.paramFloats = p.paramFloats;
+    d.channelInputs = static_cast<int>(channels.size());
+    std::vector<int32_t> map(static_cast<size_t>(p.valueCount), -1);
+    auto define = [&](const Inst& from, Op op, int nargs, int nout, int imm,
+                      const std::vector<int32_t>& args) {
+        Inst inst = from;
+        inst.op = op;
+        inst.nargs = static_cast<uint8_t>(nargs);
+        inst.nout = static_cast<uint8_t>(nout);
+        inst.imm = imm;
+        inst.firstArg = static_cast<int32_t>(d.args.size());
+        inst.result = d.valueCount;
+        d.args.insert(d.args.end(), args.begin(), args.end());
+        d.valueCount += nout;
+        d.insts.push_back(inst);
+        return inst.result;
+    };
+    for (const Inst& inst : p.insts) {
+        std::vector<int32_t> args;
+        for (int a = 0; a < inst.nargs; ++a)
+            args.push_back(map[static_cast<size_t>(p.argsOf(inst)[a])]);
+        // Outputs that are channels are read from the n-tuple; the rest are computed (and
+        // removed below when nothing dynamic needs them).
+        bool allChannels = true;
+        for (int o = 0; o < inst.nout; ++o)
+            allChannels = allChannels && channelOf.count(inst.result + o);
+        if (!allChannels) {
+            bool computable = true;
+            for (int32_t a : args) computable = computable && a >= 0;
+            if (computable) {
+                const int first = define(inst, inst.op, inst.nargs, inst.nout, inst.imm, args);
+                for (int o = 0; o < inst.nout; ++o)
+                    map[static_cast<size_t>(inst.result + o)] = first + o;
+                d.insts.back().constant = inst.constant;
+            }
+        }
+        for (int o = 0; o < inst.nout; ++o) {
+            auto it = channelOf.find(inst.result + o);
+            if (it != channelOf.end())
+                map[static_cast<size_t>(inst.result + o)] =
+                    define(inst, Op::Channel, 0, 1, it->second, {});
+        }
+    }
+    for (int k = 0; k < 3; ++k) {
+        d.ci[k] = map[static_cast<size_t>(p.ci[k])];
+        d.oi[k] = map[static_cast<size_t>(p.oi[k])];
+        MPSHADE_CHECK(d.ci[k] >= 0 && d.oi[k] >= 0);
+    }
+    d.info.resize(static_cast<size_t>(d.valueCount));
+    for (size_t v = 0; v < map.size() && v < p.info.size(); ++v)
+        if (map[v] >= 0) d.info[static_cast<size_t>(map[v])] = p.info[v];
+    eliminateDeadCode(d);
+    // Everything the dynamic part computes must be dynamic, free, or cheap static work.
+    return d;
+}
+
+std::string describeValue(const IrProgram& p, int32_t v) {
+    const ValueInfo* info =
+        static_cast<size_t>(v) < p.info.size() ? &p.info[static_cast<size_t>(v)] : nullptr;
+    if (info && !info->name.empty()) return "'" + info->name + "'";
+    return "";
+}
+
+std::vector<DynamicLine> explainDynamicLines(const IrProgram& p, const BindingTimes& bt) {
+    const std::vector<int> defining = definingInstructions(p);
+    std::map<int, DynamicLine> lines;
+    for (const Inst& inst : p.insts) {
+        const size_t v = static_cast<size_t>(inst.result);
+        if (bt.stage[v] != Stage::Dynamic || inst.line <= 0 || lines.count(inst.line)) continue;
+        // The inputs themselves (a parameter's declaration, a global) are the chain's end,
+        // not a line the author wrote dynamic work on.
+        if (inst.op == Op::Global || inst.op == Op::Param || inst.op == Op::LightAmbient) continue;
+        DynamicLine line;
+        line.line = inst.line;
+        // Follow the causes back to the dynamic input, naming each step once per line.
+        int32_t at = static_cast<int32_t>(v);
+        int lastLine = -1;
+        for (int guard = 0; at >= 0 && guard < 64; ++guard) {
+            const Inst& def = p.insts[static_cast<size_t>(defining[static_cast<size_t>(at)])];
+            const int32_t cause = bt.cause[static_cast<size_t>(at)];
+            if (cause < 0) {
+                line.chain.push_back(bt.why[static_cast<size_t>(at)] + " (line " +
+                                     std::to_string(def.line) + ":" + std::to_string(def.column) +
+                                     ")");
+                break;
+            }
+            if (def.line != lastLine) {
+                const std::string name = describeValue(p, at);
+                line.chain.push_back(std::string(opName(def.op)) +
+                                     (name.empty() ? "" : " -> " + name) + " at line " +
+                                     std::to_string(def.line) + ":" + std::to_string(def.column));
+                lastLine = def.line;
+            }
+            at = cause;
+        }
+        lines[inst.line] = line;
+    }
+    std::vector<DynamicLine> out;
+    for (auto& [l, line] : lines) out.push_back(std::move(line));
+    return out;
+}
+
+}  // namespace
+
+FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
+                            const FactorOptions& options) {
+    FactoredShader f;
+    const IrProgram lowered = lowerShader(ast, binding);
+    const BindingTimes loweredTimes = analyzeBindingTimes(lowered, binding, options);
+    const std::vector<char> naive = boundary(lowered, loweredTimes);
+    f.naiveWidth = static_cast<int>(std::count(naive.begin(), naive.end(), 1));
+    f.analyzed = options.reassociate ? reassociate(lowered, loweredTimes) : lowered;
+    f.times = analyzeBindingTimes(f.analyzed, binding, options);
+
+    const std::vector<int32_t> cut = chooseChannels(f.analyzed, f.times, options);
+    f.staticPart = staticPartOf(f.analyzed, cut);
+    f.dynamicPart = dynamicPartOf(f.analyzed, cut);
+    const std::vector<int> defining = definingInstructions(f.analyzed);
+    for (int32_t v : cut) {
+        const Inst& inst = f.analyzed.insts[static_cast<size_t>(defining[static_cast<size_t>(v)])];
+        ChannelInfo c;
+        if (static_cast<size_t>(v) < f.analyzed.info.size()) {
+            const ValueInfo& info = f.analyzed.info[static_cast<size_t>(v)];
+            c.name = info.name;
+            c.type = info.type;
+            c.component = info.component;
+        }
+        c.line = inst.line;
+        c.column = inst.column;
+        c.op = inst.op;
+        f.channels.push_back(c);
+    }
+    f.chosenWidth = static_cast<int>(cut.size());
+    f.originalInstructions = instructionCount(lowered);
+    f.staticInstructions = instructionCount(f.staticPart);
+    f.dynamicInstructions = instructionCount(f.dynamicPart);
+    f.originalCost = programCost(lowered);
+    f.staticCost = programCost(f.staticPart);
+    f.dynamicCost = programCost(f.dynamicPart);
+    f.dynamicLines = explainDynamicLines(f.analyzed, f.times);
+    return f;
+}
+
+}  // namespace mpshade

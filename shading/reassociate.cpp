@@ -1,0 +1,146 @@
+#include "shading/reassociate.h"
+
+#include "geometry/error.h"
+#include "shading/ir_builder.h"
+
+namespace mpshade {
+namespace {
+
+struct Term {
+    int32_t value;  // in the old program
+    bool negative;
+};
+
+class Reassociator {
+  public:
+    Reassociator(const IrProgram& program, const BindingTimes& times)
+        : old_(program), times_(times), builder_(out_) {
+        const size_t n = static_cast<size_t>(program.valueCount);
+        defining_.assign(n, -1);
+        uses_.assign(n, 0);
+        for (size_t k = 0; k < program.insts.size(); ++k) {
+            const Inst& inst = program.insts[k];
+            for (int o = 0; o < inst.nout; ++o)
+                defining_[static_cast<size_t>(inst.result + o)] = static_cast<int>(k);
+            for (int a = 0; a < inst.nargs; ++a)
+                ++uses_[static_cast<size_t>(program.argsOf(inst)[a])];
+        }
+        for (int v : program.ci)
+            if (v >= 0) ++uses_[static_cast<size_t>(v)];
+        for (int v : program.oi)
+            if (v >= 0) ++uses_[static_cast<size_t>(v)];
+        for (int v : program.channelOutputs) ++uses_[static_cast<size_t>(v)];
+    }
+
+    IrProgram run() {
+        out_.shaderName = old_.shaderName;
+        out_.file = old_.file;
+        out_.source = old_.source;
+        out_.animatedParams = old_.animatedParams;
+        out_.paramFloats = old_.paramFloats;
+        out_.channelInputs = old_.channelInputs;
+        map_.assign(static_cast<size_t>(old_.valueCount), -1);
+        for (const Inst& inst : old_.insts) {
+            builder_.setLocation(inst.line, inst.column);
+            const int32_t* args = old_.argsOf(inst);
+            int result;
+            if (inst.op == Op::Const) {
+                result = builder_.constant(inst.constant);
+            } else if (!regroup(inst, result)) {
+                std::vector<int> mapped;
+                for (int a = 0; a < inst.nargs; ++a)
+                    mapped.push_back(map_[static_cast<size_t>(args[a])]);
+                result = builder_.emit(inst.op, mapped, inst.nout, inst.imm);
+            }
+            for (int o = 0; o < inst.nout; ++o) {
+                map_[static_cast<size_t>(inst.result + o)] = result + o;
+                describe(inst.result + o, result + o);
+            }
+        }
+        for (int k = 0; k < 3; ++k) {
+            if (old_.ci[k] >= 0) out_.ci[k] = map_[static_cast<size_t>(old_.ci[k])];
+            if (old_.oi[k] >= 0) out_.oi[k] = map_[static_cast<size_t>(old_.oi[k])];
+        }
+        for (int v : old_.channelOutputs)
+            out_.channelOutputs.push_back(map_[static_cast<size_t>(v)]);
+        eliminateDeadCode(out_);
+        return std::move(out_);
+    }
+
+  private:
+    Stage stage(int32_t v) const { return times_.stage[static_cast<size_t>(v)]; }
+
+    void describe(int32_t oldValue, int32_t newValue) {
+        if (static_cast<size_t>(oldValue) >= old_.info.size()) return;
+        out_.info.resize(static_cast<size_t>(out_.valueCount));
+        ValueInfo& info = out_.info[static_cast<size_t>(newValue)];
+        if (info.name.empty() && info.component < 0)
+            info = old_.info[static_cast<size_t>(oldValue)];
+    }
+
+    // Leaves of the sum (or product) rooted at v: interior nodes are dynamic sums used
+    // only here, so regrouping them duplicates nothing.
+    void flatten(int32_t v, bool negative, bool root, bool product,
+                 std::vector<Term>& terms) const {
+        const int k = defining_[static_cast<size_t>(v)];
+        const Inst& inst = old_.insts[static_cast<size_t>(k)];
+        const bool chain =
+            product ? inst.op == Op::Mul : (inst.op == Op::Add || inst.op == Op::Sub);
+        if (chain && stage(v) == Stage::Dynamic && (root || uses_[static_cast<size_t>(v)] == 1)) {
+            const int32_t* args = old_.argsOf(inst);
+            flatten(args[0], negative, false, product, terms);
+            flatten(args[1], inst.op == Op::Sub ? !negative : negative, false, product, terms);
+            return;
+        }
+        terms.push_back({v, negative});
+    }
+
+    int combine(const std::vector<Term>& terms, bool product) {
+        int acc = -1;
+        for (const Term& t : terms) {
+            const int v = map_[static_cast<size_t>(t.value)];
+            if (acc < 0) {
+                acc = t.negative ? builder_.emit(Op::Neg, {v}) : v;
+            } else if (product) {
+                acc = builder_.emit(Op::Mul, {acc, v});
+            } else {
+                acc = builder_.emit(t.negative ? Op::Sub : Op::Add, {acc, v});
+            }
+        }
+        return acc;
+    }
+
+    bool regroup(const Inst& inst, int& result) {
+        const bool product = inst.op == Op::Mul;
+        if (!(product || inst.op == Op::Add || inst.op == Op::Sub)) return false;
+        if (stage(inst.result) != Stage::Dynamic) return false;
+        std::vector<Term> terms, fixed, varying;
+        flatten(inst.result, false, true, product, terms);
+        for (const Term& t : terms)
+            (stage(t.value) == Stage::Dynamic ? varying : fixed).push_back(t);
+        if (fixed.size() < 2 || varying.empty()) return false;
+        // All the static terms first, as one static value; then the dynamic ones.
+        int acc = combine(fixed, product);
+        for (const Term& t : varying) {
+            const int v = map_[static_cast<size_t>(t.value)];
+            acc = builder_.emit(product ? Op::Mul : (t.negative ? Op::Sub : Op::Add), {acc, v});
+        }
+        result = acc;
+        return true;
+    }
+
+    const IrProgram& old_;
+    const BindingTimes& times_;
+    IrProgram out_;
+    IrBuilder builder_;
+    std::vector<int> defining_, uses_;
+    std::vector<int32_t> map_;
+};
+
+}  // namespace
+
+IrProgram reassociate(const IrProgram& program, const BindingTimes& times) {
+    return Reassociator(program, times).run();
+}
+
+}  // namespace mpshade

@@ -1,0 +1,388 @@
+// The factoring front end. The core property: running the static part, storing its
+// n-tuple, and running the dynamic part gives what the unfactored shader gives, while the
+// static part sees different values of every dynamic input than the dynamic part does
+// (so a static part that wrongly read a dynamic input would be caught).
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "geometry/ray_scene.h"
+#include "scene/scene.h"
+#include "scene/variability.h"
+#include "shading/factoring.h"
+#include "shading/lower.h"
+#include "shading/shader_harness.h"
+#include "test_support.h"
+
+namespace mpshade {
+namespace {
+
+using test::ShadingPoint;
+
+struct Instance {
+    std::vector<ShadingPoint> points;
+    ShadingUniforms uniforms;
+    std::vector<float> params;
+    std::vector<LightSample> lights;
+};
+
+// The same surface points, with every dynamic input (I, E, time, animated parameters,
+// moving lights) drawn afresh; geometry and fixed lights are the same.
+Instance makeInstance(const std::vector<ShadingPoint>& surface, const IrProgram& program,
+                      const ShaderBinding& binding, std::mt19937& rng,
+                      const SurfaceRayScene* occluder) {
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    Instance inst;
+    inst.points = surface;
+    for (ShadingPoint& p : inst.points) {
+        glm::vec3 I(uni(rng), uni(rng), uni(rng));
+        p.I = glm::length(I) > 0.01f ? glm::normalize(I) : glm::vec3(0, 0, -1);
+    }
+    for (int k = 0; k < program.paramFloats; ++k) inst.params.push_back(2.0f * uni(rng));
+    std::mt19937 fixedRng(1234);  // fixed lights: the same in every instance
+    std::uniform_real_distribution<float> fixedUni(0.1f, 1.0f);
+    for (const LightBinding& lb : binding.lights) {
+        std::mt19937& r = lb.movesRelativeToObject || lb.animated ? rng : fixedRng;
+        std::uniform_real_distribution<float>& d =
+            lb.movesRelativeToObject || lb.animated ? uni : fixedUni;
+        LightSample l;
+        l.kind = lb.kind;
+        l.color = glm::abs(glm::vec3(d(r), d(r), d(r))) + 0.1f;
+        l.position = glm::vec3(3 * d(r), 3 + d(r), 3 * d(r));
+        l.toLight = glm::normalize(glm::vec3(d(r), 1.0f, d(r)));
+        inst.lights.push_back(l);
+    }
+    inst.uniforms.time = 3.0f * uni(rng);
+    inst.uniforms.eye = glm::vec3(5 * uni(rng), 5 * uni(rng), 5 * uni(rng));
+    inst.uniforms.params = inst.params;
+    inst.uniforms.lights = inst.lights;
+    inst.uniforms.occluder = occluder;
+    return inst;
+}
+
+std::vector<ShadingPoint> surfacePoints(std::mt19937& rng, size_t n) {
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    std::vector<ShadingPoint> pts(n);
+    for (ShadingPoint& p : pts) {
+        p.P = glm::vec3(2 * uni(rng), 2 * uni(rng), 2 * uni(rng));
+        p.N = glm::normalize(glm::vec3(uni(rng), uni(rng) + 1.5f, uni(rng)));
+        p.Ng = p.N;
+        p.u = 0.5f + 0.5f * uni(rng), p.v = 0.5f + 0.5f * uni(rng);
+        p.s = p.u, p.t = p.v;
+        p.dPdu = glm::vec3(1, 0, uni(rng));
+        p.dPdv = glm::vec3(0, uni(rng), -1);
+    }
+    return pts;
+}
+
+bool close(float a, float b) {
+    if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b);
+    if (std::isinf(a) || std::isinf(b)) return a == b;
+    return std::fabs(a - b) <= 1e-5f * std::fmax(1.0f, std::fmax(std::fabs(a), std::fabs(b)));
+}
+
+// Checks static-then-dynamic against the unfactored shader; returns the factoring.
+FactoredShader expectExact(const ShaderAst& ast, const ShaderBinding& binding,
+                           const std::string& what, const FactorOptions& options = {},
+                           int instances = 3) {
+    static const Surface sphere = Sphere{1.0f};
+    static const SurfaceRayScene occluder(sphere);
+    const FactoredShader f = factorShader(ast, binding, options);
+    const ShaderKernel original(lowerShader(ast, binding));
+    const ShaderKernel staticKernel(f.staticPart), dynamicKernel(f.dynamicPart);
+    EXPECT_EQ(static_cast<int>(f.staticPart.channelOutputs.size()), f.chosenWidth) << what;
+    EXPECT_EQ(f.dynamicPart.channelInputs, f.chosenWidth) << what;
+    std::mt19937 rng(42);
+    const std::vector<ShadingPoint> surface = surfacePoints(rng, 300);
+    // The static phase runs once, at other values of the dynamic inputs.
+    const Instance representative = makeInstance(surface, f.analyzed, binding, rng, &occluder);
+    std::vector<std::vector<float>> tuple;
+    test::runKernel(staticKernel, representative.points, representative.uniforms, nullptr, &tuple);
+    for (int i = 0; i < instances; ++i) {
+        const Instance frame = makeInstance(surface, f.analyzed, binding, rng, &occluder);
+        const auto expected = test::runKernel(original, frame.points, frame.uniforms);
+        const auto got = test::runKernel(dynamicKernel, frame.points, frame.uniforms, &tuple);
+        for (size_t p = 0; p < surface.size(); ++p) {
+            for (int k = 0; k < 3; ++k) {
+                if (!close(got.Ci[p][k], expected.Ci[p][k]) ||
+                    !close(got.Oi[p][k], expected.Oi[p][k])) {
+                    ADD_FAILURE() << what << ": point " << p << " component " << k << ": factored "
+                                  << got.Ci[p][k] << " vs " << expected.Ci[p][k]
+                                  << "\nstatic part:\n"
+                                  << f.staticPart.dump() << "dynamic part:\n"
+                                  << f.dynamicPart.dump();
+                    return f;
+                }
+            }
+        }
+    }
+    return f;
+}
+
+ShaderBinding everythingVaries(const ShaderAst& ast) {
+    ShaderBinding b;
+    // Int parameters count rays and octaves, which must stay constant.
+    for (const ParamDecl& p : ast.params)
+        if (p.type != ValueType::Int) b.params[p.name].kind = ParamBinding::Kind::Animated;
+    b.lights.resize(3);
+    b.lights[0].kind = LightKind::Ambient;
+    b.lights[0].animated = b.lights[0].movesRelativeToObject = true;
+    b.lights[1].kind = LightKind::Distant;
+    b.lights[1].movesRelativeToObject = true;
+    b.lights[2].kind = LightKind::Point;
+    b.lights[2].animated = b.lights[2].movesRelativeToObject = true;
+    return b;
+}
+
+ShaderBinding fixedLights() {
+    ShaderBinding b;
+    b.lights.resize(3);
+    b.lights[0].kind = LightKind::Ambient;
+    b.lights[0].color[0] = b.lights[0].color[1] = b.lights[0].color[2] = 0.2f;
+    b.lights[1].kind = LightKind::Distant;
+    b.lights[2].kind = LightKind::Point;
+    return b;
+}
+
+TEST(Factoring, ExampleShadersAreExactForEveryExampleBinding) {
+    int checked = 0;
+    for (const char* scenePath : {"examples/vase/scene.json", "examples/teapot/scene.json",
+                                  "examples/courtyard/scene.json"}) {
+        const Scene scene = loadScene(test::sourcePath(scenePath));
+        std::set<std::string> seen;
+        for (const SceneObject& obj : scene.objects) {
+            if (!seen.insert(obj.shaderName).second) continue;
+            expectExact(*obj.shader, bindingOf(scene, obj),
+                        std::string(scenePath) + " " + obj.name);
+            ++checked;
+        }
+    }
+    EXPECT_GE(checked, 7);
+}
+
+TEST(Factoring, ExampleShadersAreExactWhenEverythingVariesOrNothingDoes) {
+    for (const auto& entry :
+         std::filesystem::directory_iterator(test::sourcePath("examples/shaders"))) {
+        auto ast = loadShaderFile(entry.path().string());
+        expectExact(*ast, everythingVaries(*ast),
+                    entry.path().filename().string() + " (everything varies)");
+        const FactoredShader f =
+            expectExact(*ast, fixedLights(), entry.path().filename().string() + " (fixed lights)");
+        // With fixed lights every example has static work to save; the pattern-heavy ones
+        // leave the dynamic part (the specular highlights) far cheaper than the static part.
+        EXPECT_LT(f.dynamicCost, f.originalCost) << entry.path();
+        const std::string name = entry.path().stem().string();
+        if (name == "marble" || name == "wood" || name == "rust_over_paint") {
+            EXPECT_LT(f.dynamicCost * 3, f.staticCost)
+                << entry.path() << ": the dynamic part should be far cheaper";
+        }
+    }
+}
+
+TEST(Factoring, PatentExampleStoresTwoValuesNotThree) {
+    // C = A1 + A2 + A3 * Kspec, with Kspec dynamic (col. 10 of the patent): the n-tuple
+    // holds A1 + A2 and A3.
+    auto ast = compileShaderText("patent.sl", R"(
+        surface patent(float Kspec = 1) {
+            float A1 = noise(P);
+            float A2 = noise(P * 2);
+            float A3 = noise(P * 3);
+            Ci = color(A1 + A3 * Kspec + A2);
+        })");
+    ShaderBinding b;
+    b.params["Kspec"].kind = ParamBinding::Kind::Animated;
+    const FactoredShader f = expectExact(*ast, b, "patent example");
+    EXPECT_EQ(f.naiveWidth, 3);
+    EXPECT_EQ(f.chosenWidth, 2);
+    FactorOptions plain;
+    plain.reassociate = false;
+    EXPECT_EQ(expectExact(*ast, b, "patent example, no reassociation", plain).chosenWidth, 3);
+}
+
+TEST(Factoring, MinimumCutPrefersTheNarrowerSideAndDoesNotRepeatExpensiveWork) {
+    // Five noise values feed one static sum used dynamically: one float, not five.
+    auto ast = compileShaderText("cut.sl", R"(
+        surface cut() {
+            float sum = noise(P) + noise(P * 2) * noise(P * 3) - noise(P * 5) / (1 + noise(P * 7));
+            Ci = color(sum * time, sum, 0);
+        })");
+    const FactoredShader f = expectExact(*ast, {}, "cut");
+    EXPECT_EQ(f.naiveWidth, 1);
+    EXPECT_EQ(f.chosenWidth, 1);
+    for (const Inst& inst : f.dynamicPart.insts) EXPECT_NE(inst.op, Op::Noise);
+    // Three uses of one static noise, reached by cheap arithmetic: store the noise once and
+    // repeat the cheap arithmetic.
+    auto ast2 = compileShaderText("cut2.sl", R"(
+        surface cut2() {
+            float n = fbm(P, 4);
+            Ci = color((n + 1) * time, (n * 2) * time, (n - 3) * time);
+        })");
+    const FactoredShader f2 = expectExact(*ast2, {}, "cut2");
+    EXPECT_EQ(f2.naiveWidth, 3);
+    EXPECT_EQ(f2.chosenWidth, 1);
+}
+
+TEST(Factoring, AllStaticAndAllDynamic) {
+    auto allStatic = compileShaderText(
+        "s.sl", "surface s() { Ci = color(noise(P), fbm(P, 3), u); Oi = noise(P * 2); }");
+    const FactoredShader s = expectExact(*allStatic, {}, "all static");
+    // The dynamic part only reads channels (u is geometry the dynamic phase has).
+    for (const Inst& inst : s.dynamicPart.insts)
+        EXPECT_TRUE(inst.op == Op::Channel || inst.op == Op::Const || inst.op == Op::Global)
+            << opName(inst.op);
+    EXPECT_EQ(s.chosenWidth, 3);
+    EXPECT_TRUE(s.dynamicLines.empty());
+
+    auto allDynamic =
+        compileShaderText("d.sl", "surface d() { Ci = color(noise(I * time), time, E[0]); }");
+    const FactoredShader d = expectExact(*allDynamic, {}, "all dynamic");
+    EXPECT_EQ(d.chosenWidth, 0);
+    EXPECT_EQ(d.staticInstructions, 0);
+    EXPECT_EQ(d.dynamicInstructions, d.originalInstructions);
+}
+
+TEST(Factoring, DynamicBranchesLoopsAndNaN) {
+    auto branch = compileShaderText("b.sl", R"(
+        surface b() {
+            color c = 0;
+            if (time > 0.5) { c = color(noise(P * 4)); } else { c = color(fbm(P, 3), 0, 1); }
+            float acc = 0;
+            for (int i = 1; i <= 3; i += 1) { acc += noise(P * i) * time; }
+            Ci = c + acc + color(log(noise(P) - 2) + sqrt(time - 1), 1 / (time - time), pow(-2, time));
+        })");
+    const FactoredShader f = expectExact(*branch, {}, "branches and loops", {}, 6);
+    for (const Inst& inst : f.dynamicPart.insts) {
+        EXPECT_NE(inst.op, Op::Noise);
+        EXPECT_NE(inst.op, Op::Fbm);
+    }
+    EXPECT_GT(f.chosenWidth, 0);
+}
+
+TEST(Factoring, OverridesBakeAndDynamic) {
+    // bake() holds a view-dependent value fixed at the range's representative view.
+    auto baked =
+        compileShaderText("k.sl", "surface k() { Ci = color(bake(dot(N, -I)) * noise(P)); }");
+    const FactoredShader fb = factorShader(*baked, {});
+    EXPECT_EQ(fb.chosenWidth, 1);
+    EXPECT_EQ(fb.dynamicInstructions, 1);  // read the channel: nothing else varies
+    // dynamic() forces noise to be evaluated every frame.
+    auto forced =
+        compileShaderText("f.sl", "surface f() { Ci = color(dynamic(noise(P)) + fbm(P, 2)); }");
+    const FactoredShader ff = expectExact(*forced, {}, "dynamic()");
+    int noise = 0;
+    for (const Inst& inst : ff.dynamicPart.insts) noise += inst.op == Op::Noise;
+    EXPECT_EQ(noise, 1);
+    EXPECT_EQ(ff.chosenWidth, 1);  // the fbm
+}
+
+TEST(Factoring, LightingSplitsPerLightAndPerBinding) {
+    auto ast = compileShaderText(
+        "l.sl", "surface l() { Ci = noise(P) * (ambient() + diffuse(N)) + specular(N, -I, 0.3); }");
+    ShaderBinding b = fixedLights();
+    b.lights[2].movesRelativeToObject = true;  // the point light moves
+    const FactoredShader f = expectExact(*ast, b, "one fixed and one moving light");
+    for (const Inst& inst : f.staticPart.insts)
+        if (inst.op == Op::Diffuse) {
+            EXPECT_EQ(inst.imm, 1) << "only the fixed distant light's diffuse is static";
+        }
+    int dynamicDiffuse = 0;
+    for (const Inst& inst : f.dynamicPart.insts)
+        dynamicDiffuse += inst.op == Op::Diffuse && inst.imm == 2;
+    EXPECT_EQ(dynamicDiffuse, 1);
+    // The same shader on a moving object: every positional light moves relative to it.
+    const FactoredShader g = expectExact(*ast, everythingVaries(*ast), "moving object");
+    for (const Inst& inst : g.staticPart.insts) EXPECT_NE(inst.op, Op::Diffuse);
+    EXPECT_NE(f.chosenWidth, g.chosenWidth);
+}
+
+TEST(Factoring, ExplainsWhyEachLineIsDynamic) {
+    auto ast = compileShaderText("why.sl",
+                                 "surface why(float k = 1) {\n  float a = noise(P);\n  float b = a "
+                                 "* k;\n  Ci = color(b);\n}");
+    ShaderBinding b;
+    b.params["k"].kind = ParamBinding::Kind::Animated;
+    const FactoredShader f = factorShader(*ast, b);
+    ASSERT_EQ(f.dynamicLines.size(), 1u);
+    EXPECT_EQ(f.dynamicLines[0].line, 3);
+    ASSERT_FALSE(f.dynamicLines[0].chain.empty());
+    EXPECT_NE(f.dynamicLines[0].chain.back().find("parameter 'k' is animated"), std::string::npos);
+    ASSERT_EQ(f.channels.size(), 1u);
+    EXPECT_EQ(f.channels[0].name, "a");
+    EXPECT_EQ(f.channels[0].line, 2);
+}
+
+// Random well-typed programs over random mixes of static and dynamic inputs, with
+// branches, loops and lighting.
+std::string randomShader(std::mt19937& rng, int statements) {
+    std::vector<std::string> vars = {"u",    "v", "P[0]",     "N[1]", "I[2]",
+                                     "time", "k", "noise(P)", "E[1]"};
+    std::ostringstream src;
+    src << "surface r(float k = 1, color tint = color(0.5, 0.25, 1)) {\n    color c = tint * "
+           "diffuse(N);\n";
+    auto pick = [&]() { return vars[rng() % vars.size()]; };
+    static const char* kBinary[] = {"+", "-", "*"};
+    for (int i = 0; i < statements; ++i) {
+        const std::string name = "t" + std::to_string(i);
+        std::string e;
+        switch (rng() % 7) {
+            case 0:
+            case 1:
+                e = pick() + " " + kBinary[rng() % 3] + " " + pick();
+                break;
+            case 2:
+                e = "sin(" + pick() + ") + " + pick();
+                break;
+            case 3:
+                e = "noise(point(" + pick() + ", " + pick() + ", 0.25))";
+                break;
+            case 4:
+                e = "mix(" + pick() + ", " + pick() + ", " + pick() + ")";
+                break;
+            case 5:
+                e = "fbm(P * " + pick() + ", 2)";
+                break;
+            case 6:
+                e = "max(" + pick() + ", 0) * " + pick();
+                break;
+        }
+        src << "    float " << name << " = " << e << ";\n";
+        if (rng() % 4 == 0)
+            src << "    if (" << pick() << " > " << pick() << ") { " << name << " += " << pick()
+                << "; } else { c += color(" << pick() << "); }\n";
+        if (rng() % 6 == 0)
+            src << "    for (int j = 0; j < 2; j += 1) { " << name << " += " << pick()
+                << " * j; }\n";
+        vars.push_back(name);
+    }
+    src << "    Ci = c * " << vars.back() << " + color(" << pick() << ", " << pick() << ", "
+        << pick() << ")"
+        << " + specular(N, -I, 0.4) * " << pick() << ";\n    Oi = clamp(" << pick()
+        << ", 0, 1);\n}\n";
+    return src.str();
+}
+
+TEST(Factoring, RandomShadersFactorExactly) {
+    std::mt19937 rng(2024);
+    for (int i = 0; i < 80; ++i) {
+        const std::string src = randomShader(rng, 4 + i % 12);
+        auto ast = compileShaderText("random.sl", src);
+        ShaderBinding b = fixedLights();
+        if (i % 2) b.params["k"].kind = ParamBinding::Kind::Animated;
+        if (i % 3 == 0) b.params["tint"].kind = ParamBinding::Kind::Animated;
+        if (i % 5 == 0) b.lights[1].movesRelativeToObject = true;
+        FactorOptions options;
+        options.geometryInDynamicPhase = i % 4 != 0;
+        expectExact(*ast, b, src, options);
+        if (HasFailure()) break;
+    }
+}
+
+}  // namespace
+
+}  // namespace mpshade
