@@ -168,10 +168,7 @@ BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& 
     for (const Inst& inst : program.insts)
         if (inst.op == Op::Dynamic)
             for (int a = 0; a < inst.nargs; ++a) stack.push_back(program.argsOf(inst)[a]);
-    std::vector<int> defining(n, -1);
-    for (size_t k = 0; k < program.insts.size(); ++k)
-        for (int o = 0; o < program.insts[k].nout; ++o)
-            defining[static_cast<size_t>(program.insts[k].result + o)] = static_cast<int>(k);
+    const std::vector<int> defining = definingInstructions(program);
     while (!stack.empty()) {
         const size_t v = static_cast<size_t>(stack.back());
         stack.pop_back();

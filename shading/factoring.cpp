@@ -25,14 +25,6 @@ int programCost(const IrProgram& program) {
 
 namespace {
 
-std::vector<int> definingInstructions(const IrProgram& p) {
-    std::vector<int> defining(static_cast<size_t>(p.valueCount), -1);
-    for (size_t k = 0; k < p.insts.size(); ++k)
-        for (int o = 0; o < p.insts[k].nout; ++o)
-            defining[static_cast<size_t>(p.insts[k].result + o)] = static_cast<int>(k);
-    return defining;
-}
-
 // Static values that a dynamic instruction reads, or that are outputs themselves.
 std::vector<char> boundary(const IrProgram& p, const BindingTimes& bt) {
     std::vector<char> b(static_cast<size_t>(p.valueCount), 0);
@@ -98,12 +90,7 @@ IrProgram staticPartOf(const IrProgram& p, const std::vector<int32_t>& channels)
 IrProgram dynamicPartOf(const IrProgram& p, const std::vector<int32_t>& channels) {
     std::map<int32_t, int> channelOf;
     for (size_t k = 0; k < channels.size(); ++k) channelOf[channels[k]] = static_cast<int>(k);
-    IrProgram d;
-    d.shaderName = p.shaderName;
-    d.file = p.file;
-    d.source = p.source;
-    d.animatedParams = p.animatedParams;
-    d.paramFloats = p.paramFloats;
+    IrProgram d = p.emptyCopy();
     d.channelInputs = static_cast<int>(channels.size());
     std::vector<int32_t> map(static_cast<size_t>(p.valueCount), -1);
     auto define = [&](const Inst& from, Op op, int nargs, int nout, int imm,

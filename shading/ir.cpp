@@ -51,11 +51,27 @@ std::string IrProgram::dump() const {
     return out.str();
 }
 
-void eliminateDeadCode(IrProgram& program) {
+IrProgram IrProgram::emptyCopy() const {
+    IrProgram p;
+    p.shaderName = shaderName;
+    p.file = file;
+    p.source = source;
+    p.animatedParams = animatedParams;
+    p.paramFloats = paramFloats;
+    p.channelInputs = channelInputs;
+    return p;
+}
+
+std::vector<int> definingInstructions(const IrProgram& program) {
     std::vector<int> defining(static_cast<size_t>(program.valueCount), -1);
     for (size_t k = 0; k < program.insts.size(); ++k)
         for (int o = 0; o < program.insts[k].nout; ++o)
             defining[static_cast<size_t>(program.insts[k].result + o)] = static_cast<int>(k);
+    return defining;
+}
+
+void eliminateDeadCode(IrProgram& program) {
+    const std::vector<int> defining = definingInstructions(program);
     std::vector<char> live(program.insts.size(), 0);
     std::vector<int> stack;
     for (int v : program.ci)

@@ -132,9 +132,14 @@ struct IrProgram {
     int paramFloats = 0;  // size of the per-frame parameter block
 
     const int32_t* argsOf(const Inst& i) const { return args.data() + i.firstArg; }
+    // The same shader's names, parameters and source, with no instructions or outputs.
+    IrProgram emptyCopy() const;
     // Prints one instruction per line ("%12 = mul %3 %7   ; line 9"), for tests and --dump.
     std::string dump() const;
 };
+
+// For each value, the index of the instruction that defines it.
+std::vector<int> definingInstructions(const IrProgram& program);
 
 // Removes instructions no output (Ci, Oi, channel outputs) depends on and renumbers
 // values densely.

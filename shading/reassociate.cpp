@@ -16,12 +16,10 @@ class Reassociator {
     Reassociator(const IrProgram& program, const BindingTimes& times)
         : old_(program), times_(times), builder_(out_) {
         const size_t n = static_cast<size_t>(program.valueCount);
-        defining_.assign(n, -1);
+        defining_ = definingInstructions(program);
         uses_.assign(n, 0);
         for (size_t k = 0; k < program.insts.size(); ++k) {
             const Inst& inst = program.insts[k];
-            for (int o = 0; o < inst.nout; ++o)
-                defining_[static_cast<size_t>(inst.result + o)] = static_cast<int>(k);
             for (int a = 0; a < inst.nargs; ++a)
                 ++uses_[static_cast<size_t>(program.argsOf(inst)[a])];
         }
@@ -33,12 +31,7 @@ class Reassociator {
     }
 
     IrProgram run() {
-        out_.shaderName = old_.shaderName;
-        out_.file = old_.file;
-        out_.source = old_.source;
-        out_.animatedParams = old_.animatedParams;
-        out_.paramFloats = old_.paramFloats;
-        out_.channelInputs = old_.channelInputs;
+        out_ = old_.emptyCopy();
         map_.assign(static_cast<size_t>(old_.valueCount), -1);
         for (const Inst& inst : old_.insts) {
             builder_.setLocation(inst.line, inst.column);
