@@ -27,6 +27,9 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--seed", render.seed, "Seed of the sample positions")
         ->capture_default_str();
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
+    renderCmd->add_flag(
+        "--compare", render.compare,
+        "With --mode multiphase: also render the reference; report PSNR and speed in stats.json");
 
     mpshade::FactorCommandOptions factor;
     CLI::App* factorCmd = app.add_subcommand(

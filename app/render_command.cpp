@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 
 #include <unistd.h>
@@ -11,6 +12,8 @@
 
 #include "app/image_output.h"
 #include "geometry/error.h"
+#include "phases/image_compare.h"
+#include "phases/multiphase_renderer.h"
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
 
@@ -94,9 +97,12 @@ class ProgressBar {
 
 int runRenderCommand(const RenderCommandOptions& options) {
     try {
-        if (options.mode != "reference")
-            throw InputError({"--mode", 0, 0, {}},
-                             "unknown mode '" + options.mode + "' (available: reference)");
+        if (options.mode != "reference" && options.mode != "multiphase")
+            throw InputError({"--mode", 0, 0, {}}, "unknown mode '" + options.mode +
+                                                       "' (available: reference, multiphase)");
+        if (options.compare && options.mode != "multiphase")
+            throw InputError({"--compare", 0, 0, {}},
+                             "--compare measures --mode multiphase against the reference");
         if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
             throw InputError({"--spp", 0, 0, {}},
                              "expected 1..1024, found " + std::to_string(options.spp));
@@ -114,30 +120,71 @@ int runRenderCommand(const RenderCommandOptions& options) {
             throw InputError({options.outDir, 0, 0, {}},
                              "cannot create the output folder: " + ec.message());
 
-        const ReferenceRenderer renderer(scene);
+        const bool multiphase = options.mode == "multiphase";
+        std::unique_ptr<ReferenceRenderer> reference;
+        if (!multiphase || options.compare) reference = std::make_unique<ReferenceRenderer>(scene);
+        std::unique_ptr<MultiphaseRenderer> multi;
+        if (multiphase) multi = std::make_unique<MultiphaseRenderer>(scene);
         ProgressBar bar(!options.quiet && isatty(STDERR_FILENO));
         bar.setFirst(first);
         nlohmann::json frames = nlohmann::json::array();
         const auto start = std::chrono::steady_clock::now();
         for (int frame = first; frame < last; ++frame) {
             FrameStats stats;
-            const Image image = renderer.renderFrame(
-                frame, render, stats,
-                [&](int done, int total) { bar.update(frame, last - first, done, total); });
+            const ProgressFn progress = [&](int done, int total) {
+                bar.update(frame, last - first, done, total);
+            };
+            const Image image = multiphase ? multi->renderFrame(frame, render, stats, progress)
+                                           : reference->renderFrame(frame, render, stats, progress);
             char name[32];
             std::snprintf(name, sizeof name, "frame_%04d", frame);
             const std::string base = (std::filesystem::path(options.outDir) / name).string();
             writeExr(image, base + ".exr");
             writePng(image, base + ".png");
-            frames.push_back({{"index", stats.index},
-                              {"time", stats.time},
-                              {"wall_seconds", stats.wallSeconds},
-                              {"samples", stats.samples},
-                              {"rays", stats.rays},
-                              {"occlusion_rays", stats.occlusionRays},
-                              {"shaded_points", stats.shadedPoints},
-                              {"shader_instructions", stats.shaderInstructions},
-                              {"nonfinite_samples", stats.nonFiniteSamples}});
+            nlohmann::json entry = {{"index", stats.index},
+                                    {"time", stats.time},
+                                    {"wall_seconds", stats.wallSeconds},
+                                    {"samples", stats.samples},
+                                    {"rays", stats.rays},
+                                    {"occlusion_rays", stats.occlusionRays},
+                                    {"shaded_points", stats.shadedPoints},
+                                    {"shader_instructions", stats.shaderInstructions},
+                                    {"nonfinite_samples", stats.nonFiniteSamples}};
+            if (multiphase) {
+                entry["static_runs"] = stats.staticRuns;
+                entry["static_seconds"] = stats.staticSeconds;
+                entry["warp_seconds"] = stats.warpSeconds;
+                entry["raster_seconds"] = stats.rasterSeconds;
+                entry["shade_seconds"] = stats.shadeSeconds;
+                entry["static_instructions"] = stats.staticInstructions;
+                entry["facets"] = stats.facets;
+                entry["facet_bytes"] = stats.facetBytes;
+                entry["facets_rasterized"] = stats.facetsRasterized;
+                entry["fragments"] = stats.fragments;
+                entry["vertices_warped"] = stats.verticesWarped;
+            }
+            if (options.compare) {
+                FrameStats refStats;
+                const Image ref = reference->renderFrame(frame, render, refStats);
+                const ImageError err = compareImages(image, ref);
+                entry["reference"] = {
+                    {"wall_seconds", refStats.wallSeconds},
+                    {"psnr_db", err.psnr},
+                    {"rmse", err.rmse},
+                    {"max_abs_error", err.maxAbs},
+                    {"coverage_difference", err.coverageDiff},
+                    {"speedup",
+                     stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0}};
+                if (!options.quiet)
+                    std::fprintf(
+                        stderr,
+                        "%sframe %d: PSNR %.2f dB against the reference, %.3f s vs %.3f s "
+                        "(%.2fx)\n",
+                        isatty(STDERR_FILENO) ? "\n" : "", frame, err.psnr, stats.wallSeconds,
+                        refStats.wallSeconds,
+                        stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0);
+            }
+            frames.push_back(entry);
         }
         bar.finish();
         const int width = render.width > 0 ? render.width : scene.settings.width;

@@ -15,6 +15,7 @@ struct RenderCommandOptions {
     int spp = -1;        // -1 = the scene's; else 1..1024
     uint32_t seed = 0;
     bool quiet = false;  // no progress bar
+    bool compare = false;  // multiphase: also render the reference, report error and speed
 };
 
 // Returns the process exit code: 0 success, 2 bad input (message already on stderr).

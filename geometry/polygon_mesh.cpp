@@ -1,10 +1,33 @@
 #include "geometry/polygon_mesh.h"
 
+#include <map>
+
 #include <glm/geometric.hpp>
 
 namespace mpshade {
 
+bool cageIsClosed(const std::vector<int>& faceSizes, const std::vector<int>& faceIndices) {
+    std::map<std::pair<int, int>, int> edges;
+    size_t first = 0;
+    for (int size : faceSizes) {
+        for (int k = 0; k < size; ++k) {
+            const int a = faceIndices[first + static_cast<size_t>(k)];
+            const int b = faceIndices[first + static_cast<size_t>((k + 1) % size)];
+            ++edges[{std::min(a, b), std::max(a, b)}];
+        }
+        first += static_cast<size_t>(size);
+    }
+    for (const auto& [edge, count] : edges)
+        if (count != 2) return false;
+    return !edges.empty();
+}
+
 PolygonMesh::PolygonMesh(PolygonMeshData data) : data_(std::move(data)) {
+    {
+        std::vector<int> indices;
+        for (const ObjCorner& c : data_.corners) indices.push_back(c.position);
+        closed_ = cageIsClosed(data_.faceSizes, indices);
+    }
     size_t first = 0;
     auto area2 = [&](const ObjCorner& a, const ObjCorner& b, const ObjCorner& c) {
         const glm::vec3 &pa = data_.positions[a.position], &pb = data_.positions[b.position],

@@ -44,6 +44,7 @@ class PolygonMesh {
     Bounds3 bounds() const { return bounds_; }
     int tessellationRate(int chart) const { return 1; }
     int droppedFaces() const { return dropped_; }
+    bool closed() const { return closed_; }
 
   private:
     struct Chart {
@@ -54,6 +55,10 @@ class PolygonMesh {
     std::vector<Chart> charts_;
     Bounds3 bounds_;
     int dropped_ = 0;
+    bool closed_ = false;
 };
+
+// Whether every edge of a polygon mesh is shared by exactly two faces.
+bool cageIsClosed(const std::vector<int>& faceSizes, const std::vector<int>& faceIndices);
 
 }  // namespace mpshade

@@ -23,6 +23,7 @@ struct SubdivSurface::Impl {
         float origin[2], du[2], dv[2];
     };
     SubdivScheme scheme;
+    bool closed = false;
     std::vector<Bfr::Surface<float>> surfaces;
     std::vector<std::vector<float>> patchPoints;  // xyz per patch point, per surface
     std::vector<Chart> charts;
@@ -87,6 +88,7 @@ SubdivSurface::SubdivSurface(const SubdivCage& cage, SubdivScheme scheme, const 
     }
     if (impl_->charts.empty())
         throw InputError({source, 0, 0, {}}, "no face of the cage has a limit surface");
+    impl_->closed = cageIsClosed(cage.faceSizes, cage.faceIndices);
     // Limit points lie in the convex hull of the cage.
     for (const auto& p : cage.positions) impl_->bounds.extend(p);
 }
@@ -101,6 +103,7 @@ int SubdivSurface::chartCount() const {
 int SubdivSurface::chartFace(int chart) const {
     return impl_->charts[chart].face;
 }
+bool SubdivSurface::closed() const { return impl_->closed; }
 Bounds3 SubdivSurface::bounds() const {
     return impl_->bounds;
 }

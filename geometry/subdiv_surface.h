@@ -38,6 +38,8 @@ class SubdivSurface {
     int tessellationRate(int chart) const { return 24; }
     // The cage face a chart belongs to.
     int chartFace(int chart) const;
+    // Every cage edge is shared by exactly two faces: the surface bounds a solid.
+    bool closed() const;
 
   private:
     struct Impl;

@@ -22,6 +22,13 @@ SurfaceSample evaluate(const Surface& surface, ChartPoint at) {
     return std::visit([&](const auto& s) { return s.evaluate(at.chart, at.u, at.v); }, surface);
 }
 
+bool isClosed(const Surface& surface) {
+    if (std::holds_alternative<Sphere>(surface) || std::holds_alternative<Torus>(surface)) return true;
+    if (const auto* s = std::get_if<SubdivSurface>(&surface)) return s->closed();
+    if (const auto* m = std::get_if<PolygonMesh>(&surface)) return m->closed();
+    return false;  // planes, Bezier patch sets, points
+}
+
 void evaluateBatch(const Surface& surface, std::span<const ChartPoint> points,
                    std::span<SurfaceSample> out) {
     MPSHADE_CHECK(points.size() == out.size());

@@ -20,6 +20,8 @@ const char* surfaceTypeName(const Surface& surface);
 int chartCount(const Surface& surface);
 Bounds3 surfaceBounds(const Surface& surface);
 SurfaceSample evaluate(const Surface& surface, ChartPoint at);
+// The surface bounds a solid, so only its outside can be seen.
+bool isClosed(const Surface& surface);
 // Evaluates points.size() chart points into out (same size), one dispatch for the batch.
 void evaluateBatch(const Surface& surface, std::span<const ChartPoint> points,
                    std::span<SurfaceSample> out);

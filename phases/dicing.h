@@ -1,0 +1,72 @@
+// dicing.h -- the static TSI (patent FIG. 4, claim 24): dice a surface into facets whose
+// projected edges stay under P/2 (P = pixel spacing) for every viewpoint in the range,
+// and near P/4 where that allows, as REYES dices grids.
+//
+// Per chart, the edge rates come from the length of each chart edge and row (sampled on a
+// 9x9 grid), each segment in pixels at the closest the range lets the eye come to it,
+// stretched by the worst off-axis magnification 1 + tan^2 (the frustum's half diagonal). Shared
+// edges are found by welding chart corners (and edge midpoints, for the quad sub-faces of
+// n-gons) and take the larger rate of their two sides, so both sides place the same
+// vertices there: OpenSubdiv's Bfr::Tessellation then triangulates each chart with its
+// four edge rates and two inner rates. Boundary vertices are welded into shared
+// positions. Closed surfaces drop patches that face away from every viewpoint in the range.
+//
+// The range's viewpoints form a spherical-shell sector around the object's centre (within
+// `angle` of the representative direction, at distances within `distance_factor`);
+// distances and facing are measured exactly against that set. A chart too large for one
+// rate (a ground plane reaching the camera) is split: every chart of the object is cut
+// into 2^d x 2^d patches, the same d throughout so shared edges still split alike.
+//
+// The view direction is part of the range too (it may turn by `angle`): a patch is dropped
+// when, from the representative eye, it lies outside the frustum widened by that angle
+// and by the parallax the eye's movement within the range can cause. A facet budget per
+// object bounds the worst case (a ground plane the range's eyes come close to): beyond it
+// every rate is scaled by the same factor, which keeps shared edges matched but breaks the
+// P/2 bound, and is counted.
+#pragma once
+
+#include <vector>
+
+#include "geometry/surface.h"
+#include "phases/facet_mesh.h"
+
+namespace mpshade {
+
+struct DicingOptions {
+    float maxEdgePixels = 0.5f;  // P/2: the bound on every facet edge over the range
+    int maxEdgeRate = 256;       // per patch edge; charts split into patches to stay under it
+    int maxSplitDepth = 6;       // charts split into at most 2^6 x 2^6 patches
+    int maxPatches = 1 << 14;    // per object
+    size_t maxFacets =
+        4'000'000;  // per object; beyond it every rate scales down alike (counted as capped)
+    bool frustumCull = true;  // drop patches no view of the range can see
+};
+
+// The representative view in the object's own coordinates.
+struct DicingView {
+    glm::vec3 eye{0.0f};
+    float pixelsPerUnit =
+        1000.0f;  // pixels per object unit at unit distance: (height / 2) / tan(fov_y / 2)
+    float fovSlack = 1.5f;       // >= 1: off-axis projections stretch lengths up to this factor
+    float nearDistance = 0.01f;  // the near plane, object units
+    glm::vec3 forward{0.0f, 0.0f, -1.0f};  // unit view direction
+    float halfDiagonalFov = 0.7f;          // radians: the frustum's half angle across its diagonal
+};
+
+struct DicedSurface {
+    FixedPointFormat format;
+    std::vector<uint16_t> qx, qy, qz;
+    std::vector<ChartPoint> attributePoints;  // one per attribute vertex
+    std::vector<SurfaceSample> attributeGeometry;
+    std::vector<uint32_t> positionOf;  // attribute vertex -> position
+    std::vector<uint32_t> triangles;   // attribute vertex indices, 3 per facet
+    int charts = 0, patches = 0, culledCharts = 0,
+        cappedCharts = 0;    // culled and capped count patches
+    int frustumCulled = 0;   // patches outside every view of the range
+    float rateScale = 1.0f;  // < 1 when the facet budget cut every rate
+};
+
+DicedSurface diceSurface(const Surface& surface, const DicingView& view, const RangeOptions& range,
+                         const DicingOptions& options = {});
+
+}  // namespace mpshade

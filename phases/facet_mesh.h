@@ -1,0 +1,102 @@
+// facet_mesh.h -- the static phase's product for one object (patent FIG. 4, claims 22-25):
+// sub-pixel polygonal facets with shared vertices in fixed point, in the object's own
+// coordinates, and per-vertex data for the dynamic phase.
+//
+// Fixed-point format: each vertex coordinate is a 16-bit unsigned integer q over the
+// object's bounding box: object = origin + q * step, step = extent / 65535 per axis. The
+// quantization error is at most step / 2 per axis (extent / 131070): 1/131070 of the
+// object's size.
+//
+// A facet corner has two indices: its position (shared by every chart that meets there,
+// so neighbouring grids are watertight under the warp) and its attributes (per chart,
+// since (u, v), s, t and the n-tuple are the chart's own and may jump across a chart
+// border).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "geometry/surface_sample.h"
+#include "scene/scene.h"
+#include "shading/interpreter.h"
+
+namespace mpshade {
+
+struct FixedPointFormat {
+    glm::vec3 origin{0.0f};
+    glm::vec3 step{1.0f};  // object units per quantum, per axis
+    static constexpr int kBits = 16;
+    static constexpr uint32_t kMax = (1u << kBits) - 1;
+
+    static FixedPointFormat forBounds(const Bounds3& bounds);
+    uint16_t quantize(float x, int axis) const;
+    glm::vec3 dequantize(uint16_t x, uint16_t y, uint16_t z) const {
+        return origin + step * glm::vec3(x, y, z);
+    }
+};
+
+// Per-attribute-vertex data the dynamic part reads, structure of arrays. Geometry rows hold
+// only what the dynamic program uses; channel rows hold the n-tuple.
+struct VertexAttributes {
+    enum Row {
+        Px,
+        Py,
+        Pz,
+        Nx,
+        Ny,
+        Nz,
+        Ngx,
+        Ngy,
+        Ngz,
+        dPdux,
+        dPduy,
+        dPduz,
+        dPdvx,
+        dPdvy,
+        dPdvz,
+        U,
+        V,
+        S,
+        T,
+        kGeometryRows
+    };
+    std::vector<std::vector<float>> rows;  // kGeometryRows + channels; unused rows empty
+    size_t count = 0;
+};
+
+struct FacetMesh {
+    FixedPointFormat format;
+    // Shared positions, quantized, structure of arrays.
+    std::vector<uint16_t> qx, qy, qz;
+    // Per facet: three position indices and three attribute indices.
+    std::vector<uint32_t> positionIndex;
+    std::vector<uint32_t> attributeIndex;
+    VertexAttributes attributes;
+    std::vector<ChartPoint> attributeChartPoint;  // where each attribute vertex lies
+
+    // The data block (claim 25): the viewpoint the facets were made for, the range of
+    // viewpoints they stay valid for, and the dynamic shader to run on them.
+    glm::vec3 representativeEye{0.0f};                   // object space
+    glm::vec3 representativeForward{0.0f, 0.0f, -1.0f};  // object space, unit
+    bool frustumCulled = false;  // patches outside the range's views were dropped
+    glm::vec3 center{0.0f};      // object space: the centre the range is measured from
+    RangeOptions range;
+    std::shared_ptr<const ShaderKernel> dynamicKernel;
+    int channels = 0;
+
+    // What dicing did.
+    int charts = 0, culledCharts = 0, cappedCharts = 0;
+    size_t facetCount() const { return positionIndex.size() / 3; }
+    size_t positionCount() const { return qx.size(); }
+    size_t bytes() const;
+
+    // Whether a viewpoint (object space) is still inside the range: distance within the
+    // factor, direction around the centre within the angle, and, if patches were
+    // frustum culled, the view direction within the angle too.
+    bool inRange(const glm::vec3& eye, const glm::vec3& forward) const;
+};
+
+}  // namespace mpshade

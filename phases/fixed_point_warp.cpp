@@ -1,0 +1,117 @@
+#include "phases/fixed_point_warp.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "geometry/error.h"
+
+namespace mpshade {
+
+void WarpedVertices::resize(size_t n) {
+    x.resize(n);
+    y.resize(n);
+    depth.resize(n);
+    culled.resize(n);
+}
+
+FixedPointWarp::FixedPointWarp(const glm::mat4& objectToWorld, const CameraState& camera,
+                               const FixedPointFormat& format)
+    : format_(format) {
+    // World -> (X, Y, W): W = forward . (p - eye), X = x_px W, Y = y_px W.
+    const double w2 = camera.width * 0.5, h2 = camera.height * 0.5;
+    const double th = camera.tanHalfFovY, ta = camera.tanHalfFovY * camera.aspect;
+    const glm::dvec3 eye(camera.eye), f(camera.forward), r(camera.right), u(camera.up);
+    double rows[3][4];
+    for (int k = 0; k < 3; ++k) {
+        rows[0][k] = w2 * (f[k] + r[k] / ta);
+        rows[1][k] = h2 * (f[k] - u[k] / th);
+        rows[2][k] = f[k];
+    }
+    rows[0][3] = -w2 * (glm::dot(f, eye) + glm::dot(r, eye) / ta);
+    rows[1][3] = -h2 * (glm::dot(f, eye) - glm::dot(u, eye) / th);
+    rows[2][3] = -glm::dot(f, eye);
+    // Compose with object -> world.
+    const glm::dmat4 o(objectToWorld);
+    for (int row = 0; row < 3; ++row)
+        for (int c = 0; c < 4; ++c) {
+            double s = c == 3 ? rows[row][3] : 0.0;
+            for (int k = 0; k < 3; ++k) s += rows[row][k] * o[c][k];
+            m_[row][c] = s;
+        }
+    // Coefficients of q, and the translation at the quantization origin.
+    double l[3][3], t[3], maxL = 0.0, maxT = 0.0;
+    for (int row = 0; row < 3; ++row) {
+        t[row] = m_[row][3];
+        for (int k = 0; k < 3; ++k) {
+            l[row][k] = m_[row][k] * format.step[k];
+            t[row] += m_[row][k] * format.origin[k];
+            maxL = std::max(maxL, std::fabs(l[row][k]));
+        }
+        maxT = std::max(maxT, std::fabs(t[row]));
+    }
+    auto log2up = [](double v) {
+        return v > 0.0 ? static_cast<int>(std::ceil(std::log2(v))) : -1000;
+    };
+    shift_ = std::min(40 - log2up(maxL), 61 - log2up(maxT));
+    shift_ = std::clamp(shift_, -60, 60);
+    const double scale = std::ldexp(1.0, shift_);
+    for (int row = 0; row < 3; ++row) {
+        t_[row] = static_cast<int64_t>(std::llround(t[row] * scale));
+        for (int k = 0; k < 3; ++k)
+            l_[row][k] = static_cast<int64_t>(std::llround(l[row][k] * scale));
+    }
+    nearW_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(camera.zNear * scale)));
+
+    // The bound at the object's nearest depth in front of the near plane.
+    double minW = 1e300;
+    for (int corner = 0; corner < 8; ++corner) {
+        const double q[3] = {(corner & 1) ? 65535.0 : 0.0, (corner & 2) ? 65535.0 : 0.0,
+                             (corner & 4) ? 65535.0 : 0.0};
+        double w = t[2];
+        for (int k = 0; k < 3; ++k) w += l[2][k] * q[k];
+        minW = std::min(minW, w);
+    }
+    minW = std::max(minW, static_cast<double>(camera.zNear));
+    const double roundingUnits = 0.5 * (3.0 * 65535.0 + 1.0);
+    const double widest = std::max(camera.width, camera.height);
+    errorBound_ = roundingUnits * (1.0 + widest) / (minW * scale) + 1.0 / 512.0;
+}
+
+void FixedPointWarp::warp(const uint16_t* qx, const uint16_t* qy, const uint16_t* qz, size_t n,
+                          WarpedVertices& out) const {
+    out.resize(n);
+    const double invScale = std::ldexp(1.0, -shift_);
+    for (size_t i = 0; i < n; ++i) {
+        const int64_t a = qx[i], b = qy[i], c = qz[i];
+        const int64_t X = l_[0][0] * a + l_[0][1] * b + l_[0][2] * c + t_[0];
+        const int64_t Y = l_[1][0] * a + l_[1][1] * b + l_[1][2] * c + t_[1];
+        const int64_t W = l_[2][0] * a + l_[2][1] * b + l_[2][2] * c + t_[2];
+        // |W| < 2^62, so the guard band is formed in 128 bits.
+        const __int128 guard = static_cast<__int128>(W) << kGuardBandBits;
+        const bool keep = W >= nearW_ && (X < guard && X > -guard) && (Y < guard && Y > -guard);
+        out.culled[i] = keep ? 0 : 1;
+        if (keep) {
+            out.x[i] = static_cast<int32_t>((static_cast<__int128>(X) << kSubpixelBits) / W);
+            out.y[i] = static_cast<int32_t>((static_cast<__int128>(Y) << kSubpixelBits) / W);
+        } else {
+            out.x[i] = out.y[i] = 0;
+        }
+        out.depth[i] = static_cast<float>(static_cast<double>(W) * invScale);
+    }
+}
+
+bool FixedPointWarp::warpExact(uint16_t qx, uint16_t qy, uint16_t qz, double& x, double& y) const {
+    const glm::dvec3 p =
+        glm::dvec3(format_.origin) + glm::dvec3(format_.step) * glm::dvec3(qx, qy, qz);
+    double h[3];
+    for (int row = 0; row < 3; ++row)
+        h[row] = m_[row][0] * p.x + m_[row][1] * p.y + m_[row][2] * p.z + m_[row][3];
+    if (!(h[2] > 0.0)) return false;
+    x = h[0] / h[2];
+    y = h[1] / h[2];
+    return true;
+}
+
+}  // namespace mpshade

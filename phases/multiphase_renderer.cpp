@@ -1,0 +1,420 @@
+#include "phases/multiphase_renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <glm/geometric.hpp>
+
+#include "scene/variability.h"
+
+namespace mpshade {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The shading-input rows of a geometric global, in VertexAttributes' order.
+int rowOf(GlobalId id) {
+    switch (id) {
+        case GlobalId::P:
+            return VertexAttributes::Px;
+        case GlobalId::N:
+            return VertexAttributes::Nx;
+        case GlobalId::Ng:
+            return VertexAttributes::Ngx;
+        case GlobalId::dPdu:
+            return VertexAttributes::dPdux;
+        case GlobalId::dPdv:
+            return VertexAttributes::dPdvx;
+        case GlobalId::u:
+            return VertexAttributes::U;
+        case GlobalId::v:
+            return VertexAttributes::V;
+        case GlobalId::s:
+            return VertexAttributes::S;
+        case GlobalId::t:
+            return VertexAttributes::T;
+        default:
+            return -1;
+    }
+}
+
+bool isOpaque(const IrProgram& dynamicPart) {
+    for (int v : dynamicPart.oi) {
+        const Inst* def = nullptr;
+        for (const Inst& inst : dynamicPart.insts)
+            if (inst.result <= v && v < inst.result + inst.nout) def = &inst;
+        if (!def || def->op != Op::Const || def->constant != 1.0f) return false;
+    }
+    return true;
+}
+
+// Shading inputs in structure of arrays, sized for one chunk of points: 22 input rows
+// (P N Ng dPdu dPdv I u v s t), 6 output rows, and the n-tuple.
+struct ChunkBuffers {
+    std::vector<float> rows;
+    std::vector<float> channelData;
+    std::vector<const float*> channelIn;
+    std::vector<float*> channelOut;
+    std::vector<float> workspace;
+    ShadingCounters counters;
+    ShadingInputs in;
+    ShadingOutputs out;
+
+    void prepare(size_t n, size_t channels) {
+        rows.resize(28 * n);
+        channelData.resize(std::max<size_t>(channels, 1) * n);
+        channelIn.resize(channels);
+        channelOut.resize(channels);
+        auto row = [&](int r) { return rows.data() + static_cast<size_t>(r) * n; };
+        for (int k = 0; k < 3; ++k) {
+            in.P[k] = row(0 + k);
+            in.N[k] = row(3 + k);
+            in.Ng[k] = row(6 + k);
+            in.dPdu[k] = row(9 + k);
+            in.dPdv[k] = row(12 + k);
+            in.I[k] = row(15 + k);
+            out.Ci[k] = row(22 + k);
+            out.Oi[k] = row(25 + k);
+        }
+        in.u = row(18), in.v = row(19), in.s = row(20), in.t = row(21);
+        for (size_t c = 0; c < channels; ++c)
+            channelOut[c] = channelData.data() + c * n, channelIn[c] = channelOut[c];
+        in.channels = channelIn.data();
+        out.channels = channelOut.data();
+    }
+    float* row(int r, size_t n) { return rows.data() + static_cast<size_t>(r) * n; }
+};
+
+constexpr size_t kChunk = 1024;
+
+}  // namespace
+
+struct MultiphaseRenderer::ObjectData {
+    FactoredShader factored;
+    std::unique_ptr<ShaderKernel> staticKernel, dynamicKernel;
+    std::unique_ptr<FacetMesh> mesh;
+    std::vector<int> geometryRows;  // attribute rows the dynamic part reads
+    bool opaque = true;
+    int diceHeight = 0;  // image height the facets were diced for
+    float diceFov = 0.0f;
+};
+
+MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptions& options)
+    : scene_(scene), options_(options), resources_(scene) {
+    for (const SceneObject& obj : scene.objects) {
+        auto data = std::make_unique<ObjectData>();
+        data->factored = factorShader(*obj.shader, bindingOf(scene, obj), options.factor);
+        data->staticKernel = std::make_unique<ShaderKernel>(data->factored.staticPart);
+        data->dynamicKernel = std::make_unique<ShaderKernel>(data->factored.dynamicPart);
+        data->opaque = isOpaque(data->factored.dynamicPart);
+        for (const Inst& inst : data->factored.dynamicPart.insts) {
+            if (inst.op != Op::Global) continue;
+            const int row = rowOf(static_cast<GlobalId>(inst.imm));
+            if (row < 0) continue;
+            for (int k = 0; k < inst.nout; ++k)
+                if (std::find(data->geometryRows.begin(), data->geometryRows.end(), row + k) ==
+                    data->geometryRows.end())
+                    data->geometryRows.push_back(row + k);
+        }
+        objects_.push_back(std::move(data));
+    }
+}
+
+MultiphaseRenderer::~MultiphaseRenderer() = default;
+
+const FacetMesh* MultiphaseRenderer::facets(size_t object) const {
+    return objects_[object]->mesh.get();
+}
+const FactoredShader& MultiphaseRenderer::factored(size_t object) const {
+    return objects_[object]->factored;
+}
+
+void MultiphaseRenderer::staticPhase(size_t index, const ObjectState& state,
+                                     const CameraState& camera, const ShadingUniforms& uniforms,
+                                     FrameStats& stats) {
+    ObjectData& obj = *objects_[index];
+    const SceneObject& sceneObject = scene_.objects[index];
+    const Surface& surface = *sceneObject.surface;
+    DicingView view;
+    view.eye = state.eye;
+    view.pixelsPerUnit = 0.5f * static_cast<float>(camera.height) / camera.tanHalfFovY;
+    // A length at angle a off the view axis projects up to 1 / cos^2 a = 1 + tan^2 a
+    // times longer than on the axis; a is at most the frustum's half diagonal.
+    const float tx = camera.tanHalfFovY * camera.aspect, ty = camera.tanHalfFovY;
+    view.fovSlack = 1.0f + tx * tx + ty * ty;
+    view.nearDistance = camera.zNear / state.scale;
+    view.forward = glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
+    view.halfDiagonalFov = std::atan(std::sqrt(tx * tx + ty * ty));
+    const DicedSurface diced = diceSurface(surface, view, sceneObject.range, options_.dicing);
+
+    auto mesh = std::make_unique<FacetMesh>();
+    mesh->format = diced.format;
+    mesh->qx = diced.qx;
+    mesh->qy = diced.qy;
+    mesh->qz = diced.qz;
+    mesh->attributeIndex = diced.triangles;
+    mesh->positionIndex.resize(diced.triangles.size());
+    for (size_t k = 0; k < diced.triangles.size(); ++k)
+        mesh->positionIndex[k] = diced.positionOf[diced.triangles[k]];
+    mesh->attributeChartPoint = diced.attributePoints;
+    mesh->representativeEye = state.eye;
+    mesh->representativeForward = view.forward;
+    mesh->frustumCulled = options_.dicing.frustumCull;
+    mesh->center = surfaceBounds(surface).center();
+    mesh->range = sceneObject.range;
+    mesh->charts = diced.charts;
+    mesh->culledCharts = diced.culledCharts;
+    mesh->cappedCharts = diced.cappedCharts;
+    const size_t channels = obj.factored.staticPart.channelOutputs.size();
+    mesh->channels = static_cast<int>(channels);
+
+    // Geometry the dynamic part reads, and the n-tuple from the static part.
+    const size_t n = diced.attributePoints.size();
+    VertexAttributes& attr = mesh->attributes;
+    attr.count = n;
+    attr.rows.assign(VertexAttributes::kGeometryRows + channels, {});
+    for (int row : obj.geometryRows) attr.rows[static_cast<size_t>(row)].resize(n);
+    for (size_t c = 0; c < channels; ++c) attr.rows[VertexAttributes::kGeometryRows + c].resize(n);
+    tbb::enumerable_thread_specific<ChunkBuffers> buffers;
+    std::atomic<uint64_t> instructions{0};
+    tbb::parallel_for(size_t{0}, (n + kChunk - 1) / kChunk, [&](size_t chunk) {
+        ChunkBuffers& b = buffers.local();
+        const size_t begin = chunk * kChunk, m = std::min(kChunk, n - begin);
+        b.prepare(m, channels);
+        for (size_t i = 0; i < m; ++i) {
+            const SurfaceSample& g = diced.attributeGeometry[begin + i];
+            const ChartPoint& at = diced.attributePoints[begin + i];
+            const glm::vec3 I = glm::normalize(g.P - state.eye);
+            const float values[22] = {g.P.x,    g.P.y,    g.P.z,    g.N.x,    g.N.y,    g.N.z,
+                                      g.Ng.x,   g.Ng.y,   g.Ng.z,   g.dPdu.x, g.dPdu.y, g.dPdu.z,
+                                      g.dPdv.x, g.dPdv.y, g.dPdv.z, I.x,      I.y,      I.z,
+                                      at.u,     at.v,     g.s,      g.t};
+            for (int r = 0; r < 22; ++r) b.row(r, m)[i] = values[r];
+            for (int row : obj.geometryRows) {
+                // VertexAttributes rows follow the same order as the first 15 shading rows,
+                // then u v s t (shading rows 18..21).
+                const int src = row < VertexAttributes::U ? row : row + 3;
+                attr.rows[static_cast<size_t>(row)][begin + i] = values[src];
+            }
+        }
+        ShadingCounters counters;
+        obj.staticKernel->run(uniforms, b.in, m, b.out, b.workspace, counters);
+        instructions += counters.instructions;
+        for (size_t c = 0; c < channels; ++c)
+            std::copy(b.channelOut[c], b.channelOut[c] + m,
+                      attr.rows[VertexAttributes::kGeometryRows + c].begin() + begin);
+    });
+    mesh->dynamicKernel = nullptr;
+    obj.mesh = std::move(mesh);
+    obj.diceHeight = camera.height;
+    obj.diceFov = scene_.camera.fovY;
+    ++stats.staticRuns;
+    stats.staticInstructions += instructions;
+}
+
+Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
+                                      const ProgressFn& progress) {
+    const SampleBuffer samples = renderSamples(frame, options, stats, progress);
+    const auto start = Clock::now();
+    Image image = resolvePixels(samples, options.filter);
+    stats.wallSeconds += secondsSince(start);
+    return image;
+}
+
+SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& options,
+                                               FrameStats& stats, const ProgressFn& progress) {
+    const auto start = Clock::now();
+    stats = FrameStats{};
+    const RenderSettings& settings = scene_.settings;
+    const int width = options.width > 0 ? options.width : settings.width;
+    const int height = options.height > 0 ? options.height : settings.height;
+    const int spp =
+        options.samplesPerPixel > 0 ? options.samplesPerPixel : settings.samplesPerPixel;
+    const float time = scene_.frameTime(frame);
+    const CameraState camera = cameraAt(scene_, time, width, height);
+    const size_t count = objects_.size();
+
+    std::vector<ObjectState> states(count);
+    std::vector<std::vector<float>> params(count);
+    std::vector<std::vector<LightSample>> lights(count);
+    std::vector<ShadingUniforms> uniforms(count);
+    for (size_t i = 0; i < count; ++i) {
+        const SceneObject& obj = scene_.objects[i];
+        states[i] = objectAt(obj, time, camera);
+        animatedParamsAt(obj, objects_[i]->factored.analyzed, time, params[i]);
+        lightsAt(scene_, states[i], time, lights[i]);
+        ShadingUniforms& u = uniforms[i];
+        u.time = time;
+        u.eye = states[i].eye;
+        u.params = params[i];
+        u.lights = lights[i];
+        u.occluder = resources_.object(i).rayScene;
+        u.occlusionBias = resources_.object(i).occlusionBias;
+    }
+
+    // Static phase where needed: new objects, views that left the range, a new image size.
+    const auto staticStart = Clock::now();
+    for (size_t i = 0; i < count; ++i) {
+        ObjectData& obj = *objects_[i];
+        const glm::vec3 forward =
+            glm::normalize(glm::vec3(states[i].worldToObject * glm::vec4(camera.forward, 0.0f)));
+        if (!obj.mesh || !obj.mesh->inRange(states[i].eye, forward) || obj.diceHeight != height)
+            staticPhase(i, states[i], camera, uniforms[i], stats);
+    }
+    stats.staticSeconds = secondsSince(staticStart);
+
+    // Dynamic TSI: warp and rasterize.
+    auto stageStart = Clock::now();
+    std::vector<WarpedVertices> warped(count);
+    std::vector<RasterObject> raster(count);
+    tbb::parallel_for(size_t{0}, count, [&](size_t i) {
+        const FacetMesh& mesh = *objects_[i]->mesh;
+        const FixedPointWarp warp(states[i].objectToWorld, camera, mesh.format);
+        warp.warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.positionCount(), warped[i]);
+    });
+    for (size_t i = 0; i < count; ++i) {
+        raster[i] = {objects_[i]->mesh.get(), &warped[i], objects_[i]->opaque};
+        stats.facets += objects_[i]->mesh->facetCount();
+        stats.verticesWarped += objects_[i]->mesh->positionCount();
+        stats.facetBytes += objects_[i]->mesh->bytes();
+    }
+    stats.warpSeconds = secondsSince(stageStart);
+    stageStart = Clock::now();
+    SampleBuffer samples;
+    samples.resize(width, height, spp);
+    for (int py = 0; py < height; ++py)
+        for (int px = 0; px < width; ++px)
+            for (int k = 0; k < spp; ++k) {
+                const size_t s = samples.index(px, py, k);
+                samplePosition(options.seed, px, py, k, spp, samples.xy[2 * s],
+                               samples.xy[2 * s + 1]);
+            }
+    FragmentBuffer fragments;
+    RasterStats rs;
+    rasterizeFacets(raster, samples, options_.raster, fragments, rs);
+    stats.facetsRasterized = rs.facetsBinned;
+    stats.fragments = rs.fragments;
+    stats.rasterSeconds = secondsSince(stageStart);
+    stageStart = Clock::now();
+    if (progress) progress(1, 3);
+
+    // Dynamic shading: every kept fragment, object by object, in chunks.
+    const size_t slots = fragments.fragments.size();
+    std::vector<uint32_t> objectStart(count + 1, 0);
+    for (size_t s = 0; s < fragments.count.size(); ++s)
+        for (int l = 0; l < fragments.count[s]; ++l)
+            ++objectStart[fragments.fragments[s * fragments.layers + l].object + 1];
+    for (size_t i = 0; i < count; ++i) objectStart[i + 1] += objectStart[i];
+    std::vector<uint32_t> order(objectStart[count]);
+    {
+        std::vector<uint32_t> next(objectStart.begin(), objectStart.end() - 1);
+        for (size_t s = 0; s < fragments.count.size(); ++s)
+            for (int l = 0; l < fragments.count[s]; ++l) {
+                const size_t slot = s * fragments.layers + l;
+                order[next[fragments.fragments[slot].object]++] = static_cast<uint32_t>(slot);
+            }
+    }
+    std::vector<float> color(slots * 3), opacity(slots * 3);
+    struct Chunk {
+        size_t object, begin, end;
+    };
+    std::vector<Chunk> chunks;
+    for (size_t i = 0; i < count; ++i)
+        for (size_t b = objectStart[i]; b < objectStart[i + 1]; b += kChunk)
+            chunks.push_back({i, b, std::min<size_t>(b + kChunk, objectStart[i + 1])});
+    tbb::enumerable_thread_specific<ChunkBuffers> buffers;
+    tbb::enumerable_thread_specific<uint64_t> instructions(0), nonFinite(0);
+    tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t c) {
+        const Chunk& chunk = chunks[c];
+        const ObjectData& obj = *objects_[chunk.object];
+        const FacetMesh& mesh = *obj.mesh;
+        const VertexAttributes& attr = mesh.attributes;
+        const size_t m = chunk.end - chunk.begin;
+        const size_t channels = static_cast<size_t>(mesh.channels);
+        ChunkBuffers& b = buffers.local();
+        b.prepare(m, channels);
+        const glm::vec3 eye = states[chunk.object].eye;
+        for (size_t i = 0; i < m; ++i) {
+            const Fragment& f = fragments.fragments[order[chunk.begin + i]];
+            const uint32_t* a = &mesh.attributeIndex[3 * static_cast<size_t>(f.facet)];
+            const float w0 = 1.0f - f.b1 - f.b2;
+            auto lerp = [&](const std::vector<float>& row) {
+                return w0 * row[a[0]] + f.b1 * row[a[1]] + f.b2 * row[a[2]];
+            };
+            for (int row : obj.geometryRows) {
+                const int dst = row < VertexAttributes::U ? row : row + 3;
+                b.row(dst, m)[i] = lerp(attr.rows[static_cast<size_t>(row)]);
+            }
+            // P for I: interpolated from the facet's own vertex positions when the dynamic
+            // part does not read P itself.
+            glm::vec3 P;
+            if (!attr.rows[VertexAttributes::Px].empty()) {
+                P = glm::vec3(b.row(0, m)[i], b.row(1, m)[i], b.row(2, m)[i]);
+            } else {
+                const uint32_t* p = &mesh.positionIndex[3 * static_cast<size_t>(f.facet)];
+                P = w0 * mesh.format.dequantize(mesh.qx[p[0]], mesh.qy[p[0]], mesh.qz[p[0]]) +
+                    f.b1 * mesh.format.dequantize(mesh.qx[p[1]], mesh.qy[p[1]], mesh.qz[p[1]]) +
+                    f.b2 * mesh.format.dequantize(mesh.qx[p[2]], mesh.qy[p[2]], mesh.qz[p[2]]);
+            }
+            if (!attr.rows[VertexAttributes::Nx].empty()) {
+                glm::vec3 N(b.row(3, m)[i], b.row(4, m)[i], b.row(5, m)[i]);
+                const float len = glm::length(N);
+                if (len > 0.0f) N /= len;
+                b.row(3, m)[i] = N.x, b.row(4, m)[i] = N.y, b.row(5, m)[i] = N.z;
+            }
+            const glm::vec3 I = glm::normalize(P - eye);
+            b.row(15, m)[i] = I.x, b.row(16, m)[i] = I.y, b.row(17, m)[i] = I.z;
+            for (size_t ch = 0; ch < channels; ++ch)
+                b.channelOut[ch][i] = lerp(attr.rows[VertexAttributes::kGeometryRows + ch]);
+        }
+        ShadingCounters counters;
+        obj.dynamicKernel->run(uniforms[chunk.object], b.in, m, b.out, b.workspace, counters);
+        instructions.local() += counters.instructions;
+        for (size_t i = 0; i < m; ++i) {
+            const size_t slot = order[chunk.begin + i];
+            bool finite = true;
+            for (int k = 0; k < 3; ++k)
+                finite = finite && std::isfinite(b.out.Ci[k][i]) && std::isfinite(b.out.Oi[k][i]);
+            if (!finite) ++nonFinite.local();
+            for (int k = 0; k < 3; ++k) {
+                color[3 * slot + k] = finite ? b.out.Ci[k][i] : 0.0f;
+                opacity[3 * slot + k] = finite ? std::clamp(b.out.Oi[k][i], 0.0f, 1.0f) : 1.0f;
+            }
+        }
+    });
+    for (uint64_t v : instructions) stats.shaderInstructions += v;
+    for (uint64_t v : nonFinite) stats.nonFiniteSamples += v;
+    stats.shadedPoints = order.size();
+    stats.shadeSeconds = secondsSince(stageStart);
+    if (progress) progress(2, 3);
+
+    // Composite front to back over the background.
+    tbb::parallel_for(size_t{0}, fragments.count.size(), [&](size_t s) {
+        float C[3] = {0, 0, 0}, T[3] = {1, 1, 1};
+        for (int l = 0; l < fragments.count[s]; ++l) {
+            const size_t slot = s * fragments.layers + l;
+            for (int k = 0; k < 3; ++k) {
+                C[k] += T[k] * opacity[3 * slot + k] * color[3 * slot + k];
+                T[k] *= 1.0f - opacity[3 * slot + k];
+            }
+        }
+        float* out = &samples.rgba[4 * s];
+        for (int k = 0; k < 3; ++k) out[k] = C[k] + T[k] * settings.background[k];
+        out[3] = 1.0f - (T[0] + T[1] + T[2]) / 3.0f;
+    });
+    if (progress) progress(3, 3);
+    stats.index = frame;
+    stats.time = time;
+    stats.samples = static_cast<uint64_t>(width) * height * spp;
+    stats.wallSeconds = secondsSince(start);
+    return samples;
+}
+
+}  // namespace mpshade
