@@ -111,7 +111,7 @@ TEST(Cli, BadInputExitsTwoNamingThePlace) {
         {"render examples/vase/scene.json --size 0x10 --out /tmp/x",
          "mpshade: --size: error: expected WxH with each in 1..16384, found '0x10'\n"},
         {"render examples/vase/scene.json --mode fast --out /tmp/x",
-         "mpshade: --mode: error: unknown mode 'fast' (available: reference)\n"},
+         "mpshade: --mode: error: unknown mode 'fast' (available: reference, multiphase)\n"},
         {"render examples/vase/scene.json --spp 0 --out /tmp/x",
          "mpshade: --spp: error: expected 1..1024, found 0\n"},
         {"render nowhere.json --out /tmp/x",
