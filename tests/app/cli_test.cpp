@@ -73,6 +73,32 @@ TEST(Cli, RendersTheVaseToReadableFrames) {
     EXPECT_EQ(run.output, "");  // no progress bar when stderr is not a terminal
 }
 
+TEST(Cli, MultiphaseComparesWithTheReference) {
+    const std::string out = tempDir("multiphase");
+    const CliRun run = mpshade(
+        "render examples/teapot/scene.json --mode multiphase --compare --frames 0:2 --size 96x64 "
+        "--spp 2 --out " +
+        out);
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    std::ifstream statsFile(out + "/stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(statsFile);
+    EXPECT_EQ(stats["mode"], "multiphase");
+    ASSERT_EQ(stats["frames"].size(), 2u);
+    EXPECT_EQ(stats["frames"][0]["static_runs"], 2);  // the teapot and the table
+    EXPECT_EQ(stats["frames"][1]["static_runs"], 0);  // frame 1 is inside both ranges
+    EXPECT_GT(stats["frames"][0]["facets"].get<double>(), 1000.0);
+    for (const auto& frame : stats["frames"]) {
+        EXPECT_GT(frame["reference"]["psnr_db"].get<double>(), 30.0);
+        EXPECT_LT(frame["reference"]["coverage_difference"].get<double>(), 0.02);
+    }
+    EXPECT_NE(run.output.find("PSNR"), std::string::npos);
+    OIIO::ImageBuf exr(out + "/frame_0001.exr");
+    ASSERT_TRUE(exr.read());
+    const auto pixels = OIIO::ImageBufAlgo::computePixelStats(exr);
+    EXPECT_EQ(pixels.nancount[0], 0u);
+    EXPECT_GT(pixels.avg[3], 0.3f);
+}
+
 TEST(Cli, SppAndSeedOverrideTheScene) {
     const std::string out = tempDir("spp");
     const CliRun run = mpshade(

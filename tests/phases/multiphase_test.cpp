@@ -200,6 +200,44 @@ TEST(FacetRasterizer, SharedEdgesAreWatertight) {
     EXPECT_EQ(stats.facetsDegenerate, 0u);
 }
 
+TEST(FacetRasterizer, SkipsDegenerateAndCulledFacets) {
+    FacetMesh mesh;
+    WarpedVertices warped;
+    auto vertex = [&](int32_t x, int32_t y, uint8_t culled) {
+        warped.x.push_back(x), warped.y.push_back(y), warped.depth.push_back(2.0f),
+            warped.culled.push_back(culled);
+        mesh.qx.push_back(0), mesh.qy.push_back(0), mesh.qz.push_back(0);
+    };
+    vertex(256, 256, 0), vertex(2560, 256, 0), vertex(256, 2560, 0);    // a real facet
+    vertex(512, 512, 0), vertex(1024, 1024, 0), vertex(2048, 2048, 0);  // collinear: zero area
+    vertex(700, 700, 0), vertex(700, 700, 0), vertex(700, 700, 0);      // a point
+    vertex(300, 300, 0), vertex(2000, 300, 1),
+        vertex(300, 2000, 0);  // a vertex behind the near plane
+    for (uint32_t k = 0; k < 12; ++k) mesh.positionIndex.push_back(k);
+    mesh.attributeIndex = mesh.positionIndex;
+    SampleBuffer samples;
+    samples.resize(12, 12, 4);
+    for (int py = 0; py < 12; ++py)
+        for (int px = 0; px < 12; ++px)
+            for (int k = 0; k < 4; ++k) {
+                const size_t s = samples.index(px, py, k);
+                samplePosition(0, px, py, k, 4, samples.xy[2 * s], samples.xy[2 * s + 1]);
+            }
+    FragmentBuffer fragments;
+    RasterStats stats;
+    rasterizeFacets({{&mesh, &warped, true}}, samples, {}, fragments, stats);
+    EXPECT_EQ(stats.facets, 4u);
+    EXPECT_EQ(stats.facetsDegenerate, 2u);
+    EXPECT_EQ(stats.facetsCulled, 1u);
+    EXPECT_EQ(stats.facetsBinned, 1u);
+    for (size_t s = 0; s < fragments.count.size(); ++s)
+        for (int l = 0; l < fragments.count[s]; ++l) {
+            const Fragment& f = fragments.fragments[s * fragments.layers + l];
+            EXPECT_EQ(f.facet, 0u);
+            EXPECT_TRUE(std::isfinite(f.b1) && std::isfinite(f.b2) && std::isfinite(f.depth));
+        }
+}
+
 std::string writeBlobScene(const std::string& name, int frames, std::mt19937& rng) {
     // A closed Loop-subdivision blob in white on black, the camera jumping between random
     // views inside the range of the first.
