@@ -1,0 +1,59 @@
+// probe.h -- filtered lookups of shader maps (patent col. 10, claims 13-14), batched: a
+// span of queries in, n-tuples out.
+//
+//   Trilinear: two bilinear probes of adjacent levels, blended (Williams 1983). The level
+//     is log2 of the footprint's longer axis in level-0 texels.
+//   Feline (McCormack et al. 1999): trilinear probes along the footprint ellipse's major
+//     axis; the minor axis picks the level. n = 2 (major / minor) - 1 probes (the ratio
+//     capped by maxAnisotropy, the minor axis widened to match), spread over a line of
+//     half length major - minor so the end probes' footprints reach the ellipse's ends,
+//     weighted by exp(-2 (d / major)^2) for a probe d texels from the centre.
+//   EWA (Heckbert 1989; Greene and Heckbert 1986): the elliptical Gaussian exp(-2 r^2) over
+//     every texel inside the ellipse (widened by one texel for reconstruction, as pbrt-v4
+//     does), at the two levels around log2(minor), blended. The quality reference.
+//
+// The footprint is the Jacobian of chart coordinates with respect to screen position:
+// (du/dx, dv/dx) and (du/dy, dv/dy). Zero, NaN or infinite derivatives and extreme
+// anisotropy still give finite results: non-finite derivatives count as the widest
+// footprint (the coarsest level).
+//
+// Residency: a probe never fills and never allocates. A bilinear probe whose tile is not
+// resident uses the finest resident coarser level, records the fallback, and reports the
+// tile it lacked into the caller's buffer (while it has room).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "shadermaps/shader_map.h"
+
+namespace mpshade {
+
+enum class ProbeFilter { Trilinear, Feline, EWA };
+
+struct ProbeOptions {
+    ProbeFilter filter = ProbeFilter::Feline;
+    float maxAnisotropy = 16.0f;  // Feline and EWA: the longest footprint over the shortest
+};
+
+struct ProbeQuery {
+    int chart = 0;
+    float u = 0.0f, v = 0.0f;                                  // chart coordinates
+    float dudx = 0.0f, dvdx = 0.0f, dudy = 0.0f, dvdy = 0.0f;  // per screen pixel
+};
+
+struct ProbeResidency {
+    TileKey* missing = nullptr;  // caller's buffer for tiles that were lacking
+    size_t capacity = 0;
+    size_t count = 0;        // written to missing (duplicates possible)
+    uint64_t fallbacks = 0;  // bilinear probes answered from a coarser level
+    uint64_t bilinearProbes = 0;
+};
+
+// Writes queries.size() * map.channels() floats to out, query by query.
+void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
+                    std::span<const ProbeQuery> queries, float* out,
+                    ProbeResidency* residency = nullptr);
+
+}  // namespace mpshade

@@ -1,0 +1,198 @@
+#include "shadermaps/shader_map.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "geometry/error.h"
+#include "geometry/ray_scene.h"
+#include "shadermaps/half_float.h"
+
+namespace mpshade {
+
+ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
+                     const ShadingUniforms& uniforms, const ShaderMapOptions& options)
+    : surface_(surface), kernel_(staticPart), uniforms_(uniforms), options_(options) {
+    MPSHADE_CHECK(options.resolution > 0 && (options.resolution & (options.resolution - 1)) == 0);
+    MPSHADE_CHECK(options.tileSize > 0 && options.border >= 1);
+    charts_ = chartCount(surface);
+    channels_ = static_cast<int>(staticPart.program().channelOutputs.size());
+    levels_ = 0;
+    for (int r = options.resolution; r >= 1; r >>= 1) ++levels_;
+    stride_ = options.tileSize + 2 * options.border;
+    levelOffset_.resize(static_cast<size_t>(levels_) + 1, 0);
+    for (int level = 0; level < levels_; ++level) {
+        const size_t side = static_cast<size_t>(tilesPerSide(level));
+        levelOffset_[static_cast<size_t>(level) + 1] =
+            levelOffset_[static_cast<size_t>(level)] + side * side;
+    }
+    tilesPerChart_ = levelOffset_.back();
+    slot_.assign(tilesPerChart_ * static_cast<size_t>(charts_), -1);
+    const int coarsest = std::max(0, levels_ - options.alwaysResidentLevels);
+    fillLevels(coarsest, levels_ - 1);
+}
+
+int ShaderMap::tilesPerSide(int level) const {
+    return (resolution(level) + options_.tileSize - 1) / options_.tileSize;
+}
+
+size_t ShaderMap::tileIndex(const TileKey& key) const {
+    return static_cast<size_t>(key.chart) * tilesPerChart_ + levelOffset_[key.level] +
+           static_cast<size_t>(key.ty) * static_cast<size_t>(tilesPerSide(key.level)) + key.tx;
+}
+
+int ShaderMap::slotOf(const TileKey& key) const {
+    return slot_[tileIndex(key)];
+}
+
+TileKey ShaderMap::tileOf(uint32_t chart, int level, int i, int j) const {
+    const int n = tilesPerSide(level);
+    const int tx = std::clamp(i / options_.tileSize, 0, n - 1),
+              ty = std::clamp(j / options_.tileSize, 0, n - 1);
+    return {chart, static_cast<uint16_t>(level), static_cast<uint16_t>(tx),
+            static_cast<uint16_t>(ty)};
+}
+
+size_t ShaderMap::bytes() const {
+    return data_.size() * sizeof(float) + halfData_.size() * sizeof(uint16_t) +
+           slot_.size() * sizeof(int32_t);
+}
+
+void ShaderMap::texel(const TileKey& key, int slot, int i, int j, float* out) const {
+    const int li = i - key.tx * options_.tileSize + options_.border;
+    const int lj = j - key.ty * options_.tileSize + options_.border;
+    const size_t at = ((static_cast<size_t>(slot) * stride_ + static_cast<size_t>(lj)) * stride_ +
+                       static_cast<size_t>(li)) *
+                      static_cast<size_t>(channels_);
+    if (options_.halfPrecision) {
+        for (int c = 0; c < channels_; ++c)
+            out[c] = halfToFloat(halfData_[at + static_cast<size_t>(c)]);
+    } else {
+        for (int c = 0; c < channels_; ++c) out[c] = data_[at + static_cast<size_t>(c)];
+    }
+}
+
+void ShaderMap::fillTile(const TileKey& key, int slot, std::vector<float>& scratch,
+                         FillStats& stats) {
+    const int res = resolution(key.level);
+    const int k = options_.prefilter == Prefilter::Box
+                      ? std::min(1 << key.level, options_.supersampleLimit)
+                      : 1;
+    const int texels = stride_ * stride_;
+    const size_t n = static_cast<size_t>(texels) * static_cast<size_t>(k * k);
+    // Chart points of every (super)sample of every texel, borders included.
+    std::vector<ChartPoint> points(n);
+    size_t p = 0;
+    for (int lj = 0; lj < stride_; ++lj)
+        for (int li = 0; li < stride_; ++li) {
+            const int i = key.tx * options_.tileSize + li - options_.border;
+            const int j = key.ty * options_.tileSize + lj - options_.border;
+            for (int sj = 0; sj < k; ++sj)
+                for (int si = 0; si < k; ++si) {
+                    const float u = (static_cast<float>(i) +
+                                     (static_cast<float>(si) + 0.5f) / static_cast<float>(k)) /
+                                    res;
+                    const float v = (static_cast<float>(j) +
+                                     (static_cast<float>(sj) + 0.5f) / static_cast<float>(k)) /
+                                    res;
+                    points[p++] = {static_cast<int>(key.chart), std::clamp(u, 0.0f, 1.0f),
+                                   std::clamp(v, 0.0f, 1.0f)};
+                }
+        }
+    std::vector<SurfaceSample> geometry(n);
+    evaluateBatch(surface_, points, geometry);
+    // Structure of arrays for the static program: 22 input rows, then the channels.
+    scratch.resize(n * static_cast<size_t>(22 + channels_ + 6));
+    auto row = [&](int r) { return scratch.data() + static_cast<size_t>(r) * n; };
+    for (size_t s = 0; s < n; ++s) {
+        const SurfaceSample& g = geometry[s];
+        const glm::vec3 toP = g.P - uniforms_.eye;
+        const float len = std::sqrt(toP.x * toP.x + toP.y * toP.y + toP.z * toP.z);
+        const glm::vec3 I = len > 0.0f ? toP / len : glm::vec3(0.0f, 0.0f, -1.0f);
+        const float values[22] = {g.P.x,       g.P.y,       g.P.z,    g.N.x,    g.N.y,    g.N.z,
+                                  g.Ng.x,      g.Ng.y,      g.Ng.z,   g.dPdu.x, g.dPdu.y, g.dPdu.z,
+                                  g.dPdv.x,    g.dPdv.y,    g.dPdv.z, I.x,      I.y,      I.z,
+                                  points[s].u, points[s].v, g.s,      g.t};
+        for (int r = 0; r < 22; ++r) row(r)[s] = values[r];
+    }
+    ShadingInputs in;
+    for (int c = 0; c < 3; ++c) {
+        in.P[c] = row(0 + c), in.N[c] = row(3 + c), in.Ng[c] = row(6 + c);
+        in.dPdu[c] = row(9 + c), in.dPdv[c] = row(12 + c), in.I[c] = row(15 + c);
+    }
+    in.u = row(18), in.v = row(19), in.s = row(20), in.t = row(21);
+    std::vector<float*> channelOut(static_cast<size_t>(channels_));
+    for (int c = 0; c < channels_; ++c) channelOut[static_cast<size_t>(c)] = row(22 + c);
+    ShadingOutputs out;
+    for (int c = 0; c < 3; ++c)
+        out.Ci[c] = row(22 + channels_ + c), out.Oi[c] = row(25 + channels_ + c);
+    out.channels = channelOut.data();
+    std::vector<float> workspace;
+    ShadingCounters counters;
+    kernel_.run(uniforms_, in, n, out, workspace, counters);
+    // Box-average the supersamples of each texel into the tile, channel-interleaved.
+    const size_t base =
+        static_cast<size_t>(slot) * static_cast<size_t>(texels) * static_cast<size_t>(channels_);
+    const float inv = 1.0f / static_cast<float>(k * k);
+    for (int t = 0; t < texels; ++t)
+        for (int c = 0; c < channels_; ++c) {
+            float sum = 0.0f;
+            for (int s = 0; s < k * k; ++s)
+                sum += channelOut[static_cast<size_t>(c)][static_cast<size_t>(t * k * k + s)];
+            const size_t at = base + static_cast<size_t>(t) * static_cast<size_t>(channels_) +
+                              static_cast<size_t>(c);
+            if (options_.halfPrecision)
+                halfData_[at] = floatToHalf(sum * inv);
+            else
+                data_[at] = sum * inv;
+        }
+    ++stats.tiles;
+    stats.texels += static_cast<uint64_t>(texels);
+    stats.programRuns += n;
+}
+
+void ShaderMap::fill(std::span<const TileKey> keys) {
+    std::lock_guard<std::mutex> lock(fillMutex_);
+    // Assign slots to the new tiles first, growing the storage once.
+    std::vector<std::pair<TileKey, int>> work;
+    for (const TileKey& key : keys) {
+        int32_t& slot = slot_[tileIndex(key)];
+        if (slot >= 0) continue;
+        slot = static_cast<int32_t>(residentTiles_++);
+        work.emplace_back(key, slot);
+    }
+    if (work.empty()) return;
+    const size_t perTile = static_cast<size_t>(stride_) * stride_ * static_cast<size_t>(channels_);
+    if (options_.halfPrecision)
+        halfData_.resize(residentTiles_ * perTile);
+    else
+        data_.resize(residentTiles_ * perTile);
+    tbb::enumerable_thread_specific<std::vector<float>> scratch;
+    tbb::enumerable_thread_specific<FillStats> stats;
+    tbb::parallel_for(size_t{0}, work.size(), [&](size_t w) {
+        enableFlushToZero();
+        fillTile(work[w].first, work[w].second, scratch.local(), stats.local());
+    });
+    for (const FillStats& s : stats) {
+        fillStats_.tiles += s.tiles;
+        fillStats_.texels += s.texels;
+        fillStats_.programRuns += s.programRuns;
+    }
+}
+
+void ShaderMap::fillLevels(int first, int last) {
+    std::vector<TileKey> keys;
+    for (int chart = 0; chart < charts_; ++chart)
+        for (int level = first; level <= last; ++level) {
+            const int n = tilesPerSide(level);
+            for (int ty = 0; ty < n; ++ty)
+                for (int tx = 0; tx < n; ++tx)
+                    keys.push_back({static_cast<uint32_t>(chart), static_cast<uint16_t>(level),
+                                    static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)});
+        }
+    fill(keys);
+}
+
+}  // namespace mpshade

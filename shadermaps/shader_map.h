@@ -1,0 +1,113 @@
+// shader_map.h -- tiled, mip-levelled maps of a shader's static n-tuple over an object's
+// charts (patent FIG. 5, claims 5-9): the static part of the factored shader evaluated at
+// texel centres, populated on demand, one tile at a time.
+//
+// Layout. Every chart of the surface is a square of R x R texels at level 0 (R a power of
+// two), with its own pyramid down to 1 x 1, so coarse levels never mix charts. Level L is
+// R / 2^L texels wide, cut into square tiles of `tileSize` texels; each tile also stores a
+// `border` of texels around it, so a bilinear lookup anywhere in the tile reads one tile.
+// Texel (i, j) of level L covers chart coordinates [i, i + 1] / (R / 2^L) (likewise j);
+// its value is the static program at the texel centre.
+//
+// Borders beyond a chart's edge are evaluated at the chart coordinate clamped to [0, 1]
+// (clamp to edge). (Evaluating them on the neighbouring chart, for seamless probes across
+// chart borders, is the next step.)
+//
+// Prefiltering: point-sampled coarse levels alias high-frequency patterns; with
+// `Prefilter::Box` a texel of level L > 0 is the mean of the static program over a
+// k x k grid inside it (k = min(2^L, supersampleLimit)).
+//
+// Residency: tiles exist only once filled. The coarsest `alwaysResidentLevels` levels of
+// every chart are filled at construction, so a probe always finds data (it falls back to
+// the finest resident coarser level, patent col. 10).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <vector>
+
+#include "geometry/surface.h"
+#include "shading/interpreter.h"
+
+namespace mpshade {
+
+enum class Prefilter { Point, Box };
+
+struct ShaderMapOptions {
+    int resolution = 256;        // level-0 texels per chart side; a power of two
+    int tileSize = 16;           // texels per tile side
+    int border = 2;              // texels around each tile
+    bool halfPrecision = false;  // store channels as binary16 (see half_float.h for the error)
+    Prefilter prefilter = Prefilter::Box;
+    int supersampleLimit = 4;      // at most k x k program samples per texel when prefiltering
+    int alwaysResidentLevels = 6;  // 1x1 .. 32x32 per chart, filled at construction
+};
+
+// A tile: chart, level, and tile column and row within the level.
+struct TileKey {
+    uint32_t chart = 0;
+    uint16_t level = 0;
+    uint16_t tx = 0, ty = 0;
+    bool operator==(const TileKey&) const = default;
+};
+
+struct FillStats {
+    uint64_t tiles = 0;
+    uint64_t texels = 0;
+    uint64_t programRuns = 0;  // static program evaluations (texels x supersamples)
+};
+
+class ShaderMap {
+  public:
+    // `staticPart` computes the channels (its channelOutputs); `uniforms` are the static
+    // phase's (representative) values. The surface and kernel must outlive the map.
+    ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
+              const ShadingUniforms& uniforms, const ShaderMapOptions& options = {});
+
+    int channels() const { return channels_; }
+    int levels() const { return levels_; }
+    int resolution(int level) const { return options_.resolution >> level; }
+    int tilesPerSide(int level) const;
+    const ShaderMapOptions& options() const { return options_; }
+
+    bool resident(const TileKey& key) const { return slotOf(key) >= 0; }
+    // Fills the tiles that are not resident yet (batched and parallel).
+    void fill(std::span<const TileKey> keys);
+    // Fills every tile of the levels in [first, last] (inclusive) of every chart.
+    void fillLevels(int first, int last);
+    const FillStats& fillStats() const { return fillStats_; }
+    size_t residentTiles() const { return residentTiles_; }
+    size_t bytes() const;
+
+    // The tile holding texel (i, j) of a level, and where in its storage that texel lies.
+    TileKey tileOf(uint32_t chart, int level, int i, int j) const;
+
+    // Reads the channels of texel (i, j), which must lie in the tile `key` or its border:
+    // i in [tx * T - border, (tx + 1) * T + border) (likewise j). Writes channels() floats.
+    void texel(const TileKey& key, int slot, int i, int j, float* out) const;
+    // The storage slot of a resident tile, or -1.
+    int slotOf(const TileKey& key) const;
+
+  private:
+    size_t tileIndex(const TileKey& key) const;
+    void fillTile(const TileKey& key, int slot, std::vector<float>& scratch, FillStats& stats);
+
+    const Surface& surface_;
+    const ShaderKernel& kernel_;
+    ShadingUniforms uniforms_;
+    ShaderMapOptions options_;
+    int charts_ = 0, channels_ = 0, levels_ = 0,
+        stride_ = 0;                   // stride_: texels per tile side with borders
+    std::vector<size_t> levelOffset_;  // first tile index of each level (per chart block)
+    size_t tilesPerChart_ = 0;
+    std::vector<int32_t> slot_;       // tile index -> storage slot, or -1
+    std::vector<float> data_;         // float storage
+    std::vector<uint16_t> halfData_;  // half storage
+    size_t residentTiles_ = 0;
+    FillStats fillStats_;
+    std::mutex fillMutex_;
+};
+
+}  // namespace mpshade

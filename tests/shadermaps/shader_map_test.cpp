@@ -1,0 +1,240 @@
+// Shader maps and probes: exact at texel centres, trilinear exact on linear functions,
+// Feline close to EWA, residency fallback, half precision, degenerate footprints.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "shadermaps/half_float.h"
+#include "shadermaps/probe.h"
+#include "shading/factoring.h"
+#include "shading/shader_compiler.h"
+
+namespace mpshade {
+namespace {
+
+// A map of a shader's static part over a 4 x 4 plane; time keeps the rest dynamic.
+struct MapFixture {
+    Surface surface = Plane{4.0f, 4.0f};
+    FactoredShader factored;
+    std::unique_ptr<ShaderKernel> kernel;
+    ShadingUniforms uniforms;
+
+    explicit MapFixture(const char* source) {
+        auto ast = compileShaderText("map.sl", source);
+        factored = factorShader(*ast, {});
+        kernel = std::make_unique<ShaderKernel>(factored.staticPart);
+    }
+
+    // The static program at one chart point, directly.
+    std::vector<float> direct(float u, float v) const {
+        const SurfaceSample g = evaluate(surface, {0, u, v});
+        std::vector<float> rows(28),
+            channels(static_cast<size_t>(kernel->program().channelOutputs.size()));
+        ShadingInputs in;
+        const float zero = 0.0f, I[3] = {0, 0, -1};
+        for (int c = 0; c < 3; ++c)
+            in.P[c] = &g.P[c], in.N[c] = &g.N[c], in.Ng[c] = &g.Ng[c], in.dPdu[c] = &g.dPdu[c],
+            in.dPdv[c] = &g.dPdv[c], in.I[c] = &I[c];
+        in.u = &u, in.v = &v, in.s = &g.s, in.t = &g.t;
+        std::vector<float*> out(channels.size());
+        for (size_t c = 0; c < channels.size(); ++c) out[c] = &channels[c];
+        ShadingOutputs o;
+        float sink[6];
+        for (int c = 0; c < 3; ++c) o.Ci[c] = &sink[c], o.Oi[c] = &sink[3 + c];
+        o.channels = out.data();
+        std::vector<float> workspace;
+        ShadingCounters counters;
+        (void)zero;
+        kernel->run(uniforms, in, 1, o, workspace, counters);
+        return channels;
+    }
+};
+
+const char* kNoiseShader =
+    "surface n() { Ci = color(noise(P * 1.5), fbm(P * 0.7, 3), noise(P * 6)) * (1 + time); }";
+// bake() keeps cheap functions of u and v in the map (otherwise the dynamic part would
+// recompute them from the geometry it has).
+const char* kLinearShader =
+    "surface l() { Ci = color(bake(3 * u + 2 * v + 1), bake(u - v), bake(0.5 * v)) * (1 + time); }";
+
+ProbeQuery query(float u, float v, float du, float dv, float aniso = 1.0f, float angle = 0.0f) {
+    const float c = std::cos(angle), s = std::sin(angle);
+    return {0, u, v, du * aniso * c, du * aniso * s, -dv * s, dv * c};
+}
+
+TEST(ShaderMap, ExactAtTexelCentres) {
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;
+    options.resolution = 64;
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    ASSERT_EQ(map.channels(), 3);
+    map.fillLevels(0, map.levels() - 1);
+    ProbeOptions probe;
+    probe.filter = ProbeFilter::Trilinear;
+    for (int j = 0; j < 64; j += 7)
+        for (int i = 0; i < 64; i += 5) {
+            const float u = (i + 0.5f) / 64, v = (j + 0.5f) / 64;
+            float out[3];
+            const ProbeQuery q = query(u, v, 0.0f, 0.0f);
+            probeShaderMap(map, probe, {&q, 1}, out);
+            const std::vector<float> expected = f.direct(u, v);
+            for (int c = 0; c < 3; ++c) ASSERT_NEAR(out[c], expected[c], 1e-6f) << i << "," << j;
+        }
+}
+
+TEST(ShaderMap, TrilinearIsExactOnLinearFunctions) {
+    MapFixture f(kLinearShader);
+    ShaderMapOptions options;
+    options.resolution = 128;
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    map.fillLevels(0, map.levels() - 1);
+    ProbeOptions probe;
+    probe.filter = ProbeFilter::Trilinear;
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> pos(0.3f, 0.7f), size(0.0f, 4.0f);
+    for (int k = 0; k < 2000; ++k) {
+        // Footprints up to 2^4 level-0 texels: the coarse texels stay inside the chart.
+        const float u = pos(rng), v = pos(rng), footprint = std::exp2(size(rng)) / 128.0f;
+        const ProbeQuery q = query(u, v, footprint, footprint * 0.5f);
+        float out[3];
+        probeShaderMap(map, probe, {&q, 1}, out);
+        ASSERT_NEAR(out[0], 3 * u + 2 * v + 1, 2e-5f);
+        ASSERT_NEAR(out[1], u - v, 2e-5f);
+        ASSERT_NEAR(out[2], 0.5f * v, 2e-5f);
+    }
+}
+
+TEST(ShaderMap, FelineStaysCloseToEwa) {
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;
+    options.resolution = 256;
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    map.fillLevels(0, map.levels() - 1);
+    ProbeOptions feline, ewa;
+    feline.filter = ProbeFilter::Feline;
+    ewa.filter = ProbeFilter::EWA;
+    ProbeOptions trilinear;
+    trilinear.filter = ProbeFilter::Trilinear;
+    std::mt19937 rng(2);
+    std::uniform_real_distribution<float> pos(0.25f, 0.75f), angle(0.0f, 3.14159265f);
+    double worst = 0.0, sum = 0.0, trilinearAt16 = 0.0, felineAt16 = 0.0;
+    int n = 0;
+    for (float aniso : {1.0f, 2.0f, 4.0f, 8.0f, 16.0f}) {
+        for (int k = 0; k < 200; ++k) {
+            const ProbeQuery q =
+                query(pos(rng), pos(rng), 1.5f / 256.0f, 1.5f / 256.0f, aniso, angle(rng));
+            float a[3], b[3], c[3];
+            probeShaderMap(map, feline, {&q, 1}, a);
+            probeShaderMap(map, ewa, {&q, 1}, b);
+            probeShaderMap(map, trilinear, {&q, 1}, c);
+            // The first channel is noise in [0, 1]: the difference is in those units.
+            const double d = std::fabs(a[0] - b[0]);
+            worst = std::max(worst, d);
+            sum += d;
+            ++n;
+            if (aniso == 16.0f) felineAt16 += d, trilinearAt16 += std::fabs(c[0] - b[0]);
+        }
+    }
+    // The bound documented in docs/shader-maps.md.
+    EXPECT_LT(sum / n, 0.002);
+    EXPECT_LT(worst, 0.015);
+    // Trilinear blurs a long footprint to its long axis: clearly further from EWA.
+    EXPECT_GT(trilinearAt16, 3.0 * felineAt16);
+    RecordProperty("feline_vs_ewa_mean", std::to_string(sum / n));
+    RecordProperty("feline_vs_ewa_max", std::to_string(worst));
+    RecordProperty("trilinear_vs_ewa_mean_at_16", std::to_string(trilinearAt16 / 200));
+}
+
+TEST(ShaderMap, MissingTilesFallBackToCoarserLevels) {
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;
+    options.resolution = 256;
+    options.alwaysResidentLevels = 3;  // 1x1, 2x2, 4x4
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    EXPECT_EQ(map.residentTiles(), 3u);
+    ProbeOptions probe;
+    probe.filter = ProbeFilter::Trilinear;
+    const ProbeQuery q = query(0.4f, 0.6f, 0.0f, 0.0f);
+    TileKey missing[8];
+    ProbeResidency residency{missing, 8};
+    float out[3], coarse[3];
+    probeShaderMap(map, probe, {&q, 1}, out, &residency);
+    EXPECT_GT(residency.fallbacks, 0u);
+    ASSERT_GT(residency.count, 0u);
+    EXPECT_EQ(missing[0].level, 0);
+    // The answer is the 4x4 level's bilinear value.
+    const ProbeQuery wide = query(0.4f, 0.6f, 64.0f / 256.0f, 64.0f / 256.0f);
+    probeShaderMap(map, probe, {&wide, 1}, coarse);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(out[c], coarse[c], 1e-6f);
+    // Filling what was missing removes the fallback.
+    map.fill({missing, residency.count});
+    ProbeResidency again{missing, 8};
+    probeShaderMap(map, probe, {&q, 1}, out, &again);
+    EXPECT_EQ(again.fallbacks, 0u);
+}
+
+TEST(ShaderMap, HalfPrecisionErrorIsBounded) {
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions full, half;
+    full.resolution = half.resolution = 64;
+    half.halfPrecision = true;
+    ShaderMap a(f.surface, *f.kernel, f.uniforms, full), b(f.surface, *f.kernel, f.uniforms, half);
+    a.fillLevels(0, a.levels() - 1);
+    b.fillLevels(0, b.levels() - 1);
+    EXPECT_LT(b.bytes(), a.bytes());
+    ProbeOptions probe;
+    probe.filter = ProbeFilter::Trilinear;
+    for (int j = 0; j < 64; ++j)
+        for (int i = 0; i < 64; ++i) {
+            const ProbeQuery q = query((i + 0.5f) / 64, (j + 0.5f) / 64, 0.0f, 0.0f);
+            float x[3], y[3];
+            probeShaderMap(a, probe, {&q, 1}, x);
+            probeShaderMap(b, probe, {&q, 1}, y);
+            for (int c = 0; c < 3; ++c)
+                ASSERT_LE(std::fabs(x[c] - y[c]),
+                          std::ldexp(std::fabs(x[c]), -11) + std::ldexp(1.0f, -25));
+        }
+}
+
+TEST(HalfFloat, RoundTripsAndRoundsToNearest) {
+    EXPECT_EQ(halfToFloat(floatToHalf(1.0f)), 1.0f);
+    EXPECT_EQ(halfToFloat(floatToHalf(-2.5f)), -2.5f);
+    EXPECT_EQ(halfToFloat(floatToHalf(65504.0f)), 65504.0f);
+    EXPECT_TRUE(std::isinf(halfToFloat(floatToHalf(1e6f))));
+    EXPECT_TRUE(std::isnan(halfToFloat(floatToHalf(NAN))));
+    EXPECT_EQ(halfToFloat(floatToHalf(std::ldexp(1.0f, -24))),
+              std::ldexp(1.0f, -24));  // the smallest subnormal
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> uni(-100.0f, 100.0f);
+    for (int k = 0; k < 100000; ++k) {
+        const float x = uni(rng);
+        ASSERT_LE(std::fabs(halfToFloat(floatToHalf(x)) - x), std::ldexp(std::fabs(x), -11));
+    }
+}
+
+TEST(Probe, DegenerateFootprintsGiveFiniteResults) {
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;
+    options.resolution = 64;
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    map.fillLevels(0, map.levels() - 1);
+    const float inf = INFINITY, nan = NAN;
+    const ProbeQuery cases[] = {
+        {0, 0.5f, 0.5f, 0, 0, 0, 0},         {0, 0.5f, 0.5f, nan, 0, 0, nan},
+        {0, 0.5f, 0.5f, inf, inf, inf, inf}, {0, 0.5f, 0.5f, 1e-3f, 0, 0, 1e-9f},
+        {0, nan, inf, 0.01f, 0, 0, 0.01f},   {0, 2.0f, -1.0f, 0.1f, 0.0f, 0.0f, 1e-7f},
+    };
+    for (ProbeFilter filter : {ProbeFilter::Trilinear, ProbeFilter::Feline, ProbeFilter::EWA}) {
+        ProbeOptions options2;
+        options2.filter = filter;
+        for (const ProbeQuery& q : cases) {
+            float out[3];
+            probeShaderMap(map, options2, {&q, 1}, out);
+            for (float x : out) ASSERT_TRUE(std::isfinite(x)) << static_cast<int>(filter);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace mpshade
