@@ -1,5 +1,7 @@
 #include "shadermaps/probe.h"
 
+#include "shadermaps/half_float.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -22,28 +24,45 @@ struct Prober {
             const float y = std::clamp(v * res - 0.5f, -0.5f, res - 0.5f);
             const float fx0 = std::floor(x), fy0 = std::floor(y);
             const int i0 = static_cast<int>(fx0), j0 = static_cast<int>(fy0);
-            const TileKey key =
-                map.tileOf(static_cast<uint32_t>(chart), level, std::max(i0, 0), std::max(j0, 0));
-            const int slot = map.slotOf(key);
+            int li, lj;
+            const int slot = map.locate(static_cast<uint32_t>(chart), level, std::max(i0, 0),
+                                        std::max(j0, 0), li, lj);
+            li += i0 - std::max(i0, 0);
+            lj += j0 - std::max(j0, 0);
             if (residency) ++residency->bilinearProbes;
             if (slot < 0 && level < maxLevel) {
                 if (residency) {
                     ++residency->fallbacks;
                     if (residency->count < residency->capacity)
-                        residency->missing[residency->count++] = key;
+                        residency->missing[residency->count++] = map.tileOf(
+                            static_cast<uint32_t>(chart), level, std::max(i0, 0), std::max(j0, 0));
                 }
                 continue;
             }
             const float fx = x - fx0, fy = y - fy0;
-            float t00[kMaxChannels], t10[kMaxChannels], t01[kMaxChannels], t11[kMaxChannels];
-            map.texel(key, slot, i0, j0, t00);
-            map.texel(key, slot, i0 + 1, j0, t10);
-            map.texel(key, slot, i0, j0 + 1, t01);
-            map.texel(key, slot, i0 + 1, j0 + 1, t11);
-            for (int c = 0; c < channels; ++c) {
-                const float a = t00[c] + fx * (t10[c] - t00[c]);
-                const float b = t01[c] + fx * (t11[c] - t01[c]);
-                out[c] = a + fy * (b - a);
+            const size_t row = static_cast<size_t>(map.stride()) * static_cast<size_t>(channels);
+            const size_t at = (static_cast<size_t>(lj) * static_cast<size_t>(map.stride()) +
+                               static_cast<size_t>(li)) *
+                              static_cast<size_t>(channels);
+            if (const float* t = map.tileFloats(slot)) {
+                const float *t00 = t + at, *t10 = t00 + channels, *t01 = t00 + row,
+                            *t11 = t01 + channels;
+                for (int c = 0; c < channels; ++c) {
+                    const float a = t00[c] + fx * (t10[c] - t00[c]);
+                    const float b = t01[c] + fx * (t11[c] - t01[c]);
+                    out[c] = a + fy * (b - a);
+                }
+            } else {
+                const uint16_t* h = map.tileHalves(slot);
+                const uint16_t *t00 = h + at, *t10 = t00 + channels, *t01 = t00 + row,
+                               *t11 = t01 + channels;
+                for (int c = 0; c < channels; ++c) {
+                    const float a00 = halfToFloat(t00[c]), a10 = halfToFloat(t10[c]);
+                    const float a01 = halfToFloat(t01[c]), a11 = halfToFloat(t11[c]);
+                    const float a = a00 + fx * (a10 - a00);
+                    const float b = a01 + fx * (a11 - a01);
+                    out[c] = a + fy * (b - a);
+                }
             }
             return;
         }
@@ -209,14 +228,32 @@ void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
         const float half = f.major - minor;
         const float dirU = f.ax / (f.major * res0),
                     dirV = f.ay / (f.major * res0);  // chart units per texel
-        float sum[kMaxChannels] = {}, probe[kMaxChannels];
+        // Every probe uses the same two levels; weights exp(-2 (d / major)^2) along an
+        // arithmetic progression of d follow a recurrence: two exp() calls per lookup.
+        const float clampedLod = std::clamp(lod, 0.0f, static_cast<float>(p.maxLevel));
+        const int l0 = static_cast<int>(clampedLod);
+        const int l1 = std::min(l0 + 1, p.maxLevel);
+        const float blend = l1 > l0 ? clampedLod - static_cast<float>(l0) : 0.0f;
+        const float step = 2.0f * half / static_cast<float>(n - 1);
+        const float gk = 2.0f / (f.major * f.major);
+        float w = std::exp(-gk * half * half);                              // at d = -half
+        float ratioW = std::exp(-gk * (step * step - 2.0f * half * step));  // w(d + step) / w(d)
+        const float ratioStep = std::exp(-2.0f * gk * step * step);
+        float sum[kMaxChannels] = {}, a[kMaxChannels], b[kMaxChannels];
         float weight = 0.0f;
         for (int i = 0; i < n; ++i) {
-            const float d = -half + 2.0f * half * static_cast<float>(i) / static_cast<float>(n - 1);
-            const float w = std::exp(-2.0f * (d / f.major) * (d / f.major));
-            p.trilinear(q.chart, lod, q.u + d * dirU, q.v + d * dirV, probe);
-            for (int c = 0; c < channels; ++c) sum[c] += w * probe[c];
+            const float d = -half + step * static_cast<float>(i);
+            const float u = q.u + d * dirU, v = q.v + d * dirV;
+            p.bilinear(q.chart, l0, u, v, a);
+            if (blend > 0.0f) {
+                p.bilinear(q.chart, l1, u, v, b);
+                for (int c = 0; c < channels; ++c) sum[c] += w * (a[c] + blend * (b[c] - a[c]));
+            } else {
+                for (int c = 0; c < channels; ++c) sum[c] += w * a[c];
+            }
             weight += w;
+            w *= ratioW;
+            ratioW *= ratioStep;
         }
         for (int c = 0; c < channels; ++c) o[c] = sum[c] / weight;
     }

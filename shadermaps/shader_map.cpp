@@ -21,7 +21,12 @@ ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
     channels_ = static_cast<int>(staticPart.program().channelOutputs.size());
     levels_ = 0;
     for (int r = options.resolution; r >= 1; r >>= 1) ++levels_;
+    MPSHADE_CHECK((options.tileSize & (options.tileSize - 1)) == 0);
+    while ((1 << tileShift_) > options.tileSize) --tileShift_;
+    while ((1 << tileShift_) < options.tileSize) ++tileShift_;
     stride_ = options.tileSize + 2 * options.border;
+    tileValues_ = static_cast<size_t>(stride_) * stride_ * static_cast<size_t>(channels_);
+    for (int level = 0; level < levels_; ++level) tilesPerSide_.push_back(tilesPerSide(level));
     levelOffset_.resize(static_cast<size_t>(levels_) + 1, 0);
     for (int level = 0; level < levels_; ++level) {
         const size_t side = static_cast<size_t>(tilesPerSide(level));

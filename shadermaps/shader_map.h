@@ -22,6 +22,7 @@
 // the finest resident coarser level, patent col. 10).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <mutex>
@@ -37,7 +38,7 @@ enum class Prefilter { Point, Box };
 
 struct ShaderMapOptions {
     int resolution = 256;        // level-0 texels per chart side; a power of two
-    int tileSize = 16;           // texels per tile side
+    int tileSize = 16;           // texels per tile side; a power of two
     int border = 2;              // texels around each tile
     bool halfPrecision = false;  // store channels as binary16 (see half_float.h for the error)
     Prefilter prefilter = Prefilter::Box;
@@ -90,6 +91,30 @@ class ShaderMap {
     // The storage slot of a resident tile, or -1.
     int slotOf(const TileKey& key) const;
 
+    // Direct access for probes: a tile's texels, row-major with borders, channels
+    // interleaved; stride() texels per row. Exactly one of the two is non-null.
+    const float* tileFloats(int slot) const {
+        return options_.halfPrecision ? nullptr
+                                      : data_.data() + static_cast<size_t>(slot) * tileValues_;
+    }
+    const uint16_t* tileHalves(int slot) const {
+        return options_.halfPrecision ? halfData_.data() + static_cast<size_t>(slot) * tileValues_
+                                      : nullptr;
+    }
+    int stride() const { return stride_; }
+    // The slot holding texel (i, j) of a level (clamped to the level), or -1 if that tile is
+    // not resident; (li, lj) receive the texel's position in the tile's storage.
+    int locate(uint32_t chart, int level, int i, int j, int& li, int& lj) const {
+        const int n = tilesPerSide_[static_cast<size_t>(level)];
+        const int tx = std::clamp(i >> tileShift_, 0, n - 1),
+                  ty = std::clamp(j >> tileShift_, 0, n - 1);
+        li = i - (tx << tileShift_) + options_.border;
+        lj = j - (ty << tileShift_) + options_.border;
+        return slot_[static_cast<size_t>(chart) * tilesPerChart_ +
+                     levelOffset_[static_cast<size_t>(level)] +
+                     static_cast<size_t>(ty) * static_cast<size_t>(n) + static_cast<size_t>(tx)];
+    }
+
   private:
     size_t tileIndex(const TileKey& key) const;
     void fillTile(const TileKey& key, int slot, std::vector<float>& scratch, FillStats& stats);
@@ -101,6 +126,9 @@ class ShaderMap {
     int charts_ = 0, channels_ = 0, levels_ = 0,
         stride_ = 0;                   // stride_: texels per tile side with borders
     std::vector<size_t> levelOffset_;  // first tile index of each level (per chart block)
+    int tileShift_ = 4;                // log2(tileSize)
+    size_t tileValues_ = 0;            // floats (or halves) per tile
+    std::vector<int> tilesPerSide_;
     size_t tilesPerChart_ = 0;
     std::vector<int32_t> slot_;       // tile index -> storage slot, or -1
     std::vector<float> data_;         // float storage
