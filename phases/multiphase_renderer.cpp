@@ -67,8 +67,12 @@ struct ChunkBuffers {
     ShadingInputs in;
     ShadingOutputs out;
 
+    std::vector<ProbeQuery> queries;
+    std::vector<float> probed;
+
     void prepare(size_t n, size_t channels) {
         rows.resize(28 * n);
+        queries.resize(n);
         channelData.resize(std::max<size_t>(channels, 1) * n);
         channelIn.resize(channels);
         channelOut.resize(channels);
@@ -104,6 +108,12 @@ struct MultiphaseRenderer::ObjectData {
     bool opaque = true;
     int diceHeight = 0;  // image height the facets were diced for
     float diceFov = 0.0f;
+    // The separate representation (scene option "representation": "shadermap"): the
+    // n-tuple comes from probes of a shader map, not from the facets' vertices.
+    bool useMap = false;
+    std::unique_ptr<ShaderMap> map;
+    std::vector<LightSample> mapLights;  // the static phase's uniforms, kept for the map
+    std::vector<float> mapParams;
 };
 
 MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptions& options)
@@ -114,6 +124,7 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
         data->staticKernel = std::make_unique<ShaderKernel>(data->factored.staticPart);
         data->dynamicKernel = std::make_unique<ShaderKernel>(data->factored.dynamicPart);
         data->opaque = isOpaque(data->factored.dynamicPart);
+        data->useMap = obj.representation == Representation::ShaderMap;
         for (const Inst& inst : data->factored.dynamicPart.insts) {
             if (inst.op != Op::Global) continue;
             const int row = rowOf(static_cast<GlobalId>(inst.imm));
@@ -181,7 +192,9 @@ void MultiphaseRenderer::staticPhase(size_t index, const ObjectState& state,
     attr.count = n;
     attr.rows.assign(VertexAttributes::kGeometryRows + channels, {});
     for (int row : obj.geometryRows) attr.rows[static_cast<size_t>(row)].resize(n);
-    for (size_t c = 0; c < channels; ++c) attr.rows[VertexAttributes::kGeometryRows + c].resize(n);
+    if (!obj.useMap)
+        for (size_t c = 0; c < channels; ++c)
+            attr.rows[VertexAttributes::kGeometryRows + c].resize(n);
     tbb::enumerable_thread_specific<ChunkBuffers> buffers;
     std::atomic<uint64_t> instructions{0};
     tbb::parallel_for(size_t{0}, (n + kChunk - 1) / kChunk, [&](size_t chunk) {
@@ -204,6 +217,7 @@ void MultiphaseRenderer::staticPhase(size_t index, const ObjectState& state,
                 attr.rows[static_cast<size_t>(row)][begin + i] = values[src];
             }
         }
+        if (obj.useMap) return;  // the n-tuple lives in the shader map
         ShadingCounters counters;
         obj.staticKernel->run(uniforms, b.in, m, b.out, b.workspace, counters);
         instructions += counters.instructions;
@@ -211,6 +225,33 @@ void MultiphaseRenderer::staticPhase(size_t index, const ObjectState& state,
             std::copy(b.channelOut[c], b.channelOut[c] + m,
                       attr.rows[VertexAttributes::kGeometryRows + c].begin() + begin);
     });
+    if (obj.useMap) {
+        // Resolution: the scene's, or about one texel per pixel at the closest view the
+        // facets were diced for (their edges are ~maxEdgePixels / sqrt(2) there).
+        int resolution = sceneObject.shadermapResolution;
+        if (resolution <= 0) {
+            const double facetsPerChart =
+                static_cast<double>(diced.triangles.size() / 3) /
+                std::max(1, diced.patches - diced.culledCharts - diced.frustumCulled);
+            const double pixelsPerSide =
+                std::sqrt(facetsPerChart / 2.0) * options_.dicing.maxEdgePixels / std::sqrt(2.0) *
+                std::sqrt(static_cast<double>(diced.patches) / std::max(1, diced.charts));
+            resolution = 8;
+            while (resolution < pixelsPerSide && resolution < 1024) resolution *= 2;
+        }
+        int pow2 = 1;
+        while (pow2 < resolution) pow2 *= 2;
+        obj.mapLights.assign(uniforms.lights.begin(), uniforms.lights.end());
+        obj.mapParams.assign(uniforms.params.begin(), uniforms.params.end());
+        ShadingUniforms mapUniforms = uniforms;
+        mapUniforms.lights = obj.mapLights;
+        mapUniforms.params = obj.mapParams;
+        ShaderMapOptions mapOptions = options_.shaderMap;
+        mapOptions.resolution = pow2;
+        obj.map = std::make_unique<ShaderMap>(surface, *obj.staticKernel, mapUniforms, mapOptions);
+        obj.map->fillLevels(0, obj.map->levels() - 1);
+        instructions += obj.map->fillStats().programRuns * obj.staticKernel->instructionCount();
+    }
     mesh->dynamicKernel = nullptr;
     obj.mesh = std::move(mesh);
     obj.diceHeight = camera.height;
@@ -371,8 +412,44 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
             }
             const glm::vec3 I = glm::normalize(P - eye);
             b.row(15, m)[i] = I.x, b.row(16, m)[i] = I.y, b.row(17, m)[i] = I.z;
-            for (size_t ch = 0; ch < channels; ++ch)
-                b.channelOut[ch][i] = lerp(attr.rows[VertexAttributes::kGeometryRows + ch]);
+            if (obj.useMap) {
+                // (chart, u, v) at the sample, and its screen derivatives from the facet's
+                // own gradient (facets are sub-pixel: affine is exact enough).
+                const ChartPoint& c0 = mesh.attributeChartPoint[a[0]];
+                const ChartPoint& c1 = mesh.attributeChartPoint[a[1]];
+                const ChartPoint& c2 = mesh.attributeChartPoint[a[2]];
+                const uint32_t* pi = &mesh.positionIndex[3 * static_cast<size_t>(f.facet)];
+                const WarpedVertices& wv = warped[chunk.object];
+                const float x1 = (wv.x[pi[1]] - wv.x[pi[0]]) / 256.0f,
+                            y1 = (wv.y[pi[1]] - wv.y[pi[0]]) / 256.0f;
+                const float x2 = (wv.x[pi[2]] - wv.x[pi[0]]) / 256.0f,
+                            y2 = (wv.y[pi[2]] - wv.y[pi[0]]) / 256.0f;
+                const float det = x1 * y2 - x2 * y1;
+                ProbeQuery& q = b.queries[i];
+                q.chart = c0.chart;
+                q.u = w0 * c0.u + f.b1 * c1.u + f.b2 * c2.u;
+                q.v = w0 * c0.v + f.b1 * c1.v + f.b2 * c2.v;
+                if (std::fabs(det) > 1e-12f) {
+                    const float du1 = c1.u - c0.u, du2 = c2.u - c0.u, dv1 = c1.v - c0.v,
+                                dv2 = c2.v - c0.v;
+                    q.dudx = (du1 * y2 - du2 * y1) / det;
+                    q.dudy = (du2 * x1 - du1 * x2) / det;
+                    q.dvdx = (dv1 * y2 - dv2 * y1) / det;
+                    q.dvdy = (dv2 * x1 - dv1 * x2) / det;
+                } else {
+                    q.dudx = q.dudy = q.dvdx = q.dvdy = 0.0f;
+                }
+            } else {
+                for (size_t ch = 0; ch < channels; ++ch)
+                    b.channelOut[ch][i] = lerp(attr.rows[VertexAttributes::kGeometryRows + ch]);
+            }
+        }
+        if (obj.useMap && channels > 0) {
+            b.probed.resize(m * channels);
+            probeShaderMap(*obj.map, options_.probe, {b.queries.data(), m}, b.probed.data());
+            for (size_t i = 0; i < m; ++i)
+                for (size_t ch = 0; ch < channels; ++ch)
+                    b.channelOut[ch][i] = b.probed[i * channels + ch];
         }
         ShadingCounters counters;
         obj.dynamicKernel->run(uniforms[chunk.object], b.in, m, b.out, b.workspace, counters);

@@ -3,7 +3,10 @@
 //
 // Static phase (per object, rarely): dice the surface into sub-pixel facets for the
 // representative viewpoint (dicing.h), evaluate the static part of the object's factored
-// shader at every facet vertex, and keep the n-tuple per vertex. It runs again for an
+// shader at every facet vertex, and keep the n-tuple per vertex -- or, for objects whose
+// scene entry asks for "representation": "shadermap" (the patent's separate
+// representation, FIG. 5), fill a shader map of the static part and probe it per sample
+// with the footprint of the facet's screen-space (u, v) gradient. It runs again for an
 // object only when the viewpoint, in the object's own coordinates, leaves the range
 // (distance factor and angle of the scene's `range`).
 // Dynamic phase (every frame): warp each object's facets in fixed point
@@ -20,6 +23,7 @@
 #include "phases/facet_mesh.h"
 #include "phases/facet_rasterizer.h"
 #include "phases/reference_renderer.h"
+#include "shadermaps/probe.h"
 #include "shading/factoring.h"
 
 namespace mpshade {
@@ -28,6 +32,9 @@ struct MultiphaseOptions {
     DicingOptions dicing;
     FactorOptions factor;
     RasterOptions raster;
+    ShaderMapOptions
+        shaderMap;       // for objects with "representation": "shadermap" (resolution: per object)
+    ProbeOptions probe;  // how those objects' maps are probed
 };
 
 class MultiphaseRenderer {

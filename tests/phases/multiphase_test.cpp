@@ -347,5 +347,31 @@ TEST(MultiphaseRenderer, ExamplesMatchTheReference) {
     }
 }
 
+TEST(MultiphaseRenderer, ShaderMapRepresentationMatchesTheReference) {
+    // The vase scene with every object switched to the separate representation.
+    Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    for (SceneObject& o : scene.objects) {
+        o.representation = Representation::ShaderMap;
+        o.shadermapResolution = 64;  // about a texel per pixel at this size
+    }
+    const ReferenceRenderer reference(scene);
+    MultiphaseRenderer multi(scene);
+    RenderOptions options;
+    options.width = 160;
+    options.height = 100;
+    options.samplesPerPixel = 2;
+    FrameStats rs, ms;
+    const Image ref = reference.renderFrame(2, options, rs);
+    const Image got = multi.renderFrame(2, options, ms);
+    const ImageError e = compareImages(got, ref);
+    EXPECT_GT(e.psnr, 32.0);
+    EXPECT_LT(e.coverageDiff, 0.01);
+    // Per-vertex n-tuples are no longer stored: the channel rows are empty.
+    const FacetMesh* mesh = multi.facets(0);
+    ASSERT_NE(mesh, nullptr);
+    ASSERT_GT(mesh->channels, 0);
+    EXPECT_TRUE(mesh->attributes.rows[VertexAttributes::kGeometryRows].empty());
+}
+
 }  // namespace
 }  // namespace mpshade
