@@ -86,12 +86,17 @@ void ShaderMap::fillTile(const TileKey& key, int slot, std::vector<float>& scrat
                       ? std::min(1 << key.level, options_.supersampleLimit)
                       : 1;
     const int texels = stride_ * stride_;
-    const size_t n = static_cast<size_t>(texels) * static_cast<size_t>(k * k);
-    // Chart points of every (super)sample of every texel, borders included.
+    // Only the texels this level has, plus the border: a level smaller than a tile leaves
+    // the rest of the tile unused (probes clamp to the level).
+    const int validW = std::min(stride_, res - key.tx * options_.tileSize + 2 * options_.border);
+    const int validH = std::min(stride_, res - key.ty * options_.tileSize + 2 * options_.border);
+    const size_t n =
+        static_cast<size_t>(validW) * static_cast<size_t>(validH) * static_cast<size_t>(k * k);
+    // Chart points of every (super)sample of every valid texel, borders included.
     std::vector<ChartPoint> points(n);
     size_t p = 0;
-    for (int lj = 0; lj < stride_; ++lj)
-        for (int li = 0; li < stride_; ++li) {
+    for (int lj = 0; lj < validH; ++lj)
+        for (int li = 0; li < validW; ++li) {
             const int i = key.tx * options_.tileSize + li - options_.border;
             const int j = key.ty * options_.tileSize + lj - options_.border;
             for (int sj = 0; sj < k; ++sj)
@@ -141,20 +146,27 @@ void ShaderMap::fillTile(const TileKey& key, int slot, std::vector<float>& scrat
     const size_t base =
         static_cast<size_t>(slot) * static_cast<size_t>(texels) * static_cast<size_t>(channels_);
     const float inv = 1.0f / static_cast<float>(k * k);
-    for (int t = 0; t < texels; ++t)
-        for (int c = 0; c < channels_; ++c) {
-            float sum = 0.0f;
-            for (int s = 0; s < k * k; ++s)
-                sum += channelOut[static_cast<size_t>(c)][static_cast<size_t>(t * k * k + s)];
-            const size_t at = base + static_cast<size_t>(t) * static_cast<size_t>(channels_) +
-                              static_cast<size_t>(c);
-            if (options_.halfPrecision)
-                halfData_[at] = floatToHalf(sum * inv);
-            else
-                data_[at] = sum * inv;
+    for (int lj = 0; lj < validH; ++lj)
+        for (int li = 0; li < validW; ++li) {
+            const size_t first =
+                (static_cast<size_t>(lj) * static_cast<size_t>(validW) + static_cast<size_t>(li)) *
+                static_cast<size_t>(k * k);
+            const size_t texel =
+                static_cast<size_t>(lj) * static_cast<size_t>(stride_) + static_cast<size_t>(li);
+            for (int c = 0; c < channels_; ++c) {
+                float sum = 0.0f;
+                for (int s = 0; s < k * k; ++s)
+                    sum += channelOut[static_cast<size_t>(c)][first + static_cast<size_t>(s)];
+                const size_t at =
+                    base + texel * static_cast<size_t>(channels_) + static_cast<size_t>(c);
+                if (options_.halfPrecision)
+                    halfData_[at] = floatToHalf(sum * inv);
+                else
+                    data_[at] = sum * inv;
+            }
         }
     ++stats.tiles;
-    stats.texels += static_cast<uint64_t>(texels);
+    stats.texels += static_cast<uint64_t>(validW) * static_cast<uint64_t>(validH);
     stats.programRuns += n;
 }
 
