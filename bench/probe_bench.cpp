@@ -17,6 +17,10 @@
 #include <OpenImageIO/texture.h>
 #include <benchmark/benchmark.h>
 
+#include "geometry/ray_scene.h"
+#include "scene/scene.h"
+#include "scene/scene_state.h"
+#include "scene/variability.h"
 #include "shadermaps/probe.h"
 #include "shading/factoring.h"
 #include "shading/shader_compiler.h"
@@ -141,6 +145,60 @@ void oiio(benchmark::State& state, bool aniso, int channels) {
     state.counters["err_vs_ewa"] = d.errorVsEwa(out, aniso);
     OIIO::TextureSystem::destroy(ts);
 }
+
+// Tile fill: the static part of each example shader over the vase's 104 charts at 64 x 64
+// texels (level 0 only: one texel, one program run), fresh map each iteration.
+void tileFill(benchmark::State& state, const char* shader) {
+    const Scene scene = loadScene(std::string(MPSHADE_SOURCE_DIR) + "/examples/vase/scene.json");
+    SceneObject bound = scene.objects[0];
+    bound.params.clear();
+    const FactoredShader f = factorShader(
+        *loadShaderFile(std::string(MPSHADE_SOURCE_DIR) + "/examples/shaders/" + shader + ".sl"),
+        bindingOf(scene, bound));
+    const ShaderKernel kernel(f.staticPart);
+    const SurfaceRayScene rays(*bound.surface);
+    const CameraState camera = cameraAt(scene, 0.0f, 480, 270);
+    const ObjectState st = objectAt(bound, 0.0f, camera);
+    std::vector<LightSample> lights;
+    lightsAt(scene, st, 0.0f, lights);
+    ShadingUniforms uniforms;
+    uniforms.eye = st.eye;
+    uniforms.lights = lights;
+    uniforms.occluder = &rays;
+    uniforms.occlusionBias = 1e-4f * surfaceBounds(*bound.surface).diagonal();
+    ShaderMapOptions options;
+    options.resolution = 64;
+    options.alwaysResidentLevels = 0;
+    uint64_t texels = 0;
+    for (auto _ : state) {
+        ShaderMap map(*bound.surface, kernel, uniforms, options);
+        map.fillLevels(0, 0);
+        texels += map.fillStats().texels;
+    }
+    state.SetItemsProcessed(static_cast<int64_t>(texels));
+    state.counters["channels"] = f.chosenWidth;
+}
+
+BENCHMARK_CAPTURE(tileFill, marble, "marble")
+    ->Name("TileFill/marble")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(tileFill, wood, "wood")
+    ->Name("TileFill/wood")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(tileFill, brick, "brick")
+    ->Name("TileFill/brick")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(tileFill, rust, "rust_over_paint")
+    ->Name("TileFill/rust_over_paint")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(tileFill, plastic, "plastic")
+    ->Name("TileFill/plastic")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 #define MPSHADE_PROBE_PAIR(n)                                                            \
     BENCHMARK_CAPTURE(ours, tri##n, ProbeFilter::Trilinear, n)                           \
