@@ -373,5 +373,44 @@ TEST(MultiphaseRenderer, ShaderMapRepresentationMatchesTheReference) {
     EXPECT_TRUE(mesh->attributes.rows[VertexAttributes::kGeometryRows].empty());
 }
 
+TEST(MultiphaseRenderer, PrefilteredShaderMapsOnAMinifiedSurface) {
+    // A high-frequency procedural ground plane towards the horizon: far texels cover many
+    // cycles of the pattern. Point-sampled coarse levels alias; box-prefiltered ones (the
+    // default) average the pattern over each texel. The reference supersamples 64 times.
+    const std::string dir = ::testing::TempDir() + "mpshade_prefilter/";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "stripes.sl")
+        << "surface stripes() { float n = noise(P * 12) + 0.5 * noise(P * 29); Ci = color(n, 1 - "
+           "n, 0.5 * n) * (1 + 0.2 * time); }";
+    std::ofstream(dir + "scene.json") << R"({
+      "settings": { "width": 96, "height": 64, "samples_per_pixel": 16, "background": [0, 0, 0] },
+      "camera": { "fov_y": 40, "near": 0.05, "far": 500, "eye": [0, 0.7, 10], "target": [0, 0, -10] },
+      "shaders": { "s": "stripes.sl" },
+      "objects": [ { "name": "ground", "geometry": { "type": "plane", "size": [20, 20] }, "shader": "s",
+                     "representation": "shadermap", "shadermap_resolution": 2048,
+                     "range": { "distance_factor": 1.1, "angle": 5 } } ] })";
+    const Scene scene = loadScene(dir + "scene.json");
+    const ReferenceRenderer reference(scene);
+    FrameStats stats;
+    RenderOptions dense;
+    dense.samplesPerPixel = 64;
+    const Image truth = reference.renderFrame(0, dense, stats);
+    RenderOptions fewer;
+    fewer.samplesPerPixel = 4;
+    double error[2];
+    for (int box = 0; box < 2; ++box) {
+        MultiphaseOptions options;
+        options.shaderMap.prefilter = box ? Prefilter::Box : Prefilter::Point;
+        MultiphaseRenderer multi(scene, options);
+        error[box] = compareImages(multi.renderFrame(0, fewer, stats), truth).rmse;
+    }
+    // Measured: box 0.0107, point 0.0109 RMSE (docs/shader-maps.md): prefiltering helps a
+    // little; the probe filter's own shape dominates what is left.
+    EXPECT_LE(error[1], error[0]) << "box " << error[1] << " point " << error[0];
+    EXPECT_LT(error[1], 0.02);
+    RecordProperty("minified_rmse_point", std::to_string(error[0]));
+    RecordProperty("minified_rmse_box", std::to_string(error[1]));
+}
+
 }  // namespace
 }  // namespace mpshade
