@@ -100,12 +100,13 @@ ProbeData& data(int channels) {
     return *d;
 }
 
-void ours(benchmark::State& state, ProbeFilter filter, int channels) {
+void ours(benchmark::State& state, ProbeFilter filter, int channels, float maxAnisotropy = 16.0f) {
     ProbeData& d = data(channels);
     const bool aniso = filter != ProbeFilter::Trilinear;
     const std::vector<ProbeQuery>& queries = aniso ? d.anisotropic : d.isotropic;
     ProbeOptions options;
     options.filter = filter;
+    options.maxAnisotropy = maxAnisotropy;
     std::vector<float> out(queries.size() * static_cast<size_t>(channels));
     for (auto _ : state) {
         probeShaderMap(*d.map, options, queries, out.data());
@@ -206,6 +207,8 @@ BENCHMARK_CAPTURE(tileFill, plastic, "plastic")
     BENCHMARK_CAPTURE(oiio, tri##n, false, n)->Name("Probe/Trilinear/" #n "ch/OIIO");    \
     BENCHMARK_CAPTURE(ours, feline##n, ProbeFilter::Feline, n)                           \
         ->Name("Probe/Anisotropic/" #n "ch/ours_feline");                                \
+    BENCHMARK_CAPTURE(ours, feline4_##n, ProbeFilter::Feline, n, 4.0f)                   \
+        ->Name("Probe/Anisotropic/" #n "ch/ours_feline_max4");                           \
     BENCHMARK_CAPTURE(oiio, aniso##n, true, n)->Name("Probe/Anisotropic/" #n "ch/OIIO"); \
     BENCHMARK_CAPTURE(ours, ewa##n, ProbeFilter::EWA, n)->Name("Probe/EWA/" #n "ch/ours");
 MPSHADE_PROBE_PAIR(1)

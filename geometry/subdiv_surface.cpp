@@ -103,7 +103,9 @@ int SubdivSurface::chartCount() const {
 int SubdivSurface::chartFace(int chart) const {
     return impl_->charts[chart].face;
 }
-bool SubdivSurface::closed() const { return impl_->closed; }
+bool SubdivSurface::closed() const {
+    return impl_->closed;
+}
 Bounds3 SubdivSurface::bounds() const {
     return impl_->bounds;
 }

@@ -23,7 +23,8 @@ SurfaceSample evaluate(const Surface& surface, ChartPoint at) {
 }
 
 bool isClosed(const Surface& surface) {
-    if (std::holds_alternative<Sphere>(surface) || std::holds_alternative<Torus>(surface)) return true;
+    if (std::holds_alternative<Sphere>(surface) || std::holds_alternative<Torus>(surface))
+        return true;
     if (const auto* s = std::get_if<SubdivSurface>(&surface)) return s->closed();
     if (const auto* m = std::get_if<PolygonMesh>(&surface)) return m->closed();
     return false;  // planes, Bezier patch sets, points

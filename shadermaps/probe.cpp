@@ -10,14 +10,19 @@ namespace {
 
 constexpr int kMaxChannels = 64;
 
+// kChannels > 0: the channel count is a compile-time constant, so the per-channel loops
+// unroll and vectorize; 0: any count.
+template <int kChannels>
 struct Prober {
     const ShaderMap& map;
     ProbeResidency* residency;
-    int channels;
+    int runtimeChannels;
     int maxLevel;
+    static constexpr bool kFixed = kChannels > 0;
 
     // Bilinear probe of level `level` at chart (u, v), falling back to coarser resident levels.
     void bilinear(int chart, int level, float u, float v, float* out) const {
+        const int channels = kFixed ? kChannels : runtimeChannels;
         for (;; ++level) {
             const int res = map.resolution(level);
             const float x = std::clamp(u * res - 0.5f, -0.5f, res - 0.5f);
@@ -69,6 +74,7 @@ struct Prober {
     }
 
     void trilinear(int chart, float lod, float u, float v, float* out) const {
+        const int channels = kFixed ? kChannels : runtimeChannels;
         if (!(lod > 0.0f)) return bilinear(chart, 0, u, v, out);
         if (lod >= static_cast<float>(maxLevel)) return bilinear(chart, maxLevel, u, v, out);
         const int l0 = static_cast<int>(lod);
@@ -92,6 +98,7 @@ struct Prober {
 
     void ewaLevel(int chart, int level, float u, float v, float ax, float ay, float bx, float by,
                   float* out) const {
+        const int channels = kFixed ? kChannels : runtimeChannels;
         const int res = map.resolution(level);
         const float scale = static_cast<float>(res) / static_cast<float>(map.resolution(0));
         ax *= scale, ay *= scale, bx *= scale, by *= scale;
@@ -178,10 +185,13 @@ Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy
 
 }  // namespace
 
-void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
-                    std::span<const ProbeQuery> queries, float* out, ProbeResidency* residency) {
-    const int channels = map.channels();
-    const Prober p{map, residency, std::min(channels, kMaxChannels), map.levels() - 1};
+namespace {
+
+template <int C>
+void probeAll(const ShaderMap& map, const ProbeOptions& options,
+              std::span<const ProbeQuery> queries, float* out, ProbeResidency* residency) {
+    const int channels = C > 0 ? C : std::min(map.channels(), kMaxChannels);
+    const Prober<C> p{map, residency, channels, map.levels() - 1};
     const float res0 = static_cast<float>(map.resolution(0));
     for (size_t k = 0; k < queries.size(); ++k) {
         ProbeQuery q = queries[k];
@@ -256,6 +266,26 @@ void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
             ratioW *= ratioStep;
         }
         for (int c = 0; c < channels; ++c) o[c] = sum[c] / weight;
+    }
+}
+
+}  // namespace
+
+void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
+                    std::span<const ProbeQuery> queries, float* out, ProbeResidency* residency) {
+    switch (map.channels()) {
+        case 1:
+            return probeAll<1>(map, options, queries, out, residency);
+        case 2:
+            return probeAll<2>(map, options, queries, out, residency);
+        case 3:
+            return probeAll<3>(map, options, queries, out, residency);
+        case 4:
+            return probeAll<4>(map, options, queries, out, residency);
+        case 8:
+            return probeAll<8>(map, options, queries, out, residency);
+        default:
+            return probeAll<0>(map, options, queries, out, residency);
     }
 }
 

@@ -18,6 +18,7 @@ ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
     MPSHADE_CHECK(options.resolution > 0 && (options.resolution & (options.resolution - 1)) == 0);
     MPSHADE_CHECK(options.tileSize > 0 && options.border >= 1);
     charts_ = chartCount(surface);
+    if (options.seamless) adjacency_ = std::make_unique<ChartAdjacency>(surface);
     channels_ = static_cast<int>(staticPart.program().channelOutputs.size());
     levels_ = 0;
     for (int r = options.resolution; r >= 1; r >>= 1) ++levels_;
@@ -107,8 +108,11 @@ void ShaderMap::fillTile(const TileKey& key, int slot, std::vector<float>& scrat
                     const float v = (static_cast<float>(j) +
                                      (static_cast<float>(sj) + 0.5f) / static_cast<float>(k)) /
                                     res;
-                    points[p++] = {static_cast<int>(key.chart), std::clamp(u, 0.0f, 1.0f),
-                                   std::clamp(v, 0.0f, 1.0f)};
+                    points[p++] =
+                        adjacency_
+                            ? adjacency_->resolve(static_cast<int>(key.chart), u, v)
+                            : ChartPoint{static_cast<int>(key.chart), std::clamp(u, 0.0f, 1.0f),
+                                         std::clamp(v, 0.0f, 1.0f)};
                 }
         }
     std::vector<SurfaceSample> geometry(n);

@@ -9,9 +9,11 @@
 // Texel (i, j) of level L covers chart coordinates [i, i + 1] / (R / 2^L) (likewise j);
 // its value is the static program at the texel centre.
 //
-// Borders beyond a chart's edge are evaluated at the chart coordinate clamped to [0, 1]
-// (clamp to edge). (Evaluating them on the neighbouring chart, for seamless probes across
-// chart borders, is the next step.)
+// No seams: border texels beyond a chart's edge are evaluated on the chart across that
+// edge (geometry/chart_adjacency.h), the shader being procedural, so a probe straddling a
+// chart border interpolates the surface's own values on both sides. Where no chart lies
+// across (a plane's rim, a pole, the outer edge of an n-gon's sub-face) the coordinate
+// clamps to the edge.
 //
 // Prefiltering: point-sampled coarse levels alias high-frequency patterns; with
 // `Prefilter::Box` a texel of level L > 0 is the mean of the static program over a
@@ -29,6 +31,7 @@
 #include <span>
 #include <vector>
 
+#include "geometry/chart_adjacency.h"
 #include "geometry/surface.h"
 #include "shading/interpreter.h"
 
@@ -44,6 +47,7 @@ struct ShaderMapOptions {
     Prefilter prefilter = Prefilter::Box;
     int supersampleLimit = 4;      // at most k x k program samples per texel when prefiltering
     int alwaysResidentLevels = 6;  // 1x1 .. 32x32 per chart, filled at construction
+    bool seamless = true;          // borders from the neighbouring chart; false: clamp to edge
 };
 
 // A tile: chart, level, and tile column and row within the level.
@@ -120,6 +124,7 @@ class ShaderMap {
     void fillTile(const TileKey& key, int slot, std::vector<float>& scratch, FillStats& stats);
 
     const Surface& surface_;
+    std::unique_ptr<ChartAdjacency> adjacency_;
     const ShaderKernel& kernel_;
     ShadingUniforms uniforms_;
     ShaderMapOptions options_;

@@ -8,7 +8,9 @@
 #include "shadermaps/half_float.h"
 #include "shadermaps/probe.h"
 #include "shading/factoring.h"
+#include "shading/noise.h"
 #include "shading/shader_compiler.h"
+#include "test_support.h"
 
 namespace mpshade {
 namespace {
@@ -195,6 +197,50 @@ TEST(ShaderMap, HalfPrecisionErrorIsBounded) {
                 ASSERT_LE(std::fabs(x[c] - y[c]),
                           std::ldexp(std::fabs(x[c]), -11) + std::ldexp(1.0f, -25));
         }
+}
+
+TEST(ShaderMap, NoSeamsAcrossChartEdges) {
+    // Bilinear probes between a chart's last texel centre and its edge interpolate towards
+    // the border texel: evaluated on the neighbouring chart it continues the function;
+    // clamped to the edge it does not. Compare both with direct evaluation.
+    const Surface vase =
+        SubdivSurface(loadObjCage(test::sourcePath("examples/vase/meshes/vase.obj")),
+                      SubdivScheme::Catmark, "vase");
+    auto ast = compileShaderText(
+        "seam.sl", "surface seam() { Ci = color(noise(P * 3), fbm(P * 2, 2), 0) * (1 + time); }");
+    const FactoredShader f = factorShader(*ast, {});
+    const ShaderKernel kernel(f.staticPart);
+    ShaderMapOptions seamless, clamped;
+    seamless.resolution = clamped.resolution = 16;
+    clamped.seamless = false;
+    ShaderMap a(vase, kernel, {}, seamless), b(vase, kernel, {}, clamped);
+    a.fillLevels(0, 0);
+    b.fillLevels(0, 0);
+    ProbeOptions probe;
+    probe.filter = ProbeFilter::Trilinear;
+    const ChartAdjacency adjacency(vase);
+    double errSeamless = 0.0, errClamped = 0.0;
+    int n = 0;
+    for (int chart = 0; chart < 88; ++chart) {
+        if (adjacency.link(chart, 1).chart < 0) continue;
+        for (float along = 0.1f; along < 0.9f; along += 0.1f) {
+            const float u = 1.0f - 0.1f / 16.0f;  // beyond the last texel centre, towards the edge
+            const ProbeQuery q{chart, u, along, 0, 0, 0, 0};
+            float x[2], y[2];
+            probeShaderMap(a, probe, {&q, 1}, x);
+            probeShaderMap(b, probe, {&q, 1}, y);
+            // Direct: the static program's first channel at that point.
+            const SurfaceSample g = evaluate(vase, {chart, u, along});
+            const float truth0 = noise3(3 * g.P.x, 3 * g.P.y, 3 * g.P.z);
+            errSeamless += std::fabs(x[0] - truth0);
+            errClamped += std::fabs(y[0] - truth0);
+            ++n;
+        }
+    }
+    ASSERT_GT(n, 300);
+    EXPECT_LT(errSeamless, 0.6 * errClamped) << errSeamless / n << " vs " << errClamped / n;
+    RecordProperty("edge_error_seamless", std::to_string(errSeamless / n));
+    RecordProperty("edge_error_clamped", std::to_string(errClamped / n));
 }
 
 TEST(HalfFloat, RoundTripsAndRoundsToNearest) {
