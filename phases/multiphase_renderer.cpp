@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 
 #include "scene/variability.h"
+#include "shading/shading_batch.h"
 
 namespace mpshade {
 namespace {
@@ -55,45 +56,17 @@ bool isOpaque(const IrProgram& dynamicPart) {
     return true;
 }
 
-// Shading inputs in structure of arrays, sized for one chunk of points: 22 input rows
-// (P N Ng dPdu dPdv I u v s t), 6 output rows, and the n-tuple.
+// Per-thread scratch for one chunk of points: the shading batch, probe queries and results.
 struct ChunkBuffers {
-    std::vector<float> rows;
-    std::vector<float> channelData;
-    std::vector<const float*> channelIn;
-    std::vector<float*> channelOut;
-    std::vector<float> workspace;
-    ShadingCounters counters;
-    ShadingInputs in;
-    ShadingOutputs out;
-
+    ShadingBatch batch;
     std::vector<ProbeQuery> queries;
     std::vector<float> probed;
+    std::vector<float> workspace;
 
     void prepare(size_t n, size_t channels) {
-        rows.resize(28 * n);
+        batch.resize(n, channels);
         queries.resize(n);
-        channelData.resize(std::max<size_t>(channels, 1) * n);
-        channelIn.resize(channels);
-        channelOut.resize(channels);
-        auto row = [&](int r) { return rows.data() + static_cast<size_t>(r) * n; };
-        for (int k = 0; k < 3; ++k) {
-            in.P[k] = row(0 + k);
-            in.N[k] = row(3 + k);
-            in.Ng[k] = row(6 + k);
-            in.dPdu[k] = row(9 + k);
-            in.dPdv[k] = row(12 + k);
-            in.I[k] = row(15 + k);
-            out.Ci[k] = row(22 + k);
-            out.Oi[k] = row(25 + k);
-        }
-        in.u = row(18), in.v = row(19), in.s = row(20), in.t = row(21);
-        for (size_t c = 0; c < channels; ++c)
-            channelOut[c] = channelData.data() + c * n, channelIn[c] = channelOut[c];
-        in.channels = channelIn.data();
-        out.channels = channelOut.data();
     }
-    float* row(int r, size_t n) { return rows.data() + static_cast<size_t>(r) * n; }
 };
 
 constexpr size_t kChunk = 1024;
@@ -205,24 +178,20 @@ void MultiphaseRenderer::staticPhase(size_t index, const ObjectState& state,
             const SurfaceSample& g = diced.attributeGeometry[begin + i];
             const ChartPoint& at = diced.attributePoints[begin + i];
             const glm::vec3 I = glm::normalize(g.P - state.eye);
-            const float values[22] = {g.P.x,    g.P.y,    g.P.z,    g.N.x,    g.N.y,    g.N.z,
-                                      g.Ng.x,   g.Ng.y,   g.Ng.z,   g.dPdu.x, g.dPdu.y, g.dPdu.z,
-                                      g.dPdv.x, g.dPdv.y, g.dPdv.z, I.x,      I.y,      I.z,
-                                      at.u,     at.v,     g.s,      g.t};
-            for (int r = 0; r < 22; ++r) b.row(r, m)[i] = values[r];
+            b.batch.setPoint(i, g, at, I);
             for (int row : obj.geometryRows) {
-                // VertexAttributes rows follow the same order as the first 15 shading rows,
-                // then u v s t (shading rows 18..21).
+                // VertexAttributes rows follow the shading batch's first 15 rows, then
+                // u v s t (the batch's rows U..T, after I).
                 const int src = row < VertexAttributes::U ? row : row + 3;
-                attr.rows[static_cast<size_t>(row)][begin + i] = values[src];
+                attr.rows[static_cast<size_t>(row)][begin + i] = b.batch.row(src)[i];
             }
         }
         if (obj.useMap) return;  // the n-tuple lives in the shader map
         ShadingCounters counters;
-        obj.staticKernel->run(uniforms, b.in, m, b.out, b.workspace, counters);
+        obj.staticKernel->run(uniforms, b.batch.in, m, b.batch.out, b.workspace, counters);
         instructions += counters.instructions;
         for (size_t c = 0; c < channels; ++c)
-            std::copy(b.channelOut[c], b.channelOut[c] + m,
+            std::copy(b.batch.out.channels[c], b.batch.out.channels[c] + m,
                       attr.rows[VertexAttributes::kGeometryRows + c].begin() + begin);
     });
     if (obj.useMap) {
@@ -391,13 +360,13 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
             };
             for (int row : obj.geometryRows) {
                 const int dst = row < VertexAttributes::U ? row : row + 3;
-                b.row(dst, m)[i] = lerp(attr.rows[static_cast<size_t>(row)]);
+                b.batch.row(dst)[i] = lerp(attr.rows[static_cast<size_t>(row)]);
             }
             // P for I: interpolated from the facet's own vertex positions when the dynamic
             // part does not read P itself.
             glm::vec3 P;
             if (!attr.rows[VertexAttributes::Px].empty()) {
-                P = glm::vec3(b.row(0, m)[i], b.row(1, m)[i], b.row(2, m)[i]);
+                P = glm::vec3(b.batch.row(0)[i], b.batch.row(1)[i], b.batch.row(2)[i]);
             } else {
                 const uint32_t* p = &mesh.positionIndex[3 * static_cast<size_t>(f.facet)];
                 P = w0 * mesh.format.dequantize(mesh.qx[p[0]], mesh.qy[p[0]], mesh.qz[p[0]]) +
@@ -405,13 +374,13 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
                     f.b2 * mesh.format.dequantize(mesh.qx[p[2]], mesh.qy[p[2]], mesh.qz[p[2]]);
             }
             if (!attr.rows[VertexAttributes::Nx].empty()) {
-                glm::vec3 N(b.row(3, m)[i], b.row(4, m)[i], b.row(5, m)[i]);
+                glm::vec3 N(b.batch.row(3)[i], b.batch.row(4)[i], b.batch.row(5)[i]);
                 const float len = glm::length(N);
                 if (len > 0.0f) N /= len;
-                b.row(3, m)[i] = N.x, b.row(4, m)[i] = N.y, b.row(5, m)[i] = N.z;
+                b.batch.row(3)[i] = N.x, b.batch.row(4)[i] = N.y, b.batch.row(5)[i] = N.z;
             }
             const glm::vec3 I = glm::normalize(P - eye);
-            b.row(15, m)[i] = I.x, b.row(16, m)[i] = I.y, b.row(17, m)[i] = I.z;
+            b.batch.row(15)[i] = I.x, b.batch.row(16)[i] = I.y, b.batch.row(17)[i] = I.z;
             if (obj.useMap) {
                 // (chart, u, v) at the sample, and its screen derivatives from the facet's
                 // own gradient (facets are sub-pixel: affine is exact enough).
@@ -441,7 +410,8 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
                 }
             } else {
                 for (size_t ch = 0; ch < channels; ++ch)
-                    b.channelOut[ch][i] = lerp(attr.rows[VertexAttributes::kGeometryRows + ch]);
+                    b.batch.out.channels[ch][i] =
+                        lerp(attr.rows[VertexAttributes::kGeometryRows + ch]);
             }
         }
         if (obj.useMap && channels > 0) {
@@ -449,20 +419,23 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
             probeShaderMap(*obj.map, options_.probe, {b.queries.data(), m}, b.probed.data());
             for (size_t i = 0; i < m; ++i)
                 for (size_t ch = 0; ch < channels; ++ch)
-                    b.channelOut[ch][i] = b.probed[i * channels + ch];
+                    b.batch.out.channels[ch][i] = b.probed[i * channels + ch];
         }
         ShadingCounters counters;
-        obj.dynamicKernel->run(uniforms[chunk.object], b.in, m, b.out, b.workspace, counters);
+        obj.dynamicKernel->run(uniforms[chunk.object], b.batch.in, m, b.batch.out, b.workspace,
+                               counters);
         instructions.local() += counters.instructions;
         for (size_t i = 0; i < m; ++i) {
             const size_t slot = order[chunk.begin + i];
             bool finite = true;
             for (int k = 0; k < 3; ++k)
-                finite = finite && std::isfinite(b.out.Ci[k][i]) && std::isfinite(b.out.Oi[k][i]);
+                finite = finite && std::isfinite(b.batch.out.Ci[k][i]) &&
+                         std::isfinite(b.batch.out.Oi[k][i]);
             if (!finite) ++nonFinite.local();
             for (int k = 0; k < 3; ++k) {
-                color[3 * slot + k] = finite ? b.out.Ci[k][i] : 0.0f;
-                opacity[3 * slot + k] = finite ? std::clamp(b.out.Oi[k][i], 0.0f, 1.0f) : 1.0f;
+                color[3 * slot + k] = finite ? b.batch.out.Ci[k][i] : 0.0f;
+                opacity[3 * slot + k] =
+                    finite ? std::clamp(b.batch.out.Oi[k][i], 0.0f, 1.0f) : 1.0f;
             }
         }
     });

@@ -8,7 +8,9 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+
 #include <glm/geometric.hpp>
+#include "shading/shading_batch.h"
 
 namespace mpshade {
 namespace {
@@ -35,13 +37,11 @@ struct Scratch {
     std::vector<ChartPoint> chart;
     std::vector<SurfaceSample> geom;
     std::vector<uint32_t> hitOfPoint;
-    std::vector<float> soa;        // shading inputs and outputs, structure of arrays
+    std::vector<glm::vec3> viewDir;  // per point: unit ray direction, object space
+    ShadingBatch batch;
     std::vector<float> workspace;  // interpreter registers
     FrameStats counters;
 };
-
-// Shading input/output arrays carved from one buffer: 24 input rows + 6 output rows.
-constexpr int kSoaRows = 30;
 
 }  // namespace
 
@@ -161,10 +161,7 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
                 const SurfaceRayScene& rs = *res.rayScene;
                 s.chart.clear();
                 s.hitOfPoint.clear();
-                std::vector<float>& soa = s.soa;
-                const size_t m = end - begin;
-                soa.resize(kSoaRows * m);
-                auto row = [&](int r) { return soa.data() + static_cast<size_t>(r) * m; };
+                s.viewDir.clear();
                 for (size_t h = begin; h < end; ++h) {
                     Hit& hit = s.hits[h];
                     const PendingRay& pr = s.active[hit.ray];
@@ -175,44 +172,21 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
                     if (!rs.resolveHit(hit.geomID, hit.primID, hit.u, hit.v, hit.t, org, dir, sh))
                         continue;
                     hit.t = sh.t;
-                    const size_t p = s.chart.size();
                     s.chart.push_back(sh.at);
                     s.hitOfPoint.push_back(static_cast<uint32_t>(h));
-                    const glm::vec3 I = glm::normalize(dir);
-                    row(15)[p] = I.x, row(16)[p] = I.y, row(17)[p] = I.z;
+                    s.viewDir.push_back(glm::normalize(dir));
                 }
                 const size_t points = s.chart.size();
                 s.geom.resize(points);
                 evaluateBatch(rs.surface(), s.chart,
                               std::span<SurfaceSample>(s.geom.data(), points));
-                for (size_t p = 0; p < points; ++p) {
-                    const SurfaceSample& g = s.geom[p];
-                    for (int k = 0; k < 3; ++k) {
-                        row(0 + k)[p] = g.P[k];
-                        row(3 + k)[p] = g.N[k];
-                        row(6 + k)[p] = g.Ng[k];
-                        row(9 + k)[p] = g.dPdu[k];
-                        row(12 + k)[p] = g.dPdv[k];
-                    }
-                    row(18)[p] = s.chart[p].u;
-                    row(19)[p] = s.chart[p].v;
-                    row(20)[p] = g.s;
-                    row(21)[p] = g.t;
-                }
-                ShadingInputs in;
-                for (int k = 0; k < 3; ++k) {
-                    in.P[k] = row(0 + k);
-                    in.N[k] = row(3 + k);
-                    in.Ng[k] = row(6 + k);
-                    in.dPdu[k] = row(9 + k);
-                    in.dPdv[k] = row(12 + k);
-                    in.I[k] = row(15 + k);
-                }
-                in.u = row(18), in.v = row(19), in.s = row(20), in.t = row(21);
-                ShadingOutputs out;
-                for (int k = 0; k < 3; ++k) out.Ci[k] = row(24 + k), out.Oi[k] = row(27 + k);
+                ShadingBatch& batch = s.batch;
+                batch.resize(points, 0);
+                for (size_t p = 0; p < points; ++p)
+                    batch.setPoint(p, s.geom[p], s.chart[p], s.viewDir[p]);
+                const ShadingOutputs& out = batch.out;
                 ShadingCounters counters;
-                res.kernel->run(uniforms[objIndex], in, points, out, s.workspace, counters);
+                res.kernel->run(uniforms[objIndex], batch.in, points, out, s.workspace, counters);
                 s.counters.shaderInstructions += counters.instructions;
                 s.counters.shadedPoints += counters.points;
                 s.counters.occlusionRays += counters.occlusionRays;

@@ -80,8 +80,7 @@ void ShaderMap::texel(const TileKey& key, int slot, int i, int j, float* out) co
     }
 }
 
-void ShaderMap::fillTile(const TileKey& key, int slot, std::vector<float>& scratch,
-                         FillStats& stats) {
+void ShaderMap::fillTile(const TileKey& key, int slot, ShadingBatch& scratch, FillStats& stats) {
     const int res = resolution(key.level);
     const int k = options_.prefilter == Prefilter::Box
                       ? std::min(1 << key.level, options_.supersampleLimit)
@@ -117,35 +116,17 @@ void ShaderMap::fillTile(const TileKey& key, int slot, std::vector<float>& scrat
         }
     std::vector<SurfaceSample> geometry(n);
     evaluateBatch(surface_, points, geometry);
-    // Structure of arrays for the static program: 22 input rows, then the channels.
-    scratch.resize(n * static_cast<size_t>(22 + channels_ + 6));
-    auto row = [&](int r) { return scratch.data() + static_cast<size_t>(r) * n; };
-    for (size_t s = 0; s < n; ++s) {
-        const SurfaceSample& g = geometry[s];
-        const glm::vec3 toP = g.P - uniforms_.eye;
+    scratch.resize(n, static_cast<size_t>(channels_));
+    for (size_t i = 0; i < n; ++i) {
+        const glm::vec3 toP = geometry[i].P - uniforms_.eye;
         const float len = std::sqrt(toP.x * toP.x + toP.y * toP.y + toP.z * toP.z);
-        const glm::vec3 I = len > 0.0f ? toP / len : glm::vec3(0.0f, 0.0f, -1.0f);
-        const float values[22] = {g.P.x,       g.P.y,       g.P.z,    g.N.x,    g.N.y,    g.N.z,
-                                  g.Ng.x,      g.Ng.y,      g.Ng.z,   g.dPdu.x, g.dPdu.y, g.dPdu.z,
-                                  g.dPdv.x,    g.dPdv.y,    g.dPdv.z, I.x,      I.y,      I.z,
-                                  points[s].u, points[s].v, g.s,      g.t};
-        for (int r = 0; r < 22; ++r) row(r)[s] = values[r];
+        scratch.setPoint(i, geometry[i], points[i],
+                         len > 0.0f ? toP / len : glm::vec3(0.0f, 0.0f, -1.0f));
     }
-    ShadingInputs in;
-    for (int c = 0; c < 3; ++c) {
-        in.P[c] = row(0 + c), in.N[c] = row(3 + c), in.Ng[c] = row(6 + c);
-        in.dPdu[c] = row(9 + c), in.dPdv[c] = row(12 + c), in.I[c] = row(15 + c);
-    }
-    in.u = row(18), in.v = row(19), in.s = row(20), in.t = row(21);
-    std::vector<float*> channelOut(static_cast<size_t>(channels_));
-    for (int c = 0; c < channels_; ++c) channelOut[static_cast<size_t>(c)] = row(22 + c);
-    ShadingOutputs out;
-    for (int c = 0; c < 3; ++c)
-        out.Ci[c] = row(22 + channels_ + c), out.Oi[c] = row(25 + channels_ + c);
-    out.channels = channelOut.data();
     std::vector<float> workspace;
     ShadingCounters counters;
-    kernel_.run(uniforms_, in, n, out, workspace, counters);
+    kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters);
+    float* const* channelOut = scratch.out.channels;
     // Box-average the supersamples of each texel into the tile, channel-interleaved.
     const size_t base =
         static_cast<size_t>(slot) * static_cast<size_t>(texels) * static_cast<size_t>(channels_);
@@ -190,7 +171,7 @@ void ShaderMap::fill(std::span<const TileKey> keys) {
         halfData_.resize(residentTiles_ * perTile);
     else
         data_.resize(residentTiles_ * perTile);
-    tbb::enumerable_thread_specific<std::vector<float>> scratch;
+    tbb::enumerable_thread_specific<ShadingBatch> scratch;
     tbb::enumerable_thread_specific<FillStats> stats;
     tbb::parallel_for(size_t{0}, work.size(), [&](size_t w) {
         enableFlushToZero();

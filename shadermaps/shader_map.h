@@ -34,6 +34,7 @@
 #include "geometry/chart_adjacency.h"
 #include "geometry/surface.h"
 #include "shading/interpreter.h"
+#include "shading/shading_batch.h"
 
 namespace mpshade {
 
@@ -121,7 +122,7 @@ class ShaderMap {
 
   private:
     size_t tileIndex(const TileKey& key) const;
-    void fillTile(const TileKey& key, int slot, std::vector<float>& scratch, FillStats& stats);
+    void fillTile(const TileKey& key, int slot, ShadingBatch& scratch, FillStats& stats);
 
     const Surface& surface_;
     std::unique_ptr<ChartAdjacency> adjacency_;
