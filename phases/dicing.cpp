@@ -362,7 +362,28 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
             out.positionOf.push_back(k < boundary ? welder.weld(samples[k].P)
                                                   : welder.addUnwelded(samples[k].P));
         }
+        FacetCluster cluster;
+        cluster.firstFacet = static_cast<uint32_t>(out.triangles.size() / 3);
         for (int f : facets) out.triangles.push_back(base + static_cast<uint32_t>(f));
+        cluster.facetCount = static_cast<uint32_t>(out.triangles.size() / 3) - cluster.firstFacet;
+        // Bounding sphere and normal cone of the patch's vertices (geometric normals).
+        Bounds3 box;
+        glm::vec3 axis(0.0f);
+        for (size_t k = 0; k < n; ++k) box.extend(samples[k].P), axis += samples[k].Ng;
+        cluster.center = box.center();
+        for (size_t k = 0; k < n; ++k)
+            cluster.radius = std::max(cluster.radius, glm::length(samples[k].P - cluster.center));
+        const float axisLength = glm::length(axis);
+        if (axisLength > 0.0f) {
+            cluster.coneAxis = axis / axisLength;
+            float minCos = 1.0f;
+            for (size_t k = 0; k < n; ++k)
+                minCos = std::min(minCos, glm::dot(samples[k].Ng, cluster.coneAxis));
+            // Facets are chords between the vertices: allow a little more than the vertices'
+            // own normals span.
+            cluster.coneHalfAngle = std::acos(std::clamp(minCos, -1.0f, 1.0f)) + 0.05f;
+        }
+        out.clusters.push_back(cluster);
     }
     return out;
 }

@@ -58,8 +58,9 @@ struct DicedSurface {
     std::vector<uint16_t> qx, qy, qz;
     std::vector<ChartPoint> attributePoints;  // one per attribute vertex
     std::vector<SurfaceSample> attributeGeometry;
-    std::vector<uint32_t> positionOf;  // attribute vertex -> position
-    std::vector<uint32_t> triangles;   // attribute vertex indices, 3 per facet
+    std::vector<uint32_t> positionOf;    // attribute vertex -> position
+    std::vector<uint32_t> triangles;     // attribute vertex indices, 3 per facet
+    std::vector<FacetCluster> clusters;  // one per tessellated patch
     int charts = 0, patches = 0, culledCharts = 0,
         cappedCharts = 0;    // culled and capped count patches
     int frustumCulled = 0;   // patches outside every view of the range

@@ -67,6 +67,16 @@ struct VertexAttributes {
     size_t count = 0;
 };
 
+// A patch's facets: a contiguous facet range with an object-space bounding sphere and a
+// cone containing its normals, so a frame can skip it whole (off screen, or facing away).
+struct FacetCluster {
+    uint32_t firstFacet = 0, facetCount = 0;
+    glm::vec3 center{0.0f};
+    float radius = 0.0f;
+    glm::vec3 coneAxis{0.0f, 0.0f, 1.0f};
+    float coneHalfAngle = 4.0f;  // radians; > pi: no useful cone
+};
+
 struct FacetMesh {
     FixedPointFormat format;
     // Shared positions, quantized, structure of arrays.
@@ -76,6 +86,7 @@ struct FacetMesh {
     std::vector<uint32_t> attributeIndex;
     VertexAttributes attributes;
     std::vector<ChartPoint> attributeChartPoint;  // where each attribute vertex lies
+    std::vector<FacetCluster> clusters;           // cover every facet, in order
 
     // The data block (claim 25): the viewpoint the facets were made for, the range of
     // viewpoints they stay valid for, and the dynamic shader to run on them.

@@ -89,13 +89,30 @@ void rasterizeFacets(const std::vector<RasterObject>& objects, const SampleBuffe
     // so the facet order, and the image, do not depend on scheduling.
     struct FacetRange {
         uint32_t object;
-        size_t begin, end;
+        size_t begin, end;                // facets
+        size_t clusterBegin, clusterEnd;  // clusters covering them (empty: none)
     };
     constexpr size_t kFacetsPerChunk = 1 << 16;
     std::vector<FacetRange> ranges;
-    for (uint32_t o = 0; o < objects.size(); ++o)
-        for (size_t f = 0; f < objects[o].mesh->facetCount(); f += kFacetsPerChunk)
-            ranges.push_back({o, f, std::min(f + kFacetsPerChunk, objects[o].mesh->facetCount())});
+    for (uint32_t o = 0; o < objects.size(); ++o) {
+        const FacetMesh& mesh = *objects[o].mesh;
+        if (mesh.clusters.empty()) {
+            for (size_t f = 0; f < mesh.facetCount(); f += kFacetsPerChunk)
+                ranges.push_back({o, f, std::min(f + kFacetsPerChunk, mesh.facetCount()), 0, 0});
+            continue;
+        }
+        // Whole clusters per chunk, so a culled cluster is skipped in one step.
+        size_t first = 0;
+        while (first < mesh.clusters.size()) {
+            size_t last = first, facets = 0;
+            while (last < mesh.clusters.size() &&
+                   (last == first || facets + mesh.clusters[last].facetCount <= kFacetsPerChunk))
+                facets += mesh.clusters[last++].facetCount;
+            ranges.push_back({o, mesh.clusters[first].firstFacet,
+                              mesh.clusters[first].firstFacet + facets, first, last});
+            first = last;
+        }
+    }
     std::vector<std::vector<std::vector<Binned>>> chunkBins(ranges.size());
     std::vector<RasterStats> chunkStats(ranges.size());
     tbb::parallel_for(size_t{0}, ranges.size(), [&](size_t c) {
@@ -106,24 +123,45 @@ void rasterizeFacets(const std::vector<RasterObject>& objects, const SampleBuffe
         bins.resize(tileCount);
         RasterStats& st = chunkStats[c];
         st.facets = range.end - range.begin;
-        for (size_t f = range.begin; f < range.end; ++f) {
+        auto binFacet = [&](size_t f) {
             const uint32_t* p = &mesh.positionIndex[3 * f];
             if (w.culled[p[0]] | w.culled[p[1]] | w.culled[p[2]]) {
                 ++st.facetsCulled;
-                continue;
+                return;
             }
             const int64_t area = int64_t(w.x[p[1]] - w.x[p[0]]) * (w.y[p[2]] - w.y[p[0]]) -
                                  int64_t(w.y[p[1]] - w.y[p[0]]) * (w.x[p[2]] - w.x[p[0]]);
             if (area == 0) {
                 ++st.facetsDegenerate;
-                continue;
+                return;
+            }
+            // Facets wind counter-clockwise about their normal; the screen's y points down,
+            // so a facet seen from the front has negative area here.
+            if (objects[range.object].cullBackFaces && area > 0) {
+                ++st.facetsBackFacing;
+                return;
             }
             PixelBox box;
-            if (!facetBox(w, p, width, height, box)) continue;
+            if (!facetBox(w, p, width, height, box)) return;
             for (int ty = box.y0 / tile; ty <= box.y1 / tile; ++ty)
                 for (int tx = box.x0 / tile; tx <= box.x1 / tile; ++tx)
                     bins[static_cast<size_t>(ty) * tilesX + tx].push_back(
                         {range.object, static_cast<uint32_t>(f)});
+        };
+        const uint8_t* visible = objects[range.object].clusterVisible;
+        if (range.clusterEnd > range.clusterBegin) {
+            for (size_t k = range.clusterBegin; k < range.clusterEnd; ++k) {
+                const FacetCluster& cluster = mesh.clusters[k];
+                if (visible && !visible[k]) {
+                    st.facetsInCulledClusters += cluster.facetCount;
+                    continue;
+                }
+                for (size_t f = cluster.firstFacet; f < cluster.firstFacet + cluster.facetCount;
+                     ++f)
+                    binFacet(f);
+            }
+        } else {
+            for (size_t f = range.begin; f < range.end; ++f) binFacet(f);
         }
     });
 
@@ -209,6 +247,8 @@ void rasterizeFacets(const std::vector<RasterObject>& objects, const SampleBuffe
         stats.facets += s.facets;
         stats.facetsCulled += s.facetsCulled;
         stats.facetsDegenerate += s.facetsDegenerate;
+        stats.facetsBackFacing += s.facetsBackFacing;
+        stats.facetsInCulledClusters += s.facetsInCulledClusters;
     }
     for (const RasterStats& s : tileStats) {
         stats.facetsBinned += s.facetsBinned;

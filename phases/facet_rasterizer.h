@@ -38,15 +38,22 @@ struct RasterObject {
     const FacetMesh* mesh = nullptr;
     const WarpedVertices* warped = nullptr;
     bool opaque = true;
+    // Skip facets that face away from the eye: only for closed, opaque surfaces, whose
+    // back faces are always behind a front face.
+    bool cullBackFaces = false;
+    // Per cluster of the mesh: 0 skips the cluster's facets entirely (null: all visible).
+    const uint8_t* clusterVisible = nullptr;
 };
 
 struct RasterStats {
     uint64_t facets = 0;            // offered
     uint64_t facetsCulled = 0;      // a vertex behind the near plane or outside the guard band
     uint64_t facetsDegenerate = 0;  // zero area on the sub-pixel grid
-    uint64_t facetsBinned = 0;      // facet-tile pairs rasterized
-    uint64_t fragments = 0;         // sample hits kept or tested into the k-buffer
-    uint64_t droppedLayers = 0;     // translucent fragments beyond the k-buffer's depth
+    uint64_t facetsBackFacing = 0;  // culled as back faces of closed opaque surfaces
+    uint64_t facetsInCulledClusters = 0;  // skipped with their whole cluster
+    uint64_t facetsBinned = 0;            // facet-tile pairs rasterized
+    uint64_t fragments = 0;               // sample hits kept or tested into the k-buffer
+    uint64_t droppedLayers = 0;           // translucent fragments beyond the k-buffer's depth
 };
 
 struct RasterOptions {

@@ -71,6 +71,38 @@ struct ChunkBuffers {
 
 constexpr size_t kChunk = 1024;
 
+// Per cluster: whether any of it can be seen this frame. Off screen: its bounding sphere is
+// wholly outside a side plane or in front of the near plane. Facing away: every normal of
+// its cone points away from the eye for every point of its sphere (normal-cone culling).
+std::vector<uint8_t> clusterVisibility(const FacetMesh& mesh, const ObjectState& state,
+                                       const CameraState& camera, bool backFaces) {
+    const float tx = camera.tanHalfFovY * camera.aspect, ty = camera.tanHalfFovY;
+    const glm::vec3 planes[4] = {glm::normalize(camera.right - tx * camera.forward),
+                                 glm::normalize(-camera.right - tx * camera.forward),
+                                 glm::normalize(camera.up - ty * camera.forward),
+                                 glm::normalize(-camera.up - ty * camera.forward)};
+    std::vector<uint8_t> visible(mesh.clusters.size(), 1);
+    for (size_t k = 0; k < mesh.clusters.size(); ++k) {
+        const FacetCluster& c = mesh.clusters[k];
+        const glm::vec3 d = glm::vec3(state.objectToWorld * glm::vec4(c.center, 1.0f)) - camera.eye;
+        const float r = c.radius * state.scale;
+        bool out = glm::dot(d, camera.forward) < camera.zNear - r;
+        for (const glm::vec3& n : planes) out = out || glm::dot(d, n) > r;
+        if (!out && backFaces && c.coneHalfAngle < 1.5f) {
+            const glm::vec3 toCluster = c.center - state.eye;  // object space
+            const float distance = glm::length(toCluster);
+            if (distance > c.radius) {
+                const float spread =
+                    c.coneHalfAngle + std::asin(std::min(1.0f, c.radius / distance));
+                out = spread < 1.5707963f &&
+                      glm::dot(c.coneAxis, toCluster / distance) > std::sin(spread);
+            }
+        }
+        visible[k] = out ? 0 : 1;
+    }
+    return visible;
+}
+
 }  // namespace
 
 struct MultiphaseRenderer::ObjectData {
@@ -84,6 +116,7 @@ struct MultiphaseRenderer::ObjectData {
     // The separate representation (scene option "representation": "shadermap"): the
     // n-tuple comes from probes of a shader map, not from the facets' vertices.
     bool useMap = false;
+    bool closed = false;  // the surface bounds a solid
     std::unique_ptr<ShaderMap> map;
     std::vector<LightSample> mapLights;  // the static phase's uniforms, kept for the map
     std::vector<float> mapParams;
@@ -98,6 +131,7 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
         data->dynamicKernel = std::make_unique<ShaderKernel>(data->factored.dynamicPart);
         data->opaque = isOpaque(data->factored.dynamicPart);
         data->useMap = obj.representation == Representation::ShaderMap;
+        data->closed = isClosed(*obj.surface);
         for (const Inst& inst : data->factored.dynamicPart.insts) {
             if (inst.op != Op::Global) continue;
             const int row = rowOf(static_cast<GlobalId>(inst.imm));
@@ -148,6 +182,7 @@ void MultiphaseRenderer::staticPhase(size_t index, const ObjectState& state,
     for (size_t k = 0; k < diced.triangles.size(); ++k)
         mesh->positionIndex[k] = diced.positionOf[diced.triangles[k]];
     mesh->attributeChartPoint = diced.attributePoints;
+    mesh->clusters = diced.clusters;
     mesh->representativeEye = state.eye;
     mesh->representativeForward = view.forward;
     mesh->frustumCulled = options_.dicing.frustumCull;
@@ -289,8 +324,16 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
         const FixedPointWarp warp(states[i].objectToWorld, camera, mesh.format);
         warp.warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.positionCount(), warped[i]);
     });
+    // Whole clusters off screen, or facing away from the eye (closed opaque surfaces).
+    std::vector<std::vector<uint8_t>> visible(count);
+    tbb::parallel_for(size_t{0}, count, [&](size_t i) {
+        const FacetMesh& mesh = *objects_[i]->mesh;
+        const bool backFaces = objects_[i]->opaque && objects_[i]->closed;
+        visible[i] = clusterVisibility(mesh, states[i], camera, backFaces);
+    });
     for (size_t i = 0; i < count; ++i) {
-        raster[i] = {objects_[i]->mesh.get(), &warped[i], objects_[i]->opaque};
+        raster[i] = {objects_[i]->mesh.get(), &warped[i], objects_[i]->opaque,
+                     objects_[i]->opaque && objects_[i]->closed, visible[i].data()};
         stats.facets += objects_[i]->mesh->facetCount();
         stats.verticesWarped += objects_[i]->mesh->positionCount();
         stats.facetBytes += objects_[i]->mesh->bytes();
