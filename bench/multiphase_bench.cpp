@@ -135,6 +135,9 @@ void facetsPerPixel(benchmark::State& state, const char* path) {
     state.counters["facets"] = static_cast<double>(visibleFacets);
     state.counters["covered_pixels"] = covered;
     state.counters["facets_per_covered_pixel"] = covered > 0 ? visibleFacets / covered : 0.0;
+    // After this frame's culling (back faces, clusters off screen or facing away): the
+    // facets the dynamic phase actually rasterized.
+    state.counters["rasterized_per_covered_pixel"] = covered > 0 ? stats.facetsRasterized / covered : 0.0;
 }
 
 BENCHMARK(warpFixed)->Name("Warp/fixed")->Unit(benchmark::kMillisecond);
