@@ -44,6 +44,15 @@ struct Prober {
                 }
                 continue;
             }
+            if (residency && residency->touched) {
+                const TileKey key = map.tileOf(static_cast<uint32_t>(chart), level, std::max(i0, 0),
+                                               std::max(j0, 0));
+                if (residency->touchedCount == 0 ||
+                    !(residency->touched[residency->touchedCount - 1] == key)) {
+                    if (residency->touchedCount < residency->touchedCapacity)
+                        residency->touched[residency->touchedCount++] = key;
+                }
+            }
             const float fx = x - fx0, fy = y - fy0;
             const size_t row = static_cast<size_t>(map.stride()) * static_cast<size_t>(channels);
             const size_t at = (static_cast<size_t>(lj) * static_cast<size_t>(map.stride()) +

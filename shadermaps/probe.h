@@ -19,7 +19,8 @@
 //
 // Residency: a probe never fills and never allocates. A bilinear probe whose tile is not
 // resident uses the finest resident coarser level, records the fallback, and reports the
-// tile it lacked into the caller's buffer (while it has room).
+// tile it lacked into the caller's buffer (while it has room); the tiles it did read go
+// to a second buffer, for the tile cache's recency.
 #pragma once
 
 #include <cstddef>
@@ -49,6 +50,9 @@ struct ProbeResidency {
     size_t count = 0;        // written to missing (duplicates possible)
     uint64_t fallbacks = 0;  // bilinear probes answered from a coarser level
     uint64_t bilinearProbes = 0;
+    TileKey* touched = nullptr;  // caller's buffer for the resident tiles read (for an LRU)
+    size_t touchedCapacity = 0;
+    size_t touchedCount = 0;  // written to touched; a tile read twice in a row is written once
 };
 
 // Writes queries.size() * map.channels() floats to out, query by query.

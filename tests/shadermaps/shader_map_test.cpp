@@ -158,13 +158,18 @@ TEST(ShaderMap, MissingTilesFallBackToCoarserLevels) {
     ProbeOptions probe;
     probe.filter = ProbeFilter::Trilinear;
     const ProbeQuery q = query(0.4f, 0.6f, 0.0f, 0.0f);
-    TileKey missing[8];
+    TileKey missing[8], touched[8];
     ProbeResidency residency{missing, 8};
+    residency.touched = touched;
+    residency.touchedCapacity = 8;
     float out[3], coarse[3];
     probeShaderMap(map, probe, {&q, 1}, out, &residency);
     EXPECT_GT(residency.fallbacks, 0u);
     ASSERT_GT(residency.count, 0u);
     EXPECT_EQ(missing[0].level, 0);
+    // What was read: the 4x4 level's only tile (level 6 of 256).
+    ASSERT_EQ(residency.touchedCount, 1u);
+    EXPECT_EQ(touched[0].level, 6);
     // The answer is the 4x4 level's bilinear value.
     const ProbeQuery wide = query(0.4f, 0.6f, 64.0f / 256.0f, 64.0f / 256.0f);
     probeShaderMap(map, probe, {&wide, 1}, coarse);
@@ -172,8 +177,12 @@ TEST(ShaderMap, MissingTilesFallBackToCoarserLevels) {
     // Filling what was missing removes the fallback.
     map.fill({missing, residency.count});
     ProbeResidency again{missing, 8};
+    again.touched = touched;
+    again.touchedCapacity = 8;
     probeShaderMap(map, probe, {&q, 1}, out, &again);
     EXPECT_EQ(again.fallbacks, 0u);
+    ASSERT_EQ(again.touchedCount, 1u);
+    EXPECT_EQ(touched[0].level, 0);
 }
 
 TEST(ShaderMap, HalfPrecisionErrorIsBounded) {
