@@ -19,6 +19,7 @@ struct Prober {
     int runtimeChannels;
     int maxLevel;
     static constexpr bool kFixed = kChannels > 0;
+    static constexpr int kArr = kFixed ? kChannels : kMaxChannels;
 
     // Bilinear probe of level `level` at chart (u, v), falling back to coarser resident levels.
     void bilinear(int chart, int level, float u, float v, float* out) const {
@@ -88,7 +89,7 @@ struct Prober {
         if (lod >= static_cast<float>(maxLevel)) return bilinear(chart, maxLevel, u, v, out);
         const int l0 = static_cast<int>(lod);
         const float t = lod - static_cast<float>(l0);
-        float a[kMaxChannels], b[kMaxChannels];
+        float a[kArr], b[kArr];
         bilinear(chart, l0, u, v, a);
         bilinear(chart, l0 + 1, u, v, b);
         for (int c = 0; c < channels; ++c) out[c] = a[c] + t * (b[c] - a[c]);
@@ -123,9 +124,9 @@ struct Prober {
         const int s1 = static_cast<int>(std::floor(s + 2.0f * invDet * uSqrt));
         const int t0 = static_cast<int>(std::ceil(t - 2.0f * invDet * vSqrt));
         const int t1 = static_cast<int>(std::floor(t + 2.0f * invDet * vSqrt));
-        double sum[kMaxChannels] = {};
+        double sum[kArr] = {};
         double weight = 0.0;
-        float texel[kMaxChannels];
+        float texel[kArr];
         for (int it = t0; it <= t1; ++it) {
             const float tt = static_cast<float>(it) - t;
             for (int is = s0; is <= s1; ++is) {
@@ -224,7 +225,7 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
             }
             const float lod = std::clamp(std::log2(f.minor), 0.0f, static_cast<float>(p.maxLevel));
             const int l0 = static_cast<int>(lod);
-            float a[kMaxChannels], b[kMaxChannels];
+            float a[Prober<C>::kArr], b[Prober<C>::kArr];
             p.ewaLevel(q.chart, l0, q.u, q.v, f.ax, f.ay, f.bx, f.by, a);
             if (l0 < p.maxLevel && lod > static_cast<float>(l0)) {
                 p.ewaLevel(q.chart, l0 + 1, q.u, q.v, f.ax, f.ay, f.bx, f.by, b);
@@ -258,7 +259,7 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
         float w = std::exp(-gk * half * half);                              // at d = -half
         float ratioW = std::exp(-gk * (step * step - 2.0f * half * step));  // w(d + step) / w(d)
         const float ratioStep = std::exp(-2.0f * gk * step * step);
-        float sum[kMaxChannels] = {}, a[kMaxChannels], b[kMaxChannels];
+        float sum[Prober<C>::kArr] = {}, a[Prober<C>::kArr], b[Prober<C>::kArr];
         float weight = 0.0f;
         for (int i = 0; i < n; ++i) {
             const float d = -half + step * static_cast<float>(i);
