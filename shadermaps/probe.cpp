@@ -83,6 +83,49 @@ struct Prober {
         }
     }
 
+    // Feline's taps at one level: adds scale * w_i * bilinear(u0 + i du, v0 + i dv) to sum
+    // for i < n, with w_i from the recurrence w_{i+1} = w_i ratio_i, ratio_{i+1} = ratio_i
+    // ratioStep. The taps walk a straight line, so texel coordinates advance by a constant
+    // step and the bilinear weights go straight into the sum.
+    void lineAccumulate(int chart, int level, float u0, float v0, float du, float dv, int n,
+                        float w, float ratioW, float ratioStep, float scale, float* sum) const {
+        const int channels = kFixed ? kChannels : runtimeChannels;
+        const int res = map.resolution(level);
+        const float fres = static_cast<float>(res);
+        float x = u0 * fres - 0.5f, y = v0 * fres - 0.5f;
+        const float dx = du * fres, dy = dv * fres;
+        const size_t stride = static_cast<size_t>(map.stride());
+        const size_t row = stride * static_cast<size_t>(channels);
+        for (int i = 0; i < n; ++i, x += dx, y += dy, w *= ratioW, ratioW *= ratioStep) {
+            const float cx = std::clamp(x, -0.5f, fres - 0.5f),
+                        cy = std::clamp(y, -0.5f, fres - 0.5f);
+            const float fx0 = std::floor(cx), fy0 = std::floor(cy);
+            const int i0 = static_cast<int>(fx0), j0 = static_cast<int>(fy0);
+            int li, lj;
+            const int slot = map.locate(static_cast<uint32_t>(chart), level, std::max(i0, 0),
+                                        std::max(j0, 0), li, lj);
+            const float* t = slot >= 0 ? map.tileFloats(slot) : nullptr;
+            const float ws = w * scale;
+            if (!t || residency) {
+                // Missing tiles, half storage, or residency to report: the general path.
+                float value[kArr];
+                bilinear(chart, level, (x + 0.5f) / fres, (y + 0.5f) / fres, value);
+                for (int c = 0; c < channels; ++c) sum[c] += ws * value[c];
+                continue;
+            }
+            li += i0 - std::max(i0, 0);
+            lj += j0 - std::max(j0, 0);
+            const float fx = cx - fx0, fy = cy - fy0;
+            const float w00 = ws * (1.0f - fx) * (1.0f - fy), w10 = ws * fx * (1.0f - fy);
+            const float w01 = ws * (1.0f - fx) * fy, w11 = ws * fx * fy;
+            const float* t00 = t + (static_cast<size_t>(lj) * stride + static_cast<size_t>(li)) *
+                                       static_cast<size_t>(channels);
+            const float *t10 = t00 + channels, *t01 = t00 + row, *t11 = t01 + channels;
+            for (int c = 0; c < channels; ++c)
+                sum[c] += w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c];
+        }
+    }
+
     void trilinear(int chart, float lod, float u, float v, float* out) const {
         const int channels = kFixed ? kChannels : runtimeChannels;
         if (!(lod > 0.0f)) return bilinear(chart, 0, u, v, out);
@@ -259,22 +302,17 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
         float w = std::exp(-gk * half * half);                              // at d = -half
         float ratioW = std::exp(-gk * (step * step - 2.0f * half * step));  // w(d + step) / w(d)
         const float ratioStep = std::exp(-2.0f * gk * step * step);
-        float sum[Prober<C>::kArr] = {}, a[Prober<C>::kArr], b[Prober<C>::kArr];
+        float sum[Prober<C>::kArr] = {};
         float weight = 0.0f;
-        for (int i = 0; i < n; ++i) {
-            const float d = -half + step * static_cast<float>(i);
-            const float u = q.u + d * dirU, v = q.v + d * dirV;
-            p.bilinear(q.chart, l0, u, v, a);
-            if (blend > 0.0f) {
-                p.bilinear(q.chart, l1, u, v, b);
-                for (int c = 0; c < channels; ++c) sum[c] += w * (a[c] + blend * (b[c] - a[c]));
-            } else {
-                for (int c = 0; c < channels; ++c) sum[c] += w * a[c];
-            }
-            weight += w;
-            w *= ratioW;
-            ratioW *= ratioStep;
+        {
+            float wi = w, ri = ratioW;
+            for (int i = 0; i < n; ++i, wi *= ri, ri *= ratioStep) weight += wi;
         }
+        const float u0 = q.u - half * dirU, v0 = q.v - half * dirV;
+        const float du = step * dirU, dv = step * dirV;
+        p.lineAccumulate(q.chart, l0, u0, v0, du, dv, n, w, ratioW, ratioStep, 1.0f - blend, sum);
+        if (blend > 0.0f)
+            p.lineAccumulate(q.chart, l1, u0, v0, du, dv, n, w, ratioW, ratioStep, blend, sum);
         for (int c = 0; c < channels; ++c) o[c] = sum[c] / weight;
     }
 }
