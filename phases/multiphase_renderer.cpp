@@ -126,7 +126,9 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
     : scene_(scene), options_(options), resources_(scene) {
     for (const SceneObject& obj : scene.objects) {
         auto data = std::make_unique<ObjectData>();
-        data->factored = factorShader(*obj.shader, bindingOf(scene, obj), options.factor);
+        data->factored = forObject(scene, obj, [&] {
+            return factorShader(*obj.shader, bindingOf(scene, obj), options.factor);
+        });
         data->staticKernel = std::make_unique<ShaderKernel>(data->factored.staticPart);
         data->dynamicKernel = std::make_unique<ShaderKernel>(data->factored.dynamicPart);
         data->opaque = isOpaque(data->factored.dynamicPart);

@@ -8,7 +8,8 @@ namespace mpshade {
 SceneResources::SceneResources(const Scene& scene) : scene_(scene) {
     for (const SceneObject& obj : scene.objects) {
         ObjectResources r;
-        r.kernel = buildKernel(*obj.shader, bindingOf(scene, obj));
+        r.kernel =
+            forObject(scene, obj, [&] { return buildKernel(*obj.shader, bindingOf(scene, obj)); });
         auto& rs = rayScenes_[obj.surface.get()];
         if (!rs) rs = std::make_unique<SurfaceRayScene>(*obj.surface);
         r.rayScene = rs.get();

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "geometry/error.h"
 #include "geometry/ray_scene.h"
 #include "scene/scene.h"
 #include "scene/scene_state.h"
@@ -18,6 +19,19 @@ struct ObjectResources {
     const SurfaceRayScene* rayScene = nullptr;  // owned by SceneResources
     float occlusionBias = 1e-4f;                // object units
 };
+
+// Runs `build` (compiling or factoring an object's shader for its binding) and, when the
+// shader cannot be specialized for this object (an animated parameter the shader needs
+// constant, say), adds which object and scene bound it to the error.
+template <typename F>
+auto forObject(const Scene& scene, const SceneObject& object, F&& build) {
+    try {
+        return build();
+    } catch (const InputError& e) {
+        throw InputError(e.where(), e.message() + " (binding object '" + object.name + "' of " +
+                                        scene.file + ")");
+    }
+}
 
 class SceneResources {
   public:

@@ -7,6 +7,8 @@
 
 #include "scene/json_reader.h"
 #include "scene/scene.h"
+#include "scene/variability.h"
+#include "shading/lower.h"
 #include "shading/shader_compiler.h"
 
 namespace mpshade {
@@ -420,6 +422,14 @@ class SceneLoader {
             }
         }
         scene_.objects.push_back(std::move(obj));
+        // The shader must specialize for this binding: an animated parameter it needs
+        // constant (a loop bound, an octave or ray count) is this object's error.
+        try {
+            lowerShader(*scene_.objects.back().shader, bindingOf(scene_, scene_.objects.back()));
+        } catch (const InputError& e) {
+            throw InputError(e.where(), e.message() + " (binding " + o.path() + " '" +
+                                            scene_.objects.back().name + "' of " + o.file() + ")");
+        }
     }
 
     std::string path_;

@@ -79,6 +79,8 @@ const BadScene kBadScenes[] = {
      "invalid JSON: syntax error while parsing value - unexpected end of input; expected '[', '{', "
      "or a literal"},
     {"not_an_object", "", "(top level)", 0, 0, "a scene must be a JSON object"},
+    {"animated_count", "tests/data/shaders/counted.sl", "", 3, 32,
+     "the occlusion ray count must be a constant (binding objects[0] 'ball' of "},
 };
 
 TEST(BadScenes, GoldenErrors) {
