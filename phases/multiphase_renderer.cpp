@@ -280,31 +280,14 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
     const auto start = Clock::now();
     stats = FrameStats{};
     const RenderSettings& settings = scene_.settings;
-    const int width = options.width > 0 ? options.width : settings.width;
-    const int height = options.height > 0 ? options.height : settings.height;
-    const int spp =
-        options.samplesPerPixel > 0 ? options.samplesPerPixel : settings.samplesPerPixel;
-    const float time = scene_.frameTime(frame);
-    const CameraState camera = cameraAt(scene_, time, width, height);
+    const FrameState frameState =
+        frameStateAt(resources_, frame, options.width, options.height, options.samplesPerPixel);
+    const int width = frameState.width, height = frameState.height, spp = frameState.spp;
+    const float time = frameState.time;
+    const CameraState& camera = frameState.camera;
     const size_t count = objects_.size();
-
-    std::vector<ObjectState> states(count);
-    std::vector<std::vector<float>> params(count);
-    std::vector<std::vector<LightSample>> lights(count);
-    std::vector<ShadingUniforms> uniforms(count);
-    for (size_t i = 0; i < count; ++i) {
-        const SceneObject& obj = scene_.objects[i];
-        states[i] = objectAt(obj, time, camera);
-        animatedParamsAt(obj, objects_[i]->factored.analyzed, time, params[i]);
-        lightsAt(scene_, states[i], time, lights[i]);
-        ShadingUniforms& u = uniforms[i];
-        u.time = time;
-        u.eye = states[i].eye;
-        u.params = params[i];
-        u.lights = lights[i];
-        u.occluder = resources_.object(i).rayScene;
-        u.occlusionBias = resources_.object(i).occlusionBias;
-    }
+    const std::vector<ObjectState>& states = frameState.objects;
+    const std::vector<ShadingUniforms>& uniforms = frameState.uniforms;
 
     // Static phase where needed: new objects, views that left the range, a new image size.
     const auto staticStart = Clock::now();

@@ -61,31 +61,13 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
                                               FrameStats& stats, const ProgressFn& progress) const {
     const auto start = std::chrono::steady_clock::now();
     const RenderSettings& settings = scene_.settings;
-    const int width = options.width > 0 ? options.width : settings.width;
-    const int height = options.height > 0 ? options.height : settings.height;
-    const int spp =
-        options.samplesPerPixel > 0 ? options.samplesPerPixel : settings.samplesPerPixel;
-    const float time = scene_.frameTime(frame);
-
-    const CameraState camera = cameraAt(scene_, time, width, height);
-    std::vector<ObjectState> states;
-    std::vector<std::vector<float>> params(scene_.objects.size());
-    std::vector<std::vector<LightSample>> lights(scene_.objects.size());
-    std::vector<ShadingUniforms> uniforms(scene_.objects.size());
-    for (size_t i = 0; i < scene_.objects.size(); ++i) {
-        const SceneObject& obj = scene_.objects[i];
-        const ObjectResources& res = resources_.object(i);
-        states.push_back(objectAt(obj, time, camera));
-        animatedParamsAt(obj, res.kernel->program(), time, params[i]);
-        lightsAt(scene_, states[i], time, lights[i]);
-        ShadingUniforms& u = uniforms[i];
-        u.time = time;
-        u.eye = states[i].eye;
-        u.params = params[i];
-        u.lights = lights[i];
-        u.occluder = res.rayScene;
-        u.occlusionBias = res.occlusionBias;
-    }
+    const FrameState frameState =
+        frameStateAt(resources_, frame, options.width, options.height, options.samplesPerPixel);
+    const int width = frameState.width, height = frameState.height, spp = frameState.spp;
+    const float time = frameState.time;
+    const CameraState& camera = frameState.camera;
+    const std::vector<ObjectState>& states = frameState.objects;
+    const std::vector<ShadingUniforms>& uniforms = frameState.uniforms;
     const WorldRayScene world(resources_, states);
 
     SampleBuffer samples;

@@ -18,6 +18,38 @@ SceneResources::SceneResources(const Scene& scene) : scene_(scene) {
     }
 }
 
+FrameState frameStateAt(const SceneResources& resources, int frame, int width, int height,
+                        int spp) {
+    const Scene& scene = resources.scene();
+    FrameState f;
+    f.width = width > 0 ? width : scene.settings.width;
+    f.height = height > 0 ? height : scene.settings.height;
+    f.spp = spp > 0 ? spp : scene.settings.samplesPerPixel;
+    f.time = scene.frameTime(frame);
+    f.camera = cameraAt(scene, f.time, f.width, f.height);
+    const size_t n = scene.objects.size();
+    f.objects.resize(n);
+    f.params.resize(n);
+    f.lights.resize(n);
+    f.uniforms.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+        const SceneObject& obj = scene.objects[i];
+        const ObjectResources& res = resources.object(i);
+        f.objects[i] = objectAt(obj, f.time, f.camera);
+        // Every specialization of one binding has the same animated-parameter slots.
+        animatedParamsAt(obj, res.kernel->program(), f.time, f.params[i]);
+        lightsAt(scene, f.objects[i], f.time, f.lights[i]);
+        ShadingUniforms& u = f.uniforms[i];
+        u.time = f.time;
+        u.eye = f.objects[i].eye;
+        u.params = f.params[i];
+        u.lights = f.lights[i];
+        u.occluder = res.rayScene;
+        u.occlusionBias = res.occlusionBias;
+    }
+    return f;
+}
+
 WorldRayScene::WorldRayScene(const SceneResources& resources,
                              const std::vector<ObjectState>& states) {
     RTCDevice device = embreeDevice();

@@ -46,6 +46,22 @@ class SceneResources {
     std::map<const Surface*, std::unique_ptr<SurfaceRayScene>> rayScenes_;
 };
 
+// Everything shading needs of one frame at time t, per object: its placement, animated
+// parameter block, lights in its coordinates, and the uniforms pointing at them. The spans
+// in `uniforms` point into `params` and `lights`, which must not be resized.
+struct FrameState {
+    int width = 0, height = 0, spp = 1;  // resolved: the options', else the scene's
+    float time = 0.0f;
+    CameraState camera;
+    std::vector<ObjectState> objects;
+    std::vector<std::vector<float>> params;
+    std::vector<std::vector<LightSample>> lights;
+    std::vector<ShadingUniforms> uniforms;
+};
+
+// width, height, spp: 0 takes the scene's setting.
+FrameState frameStateAt(const SceneResources& resources, int frame, int width, int height, int spp);
+
 // The frame's world: Embree instances of each object's surface, placed at time t.
 // Instance (geometry) id i is scene object i.
 class WorldRayScene {
