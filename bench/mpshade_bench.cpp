@@ -13,6 +13,7 @@
 #include "scene/variability.h"
 #include "shading/factoring.h"
 #include "shading/shader_compiler.h"
+#include "shading/shading_batch.h"
 
 namespace mpshade {
 namespace {
@@ -47,42 +48,27 @@ struct VasePoints {
     static constexpr size_t n = 4096;
     Scene scene;
     std::unique_ptr<SurfaceRayScene> rays;
-    std::vector<std::vector<float>> rows;
+    ShadingBatch batch;
     std::vector<LightSample> lights;
-    ShadingInputs in;
-    ShadingOutputs out;
+    ShadingInputs& in = batch.in;
+    ShadingOutputs& out = batch.out;
     ShadingUniforms uniforms;
 
-    VasePoints()
-        : scene(loadScene(source("examples/vase/scene.json"))), rows(28, std::vector<float>(n)) {
+    VasePoints() : scene(loadScene(source("examples/vase/scene.json"))) {
         const SceneObject& vase = scene.objects[0];
         rays = std::make_unique<SurfaceRayScene>(*vase.surface);
         std::mt19937 rng(1);
         std::uniform_real_distribution<float> uni(0.0f, 1.0f);
         const CameraState camera = cameraAt(scene, 0.0f, 480, 270);
         const ObjectState st = objectAt(vase, 0.0f, camera);
+        batch.resize(n, 0);
         for (size_t i = 0; i < n; ++i) {
             const ChartPoint at{
                 static_cast<int>(rng() % static_cast<unsigned>(chartCount(*vase.surface))),
                 uni(rng), uni(rng)};
             const SurfaceSample s = evaluate(*vase.surface, at);
-            const glm::vec3 I = glm::normalize(s.P - st.eye);
-            for (int k = 0; k < 3; ++k) {
-                rows[0 + k][i] = s.P[k], rows[3 + k][i] = s.N[k], rows[6 + k][i] = s.Ng[k];
-                rows[9 + k][i] = s.dPdu[k], rows[12 + k][i] = s.dPdv[k], rows[15 + k][i] = I[k];
-            }
-            rows[18][i] = at.u, rows[19][i] = at.v, rows[20][i] = s.s, rows[21][i] = s.t;
+            batch.setPoint(i, s, at, glm::normalize(s.P - st.eye));
         }
-        for (int k = 0; k < 3; ++k) {
-            in.P[k] = rows[0 + k].data(), in.N[k] = rows[3 + k].data(),
-            in.Ng[k] = rows[6 + k].data();
-            in.dPdu[k] = rows[9 + k].data(), in.dPdv[k] = rows[12 + k].data(),
-            in.I[k] = rows[15 + k].data();
-        }
-        in.u = rows[18].data(), in.v = rows[19].data(), in.s = rows[20].data(),
-        in.t = rows[21].data();
-        for (int k = 0; k < 3; ++k)
-            out.Ci[k] = rows[22 + k].data(), out.Oi[k] = rows[25 + k].data();
         lightsAt(scene, st, 0.0f, lights);
         uniforms.eye = st.eye;
         uniforms.lights = lights;

@@ -107,12 +107,12 @@ std::vector<uint8_t> clusterVisibility(const FacetMesh& mesh, const ObjectState&
 
 struct MultiphaseRenderer::ObjectData {
     FactoredShader factored;
-    std::unique_ptr<ShaderKernel> staticKernel, dynamicKernel;
+    std::unique_ptr<ShaderKernel> staticKernel;
+    std::shared_ptr<const ShaderKernel> dynamicKernel;  // also in each facet mesh's data block
     std::unique_ptr<FacetMesh> mesh;
     std::vector<int> geometryRows;  // attribute rows the dynamic part reads
     bool opaque = true;
     int diceHeight = 0;  // image height the facets were diced for
-    float diceFov = 0.0f;
     // The separate representation (scene option "representation": "shadermap"): the
     // n-tuple comes from probes of a shader map, not from the facets' vertices.
     bool useMap = false;
@@ -130,7 +130,7 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
             return factorShader(*obj.shader, bindingOf(scene, obj), options.factor);
         });
         data->staticKernel = std::make_unique<ShaderKernel>(data->factored.staticPart);
-        data->dynamicKernel = std::make_unique<ShaderKernel>(data->factored.dynamicPart);
+        data->dynamicKernel = std::make_shared<const ShaderKernel>(data->factored.dynamicPart);
         data->opaque = isOpaque(data->factored.dynamicPart);
         data->useMap = obj.representation == Representation::ShaderMap;
         data->closed = isClosed(*obj.surface);
@@ -258,10 +258,9 @@ void MultiphaseRenderer::staticPhase(size_t index, const ObjectState& state,
         obj.map->fillLevels(0, obj.map->levels() - 1);
         instructions += obj.map->fillStats().programRuns * obj.staticKernel->instructionCount();
     }
-    mesh->dynamicKernel = nullptr;
+    mesh->dynamicKernel = obj.dynamicKernel;
     obj.mesh = std::move(mesh);
     obj.diceHeight = camera.height;
-    obj.diceFov = scene_.camera.fovY;
     ++stats.staticRuns;
     stats.staticInstructions += instructions;
 }
@@ -450,8 +449,8 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
                     b.batch.out.channels[ch][i] = b.probed[i * channels + ch];
         }
         ShadingCounters counters;
-        obj.dynamicKernel->run(uniforms[chunk.object], b.batch.in, m, b.batch.out, b.workspace,
-                               counters);
+        mesh.dynamicKernel->run(uniforms[chunk.object], b.batch.in, m, b.batch.out, b.workspace,
+                                counters);
         instructions.local() += counters.instructions;
         for (size_t i = 0; i < m; ++i) {
             const size_t slot = order[chunk.begin + i];
