@@ -26,10 +26,17 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--spp", render.spp, "Samples per pixel (overrides the scene)");
     renderCmd->add_option("--seed", render.seed, "Seed of the sample positions")
         ->capture_default_str();
+    renderCmd->add_option("--shading-rate", render.shadingRate,
+                          "Multiphase: run the dynamic shader per 'sample' or per 'pixel' "
+                          "(overrides the scene)");
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
     renderCmd->add_flag(
         "--compare", render.compare,
         "With --mode multiphase: also render the reference; report PSNR and speed in stats.json");
+
+    renderCmd->add_option("--truth-spp", render.truthSpp,
+                          "With --compare: also measure both renderers against the reference "
+                          "at this many samples per pixel");
 
     mpshade::FactorCommandOptions factor;
     CLI::App* factorCmd = app.add_subcommand(

@@ -103,6 +103,11 @@ int runRenderCommand(const RenderCommandOptions& options) {
         if (options.compare && options.mode != "multiphase")
             throw InputError({"--compare", 0, 0, {}},
                              "--compare measures --mode multiphase against the reference");
+        if (options.truthSpp != -1 && !options.compare)
+            throw InputError({"--truth-spp", 0, 0, {}}, "--truth-spp goes with --compare");
+        if (options.truthSpp != -1 && (options.truthSpp < 1 || options.truthSpp > 1024))
+            throw InputError({"--truth-spp", 0, 0, {}},
+                             "expected 1..1024, found " + std::to_string(options.truthSpp));
         if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
             throw InputError({"--spp", 0, 0, {}},
                              "expected 1..1024, found " + std::to_string(options.spp));
@@ -124,7 +129,21 @@ int runRenderCommand(const RenderCommandOptions& options) {
         std::unique_ptr<ReferenceRenderer> reference;
         if (!multiphase || options.compare) reference = std::make_unique<ReferenceRenderer>(scene);
         std::unique_ptr<MultiphaseRenderer> multi;
-        if (multiphase) multi = std::make_unique<MultiphaseRenderer>(scene);
+        if (multiphase) {
+            MultiphaseOptions mo;
+            if (!options.shadingRate.empty()) {
+                if (options.shadingRate == "sample")
+                    mo.shadingRate = ShadingRate::Sample;
+                else if (options.shadingRate == "pixel")
+                    mo.shadingRate = ShadingRate::Pixel;
+                else
+                    throw InputError({"--shading-rate", 0, 0, {}},
+                                     "expected sample or pixel, found '" + options.shadingRate +
+                                         "'");
+            }
+            multi = std::make_unique<MultiphaseRenderer>(scene, mo);
+            multi->plan(first, last, render);
+        }
         ProgressBar bar(!options.quiet && isatty(STDERR_FILENO));
         bar.setFirst(first);
         nlohmann::json frames = nlohmann::json::array();
@@ -151,17 +170,34 @@ int runRenderCommand(const RenderCommandOptions& options) {
                                     {"shader_instructions", stats.shaderInstructions},
                                     {"nonfinite_samples", stats.nonFiniteSamples}};
             if (multiphase) {
+                double covered = 0.0;
+                for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
                 entry["static_runs"] = stats.staticRuns;
                 entry["static_seconds"] = stats.staticSeconds;
+                entry["fill_seconds"] = stats.fillSeconds;
                 entry["warp_seconds"] = stats.warpSeconds;
                 entry["raster_seconds"] = stats.rasterSeconds;
                 entry["shade_seconds"] = stats.shadeSeconds;
+                entry["resolve_seconds"] = stats.resolveSeconds;
                 entry["static_instructions"] = stats.staticInstructions;
+                entry["objects_drawn"] = stats.objectsDrawn;
                 entry["facets"] = stats.facets;
                 entry["facet_bytes"] = stats.facetBytes;
                 entry["facets_rasterized"] = stats.facetsRasterized;
+                entry["covered_pixels"] = covered;
+                entry["facets_per_covered_pixel"] =
+                    covered > 0.0 ? static_cast<double>(stats.facetsRasterized) / covered : 0.0;
                 entry["fragments"] = stats.fragments;
                 entry["vertices_warped"] = stats.verticesWarped;
+                entry["shade_passes"] = stats.shadePasses;
+                entry["probes"] = stats.probes;
+                entry["probe_fallbacks"] = stats.probeFallbacks;
+                entry["tiles_requested"] = stats.tilesRequested;
+                entry["tiles_filled"] = stats.tilesFilled;
+                entry["tiles_from_children"] = stats.tilesFromChildren;
+                entry["texels_filled"] = stats.texelsFilled;
+                entry["resident_tiles"] = stats.residentTiles;
+                entry["resident_bytes"] = stats.residentBytes;
             }
             if (options.compare) {
                 FrameStats refStats;
@@ -175,6 +211,27 @@ int runRenderCommand(const RenderCommandOptions& options) {
                     {"coverage_difference", err.coverageDiff},
                     {"speedup",
                      stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0}};
+                if (options.truthSpp > 0) {
+                    // Both renderers against a reference with many more samples: the error
+                    // each makes, rather than how far apart they are.
+                    RenderOptions dense = render;
+                    dense.samplesPerPixel = options.truthSpp;
+                    FrameStats truthStats;
+                    const Image truth = reference->renderFrame(frame, dense, truthStats);
+                    const ImageError m = compareImages(image, truth);
+                    const ImageError r = compareImages(ref, truth);
+                    entry["truth"] = {{"samples_per_pixel", options.truthSpp},
+                                      {"multiphase_psnr_db", m.psnr},
+                                      {"multiphase_rmse", m.rmse},
+                                      {"reference_psnr_db", r.psnr},
+                                      {"reference_rmse", r.rmse}};
+                    if (!options.quiet)
+                        std::fprintf(stderr,
+                                     "%sframe %d: against %d spp: multiphase %.2f dB, reference "
+                                     "%.2f dB\n",
+                                     isatty(STDERR_FILENO) ? "\n" : "", frame, options.truthSpp,
+                                     m.psnr, r.psnr);
+                }
                 if (!options.quiet)
                     std::fprintf(
                         stderr,
@@ -200,6 +257,29 @@ int runRenderCommand(const RenderCommandOptions& options) {
             {"total_wall_seconds",
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
             {"frames", frames}};
+        if (multi) {
+            doc["shading_rate"] =
+                scene.settings.shadingRate == ShadingRate::Pixel ? "pixel" : "sample";
+            nlohmann::json objects = nlohmann::json::array();
+            for (size_t i = 0; i < multi->objectCount(); ++i) {
+                const ObjectReport& r = multi->report(i);
+                const char* kind = r.kind == Representation::Facets      ? "facets"
+                                   : r.kind == Representation::ShaderMap ? "shadermap"
+                                                                         : "none (never seen)";
+                objects.push_back({{"name", r.name},
+                                   {"representation", kind},
+                                   {"reason", r.reason},
+                                   {"static_runs", r.staticRuns},
+                                   {"static_seconds", r.staticCosts.seconds},
+                                   {"frames_drawn", r.framesDrawn},
+                                   {"facets", r.facets},
+                                   {"longest_edge_pixels", r.longestEdgePixels},
+                                   {"facet_bytes", r.facetBytes},
+                                   {"resident_tiles", r.residentTiles},
+                                   {"map_bytes", r.mapBytes}});
+            }
+            doc["objects"] = objects;
+        }
         std::ofstream out(std::filesystem::path(options.outDir) / "stats.json");
         out << doc.dump(2) << "\n";
         if (!out) throw std::runtime_error("cannot write stats.json in " + options.outDir);

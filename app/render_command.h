@@ -16,6 +16,8 @@ struct RenderCommandOptions {
     uint32_t seed = 0;
     bool quiet = false;  // no progress bar
     bool compare = false;  // multiphase: also render the reference, report error and speed
+    std::string shadingRate;  // "sample" or "pixel"; empty = the scene's
+    int truthSpp = -1;        // with compare: also measure both against this many spp
 };
 
 // Returns the process exit code: 0 success, 2 bad input (message already on stderr).

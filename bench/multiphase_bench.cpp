@@ -1,6 +1,7 @@
 // Multi-phase benchmarks: the fixed-point warp against a float (GLM) warp of the same
 // vertices, rasterization, facets per covered pixel, and whole frames side by side with
 // the reference renderer.
+#include <cstdlib>
 #include <memory>
 #include <random>
 #include <string>
@@ -15,8 +16,19 @@
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
 
+#include <tbb/global_control.h>
+
 namespace mpshade {
 namespace {
+
+// MPSHADE_BENCH_THREADS=1 runs every parallel loop on the calling thread, for instruction
+// counts that see all the work (callgrind's --toggle-collect follows one thread).
+const std::unique_ptr<tbb::global_control> threadLimit = [] {
+    const char* n = std::getenv("MPSHADE_BENCH_THREADS");
+    return n ? std::make_unique<tbb::global_control>(
+                   tbb::global_control::max_allowed_parallelism, std::stoul(n))
+             : nullptr;
+}();
 
 std::string source(const std::string& relative) {
     return std::string(MPSHADE_SOURCE_DIR) + "/" + relative;
@@ -77,17 +89,15 @@ void warpFloat(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * d.x.size()));
 }
 
-// Steady-state frames: the static phase has run; frames stay in the range.
+// Steady-state frames at the example's own size and spp: the static phase has run (frame
+// 0), then frame 1 is rendered again and again (its tiles filled by the first iteration).
+// The multi-phase figure is beside the reference's, in the same binary and run.
 struct FrameFixture {
     Scene scene;
     std::unique_ptr<MultiphaseRenderer> multi;
     std::unique_ptr<ReferenceRenderer> reference;
     RenderOptions options;
-    explicit FrameFixture(const char* path) : scene(loadScene(source(path))) {
-        options.width = 240;
-        options.height = 135;
-        options.samplesPerPixel = 2;
-    }
+    explicit FrameFixture(const char* path) : scene(loadScene(source(path))) {}
 };
 
 void frameReference(benchmark::State& state, const char* path) {
@@ -99,77 +109,93 @@ void frameReference(benchmark::State& state, const char* path) {
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * stats.samples));
 }
 
-void frameMultiphase(benchmark::State& state, const char* path) {
+// The timed loop's frame, in a function of its own so instruction counts can be taken of it
+// alone: valgrind --tool=callgrind --toggle-collect='*steadyFrame*'.
+__attribute__((noinline)) Image steadyFrame(MultiphaseRenderer& multi, const RenderOptions& options,
+                                            FrameStats& stats) {
+    return multi.renderFrame(1, options, stats);
+}
+
+void frameMultiphase(benchmark::State& state, const char* path, int representation, int rate) {
     FrameFixture f(path);
-    f.multi = std::make_unique<MultiphaseRenderer>(f.scene);
+    MultiphaseOptions options;
+    if (const char* a = std::getenv("MPSHADE_BENCH_ANISO")) options.dynamic.probe.maxAnisotropy = std::stof(a);
+    if (const char* a = std::getenv("MPSHADE_BENCH_FILTER")) options.dynamic.probe.filter = static_cast<ProbeFilter>(std::stoi(a));
+    if (representation >= 0) options.representation = static_cast<Representation>(representation);
+    if (rate >= 0) options.shadingRate = static_cast<ShadingRate>(rate);
+    f.multi = std::make_unique<MultiphaseRenderer>(f.scene, options);
     FrameStats stats;
     f.multi->renderFrame(0, f.options, stats);  // the static phase
-    uint64_t facets = 0, rasterized = 0;
-    for (auto _ : state) {
-        benchmark::DoNotOptimize(f.multi->renderFrame(1, f.options, stats).rgba.data());
-        facets += stats.facets;
-        rasterized += stats.facetsRasterized;
-    }
+    f.multi->renderFrame(1, f.options, stats);  // frame 1's tiles
+    for (auto _ : state) benchmark::DoNotOptimize(steadyFrame(*f.multi, f.options, stats).rgba.data());
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * stats.samples));
     state.counters["facets"] = static_cast<double>(stats.facets);
     state.counters["static_runs_in_loop"] = stats.staticRuns;
-    state.counters["raster_s"] = stats.rasterSeconds;
-    state.counters["warp_s"] = stats.warpSeconds;
-    state.counters["shade_s"] = stats.shadeSeconds;
+    state.counters["warp_ms"] = 1e3 * stats.warpSeconds;
+    state.counters["raster_ms"] = 1e3 * stats.rasterSeconds;
+    state.counters["shade_ms"] = 1e3 * stats.shadeSeconds;
+    state.counters["resolve_ms"] = 1e3 * stats.resolveSeconds;
+    state.counters["shading_points"] = static_cast<double>(stats.shadedPoints);
+    state.counters["probes_per_point"] =
+        stats.shadedPoints ? static_cast<double>(stats.probes) / stats.shadedPoints : 0.0;
 }
 
-// Facets per covered pixel, at the example's own size (a count, not a timing).
-void facetsPerPixel(benchmark::State& state, const char* path) {
+// Facets per covered pixel, at the example's own size (a count, not a timing): stored in
+// the drawn representations, and rasterized after culling (facet-tile pairs).
+void facetsPerPixel(benchmark::State& state, const char* path, int representation) {
     FrameFixture f(path);
-    f.options = RenderOptions{};
-    f.multi = std::make_unique<MultiphaseRenderer>(f.scene);
+    MultiphaseOptions options;
+    if (representation >= 0) options.representation = static_cast<Representation>(representation);
+    f.multi = std::make_unique<MultiphaseRenderer>(f.scene, options);
     FrameStats stats;
     SampleBuffer samples;
     for (auto _ : state) samples = f.multi->renderSamples(0, f.options, stats);
     double covered = 0;
     for (size_t i = 3; i < samples.rgba.size(); i += 4) covered += samples.rgba[i];
     covered /= samples.spp;
-    uint64_t visibleFacets = 0;
-    for (size_t o = 0; o < f.scene.objects.size(); ++o)
-        visibleFacets += f.multi->facets(o)->facetCount();
-    state.counters["facets"] = static_cast<double>(visibleFacets);
+    state.counters["facets"] = static_cast<double>(stats.facets);
     state.counters["covered_pixels"] = covered;
-    state.counters["facets_per_covered_pixel"] = covered > 0 ? visibleFacets / covered : 0.0;
-    // After this frame's culling (back faces, clusters off screen or facing away): the
-    // facets the dynamic phase actually rasterized.
-    state.counters["rasterized_per_covered_pixel"] = covered > 0 ? stats.facetsRasterized / covered : 0.0;
+    state.counters["facets_per_covered_pixel"] = covered > 0 ? stats.facets / covered : 0.0;
+    state.counters["rasterized_per_covered_pixel"] =
+        covered > 0 ? stats.facetsRasterized / covered : 0.0;
 }
 
 BENCHMARK(warpFixed)->Name("Warp/fixed")->Unit(benchmark::kMillisecond);
 BENCHMARK(warpFloat)->Name("Warp/float")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(frameReference, vase, "examples/vase/scene.json")
-    ->Name("Frame/vase/reference")
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK_CAPTURE(frameMultiphase, vase, "examples/vase/scene.json")
-    ->Name("Frame/vase/multiphase")
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK_CAPTURE(frameReference, teapot, "examples/teapot/scene.json")
-    ->Name("Frame/teapot/reference")
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK_CAPTURE(frameMultiphase, teapot, "examples/teapot/scene.json")
-    ->Name("Frame/teapot/multiphase")
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK_CAPTURE(facetsPerPixel, vase, "examples/vase/scene.json")
-    ->Name("FacetsPerPixel/vase")
-    ->Iterations(1)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(facetsPerPixel, teapot, "examples/teapot/scene.json")
-    ->Name("FacetsPerPixel/teapot")
-    ->Iterations(1)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(facetsPerPixel, courtyard, "examples/courtyard/scene.json")
-    ->Name("FacetsPerPixel/courtyard")
-    ->Iterations(1)
-    ->Unit(benchmark::kMillisecond);
+
+constexpr int kAuto = -1, kFacets = static_cast<int>(Representation::Facets),
+              kMap = static_cast<int>(Representation::ShaderMap);
+constexpr int kSceneRate = -1, kPerSample = static_cast<int>(ShadingRate::Sample);
+
+#define MPSHADE_FRAME_BENCH(name, path)                                                  \
+    BENCHMARK_CAPTURE(frameReference, name, path)                                        \
+        ->Name("Frame/" #name "/reference")                                              \
+        ->Unit(benchmark::kMillisecond)                                                  \
+        ->UseRealTime();                                                                 \
+    BENCHMARK_CAPTURE(frameMultiphase, name, path, kAuto, kSceneRate)                    \
+        ->Name("Frame/" #name "/multiphase")                                             \
+        ->Unit(benchmark::kMillisecond)                                                  \
+        ->UseRealTime();                                                                 \
+    BENCHMARK_CAPTURE(frameMultiphase, name##_sample, path, kAuto, kPerSample)           \
+        ->Name("Frame/" #name "/multiphase_per_sample")                                  \
+        ->Unit(benchmark::kMillisecond)                                                  \
+        ->UseRealTime();                                                                 \
+    BENCHMARK_CAPTURE(frameMultiphase, name##_facets, path, kFacets, kSceneRate)         \
+        ->Name("Frame/" #name "/multiphase_facets")                                      \
+        ->Unit(benchmark::kMillisecond)                                                  \
+        ->UseRealTime();                                                                 \
+    BENCHMARK_CAPTURE(facetsPerPixel, name##_map, path, kMap)                            \
+        ->Name("FacetsPerPixel/" #name "/shadermap")                                     \
+        ->Iterations(1)                                                                  \
+        ->Unit(benchmark::kMillisecond);                                                 \
+    BENCHMARK_CAPTURE(facetsPerPixel, name##_facets, path, kFacets)                      \
+        ->Name("FacetsPerPixel/" #name "/facets")                                        \
+        ->Iterations(1)                                                                  \
+        ->Unit(benchmark::kMillisecond)
+
+MPSHADE_FRAME_BENCH(vase, "examples/vase/scene.json");
+MPSHADE_FRAME_BENCH(teapot, "examples/teapot/scene.json");
+MPSHADE_FRAME_BENCH(courtyard, "examples/courtyard/scene.json");
 
 }  // namespace
 }  // namespace mpshade

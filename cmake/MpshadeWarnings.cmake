@@ -1,6 +1,19 @@
+# The instruction-set baseline on x86-64: x86-64-v2 (SSE4.2, 2009 and later) gives the
+# rounding instructions hot loops need (floor without a library call). Hot loops that gain
+# from AVX2 carry their own AVX2 clone, chosen at run time (target_clones). Empty: the
+# compiler's default.
+set(MPSHADE_ARCH "x86-64-v2" CACHE STRING "x86-64 baseline for -march (empty: compiler default)")
+if(NOT CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64|amd64)$")
+  set(MPSHADE_ARCH "")
+endif()
+
 # mpshade_target_defaults(target): warnings (errors with MPSHADE_WERROR), sanitizers with
-# MPSHADE_SANITIZE, and the include root so headers are named by module: "geometry/surface.h".
+# MPSHADE_SANITIZE, the instruction-set baseline, and the include root so headers are named
+# by module: "geometry/surface.h".
 function(mpshade_target_defaults target)
+  if(MPSHADE_ARCH)
+    target_compile_options(${target} PRIVATE -march=${MPSHADE_ARCH})
+  endif()
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wshadow=local -Wno-unused-parameter
     # GCC 12 reports false -Wrestrict positives inside std::string at -O3 (GCC bug 105329).
     -Wno-restrict)

@@ -139,8 +139,6 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
     // The back-face test allows 10 degrees more, for normals between survey points.
     EyeSet cullEyes = eyes;
     cullEyes.angle = glm::radians(std::min(range.angle + 10.0f, 180.0f));
-    const float target =
-        options.maxEdgePixels / std::sqrt(2.0f);  // a cell's diagonal is an edge too
     // How far an eye of the range can be from the representative one: for the frustum test.
     const float eyeTravel = std::max(eyes.r1 - eyeDistance, eyeDistance - eyes.r0) +
                             2.0f * eyes.r1 * std::sin(0.5f * eyes.angle);
@@ -163,7 +161,9 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
     //    rate cap.
     std::vector<Patch> patches;
     std::vector<ChartSurvey> survey;
-    std::vector<ChartPoint> grid((kGrid + 1) * (kGrid + 1));
+    // The survey grid with the chord midpoints between its points: (2 kGrid + 1)^2.
+    constexpr int kFine = 2 * kGrid;
+    std::vector<ChartPoint> grid((kFine + 1) * (kFine + 1));
     std::vector<SurfaceSample> g(grid.size());
     for (int depth = 0;; ++depth) {
         const int split = 1 << depth;
@@ -178,14 +178,16 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
         int worst = 0;
         for (size_t pi = 0; pi < patches.size(); ++pi) {
             const Patch& patch = patches[pi];
-            for (int j = 0; j <= kGrid; ++j)
-                for (int i = 0; i <= kGrid; ++i)
-                    grid[static_cast<size_t>(j * (kGrid + 1) + i)] = {
-                        patch.chart, std::min(1.0f, patch.u0 + patch.size * float(i) / kGrid),
-                        std::min(1.0f, patch.v0 + patch.size * float(j) / kGrid)};
+            for (int j = 0; j <= kFine; ++j)
+                for (int i = 0; i <= kFine; ++i)
+                    grid[static_cast<size_t>(j * (kFine + 1) + i)] = {
+                        patch.chart, std::min(1.0f, patch.u0 + patch.size * float(i) / kFine),
+                        std::min(1.0f, patch.v0 + patch.size * float(j) / kFine)};
             evaluateBatch(surface, grid, g);
+            // Survey point (i, j), i and j in [0, 2 kGrid]: even indices are the survey
+            // grid's points, odd ones the midpoints between them.
             auto at = [&](int i, int j) -> const SurfaceSample& {
-                return g[static_cast<size_t>(j * (kGrid + 1) + i)];
+                return g[static_cast<size_t>(j * (kFine + 1) + i)];
             };
             ChartSurvey& sv = survey[pi];
             float front = -1e30f;
@@ -195,45 +197,68 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
                 sv.culled = true;
                 sv.outsideFrustum = true;
             }
-            // Each survey segment's length in pixels at the closest any eye in the range
-            // comes to it (never nearer than the near plane).
-            auto pixels = [&](const SurfaceSample& a, const SurfaceSample& b) {
-                const float length = glm::length(b.P - a.P);
+            // Each survey chord in pixels at the closest the eye comes to it (never nearer
+            // than the near plane): its length (EdgeLength), or its midpoint's deviation
+            // from the surface (Flatness).
+            auto pixelsPerUnitAt = [&](const glm::vec3& p, float halfLength) {
                 const float closest =
-                    std::max(view.nearDistance, eyes.closest(0.5f * (a.P + b.P)) - 0.5f * length);
-                return length * view.pixelsPerUnit * view.fovSlack / closest;
+                    options.overRange ? eyes.closest(p) : glm::length(p - view.eye);
+                return view.pixelsPerUnit * view.fovSlack /
+                       std::max(view.nearDistance, closest - halfLength);
             };
-            auto rate = [&](float lengthPixels) {
-                return static_cast<int>(std::clamp(std::ceil(lengthPixels / target), 1.0f, 1e6f));
+            const bool flatness = options.target == DicingTarget::Flatness;
+            // Chord from survey point (i0, j0) to (i0 + 2 di, j0 + 2 dj).
+            auto chord = [&](int i0, int j0, int di, int dj) {
+                const SurfaceSample &a = at(i0, j0), &m = at(i0 + di, j0 + dj),
+                                    &b = at(i0 + 2 * di, j0 + 2 * dj);
+                const float length = glm::length(m.P - a.P) + glm::length(b.P - m.P);
+                const float scale = pixelsPerUnitAt(m.P, 0.5f * length);
+                return flatness ? glm::length(m.P - 0.5f * (a.P + b.P)) * scale : length * scale;
             };
-            float edge[4] = {0, 0, 0, 0}, rowMax = 0, colMax = 0;
-            for (int k = 0; k < kGrid; ++k) {
-                edge[0] += pixels(at(k + 1, 0), at(k, 0));
-                edge[1] += pixels(at(kGrid, k + 1), at(kGrid, k));
-                edge[2] += pixels(at(k + 1, kGrid), at(k, kGrid));
-                edge[3] += pixels(at(0, k + 1), at(0, k));
-            }
-            for (int j = 0; j <= kGrid; ++j) {
-                float row = 0, col = 0;
+            // The rate a line of kGrid chords needs.
+            const float edgeTarget = options.maxEdgePixels / std::sqrt(2.0f);  // diagonals too
+            auto rate = [&](float sumPixels, float maxPixels) {
+                const float r = flatness ? kGrid * std::sqrt(maxPixels / options.flatnessPixels)
+                                         : sumPixels / edgeTarget;
+                return static_cast<int>(std::clamp(std::ceil(r), 1.0f, 1e6f));
+            };
+            auto line = [&](int i0, int j0, int di, int dj) {
+                float sum = 0.0f, most = 0.0f;
                 for (int k = 0; k < kGrid; ++k) {
-                    row += pixels(at(k + 1, j), at(k, j));
-                    col += pixels(at(j, k + 1), at(j, k));
+                    const float p = chord(i0 + 2 * k * di, j0 + 2 * k * dj, di, dj);
+                    sum += p;
+                    most = std::max(most, p);
                 }
-                rowMax = std::max(rowMax, row);
-                colMax = std::max(colMax, col);
+                return rate(sum, most);
+            };
+            sv.desired[0] = line(0, 0, 1, 0);
+            sv.desired[1] = line(kFine, 0, 0, 1);
+            sv.desired[2] = line(0, kFine, 1, 0);
+            sv.desired[3] = line(0, 0, 0, 1);
+            sv.innerU = sv.innerV = 1;
+            for (int j = 0; j <= kFine; j += 2) {
+                sv.innerU = std::max(sv.innerU, line(0, j, 1, 0));
+                sv.innerV = std::max(sv.innerV, line(j, 0, 0, 1));
             }
-            for (int e = 0; e < 4; ++e) sv.desired[e] = rate(edge[e]);
-            sv.innerU = rate(rowMax);
-            sv.innerV = rate(colMax);
+            if (flatness) {
+                // Cell diagonals: the facets' third edges.
+                float most = 0.0f;
+                for (int j = 0; j < kFine; j += 2)
+                    for (int i = 0; i < kFine; i += 2)
+                        most = std::max({most, chord(i, j, 1, 1), chord(i + 2, j, -1, 1)});
+                const int r = rate(0.0f, most);
+                sv.innerU = std::max(sv.innerU, r);
+                sv.innerV = std::max(sv.innerV, r);
+            }
             if (!sv.culled)
                 worst = std::max({worst, sv.desired[0], sv.desired[1], sv.desired[2], sv.desired[3],
                                   sv.innerU, sv.innerV});
             for (int c = 0; c < 4; ++c) {
                 sv.corner[c] =
-                    welder.weld(at(int(kCorner[c][0]) * kGrid, int(kCorner[c][1]) * kGrid).P);
+                    welder.weld(at(int(kCorner[c][0]) * kFine, int(kCorner[c][1]) * kFine).P);
                 const int n = (c + 1) % 4;
-                const int mi = (int(kCorner[c][0]) + int(kCorner[n][0])) * kGrid / 2;
-                const int mj = (int(kCorner[c][1]) + int(kCorner[n][1])) * kGrid / 2;
+                const int mi = (int(kCorner[c][0]) + int(kCorner[n][0])) * kFine / 2;
+                const int mj = (int(kCorner[c][1]) + int(kCorner[n][1])) * kFine / 2;
                 sv.middle[c] = welder.weld(at(mi, mj).P);
             }
         }

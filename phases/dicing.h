@@ -1,15 +1,27 @@
-// dicing.h -- the static TSI (patent FIG. 4, claim 24): dice a surface into facets whose
-// projected edges stay under P/2 (P = pixel spacing) for every viewpoint in the range,
-// and near P/4 where that allows, as REYES dices grids.
+// dicing.h -- the static TSI (patent FIG. 4, claim 24): dice a surface into facets, as
+// fine as what they carry needs ("model only what the scene needs"):
+//   * EdgeLength (the combined representation, facets carrying the n-tuple per vertex):
+//     projected edges at most P/2 (P = pixel spacing) at the representative view, and
+//     near P/4 where that allows, as REYES dices grids. The dynamic phase measures the
+//     projected edges every frame and the object is diced again when they outgrow P/2.
+//   * Flatness (the separate representation, a shader map carrying the shading): every
+//     facet within 1/4 pixel of the exact surface -- its deviation, and so its silhouette
+//     error -- for every viewpoint in the range. The deviation of a chord is measured at
+//     its midpoint against the surface point at the midpoint's chart coordinates, which
+//     also bounds how far the interpolated chart coordinates stray (texture swim); a
+//     chord's deviation falls with the square of its subdivision, so the rate is
+//     8 sqrt(deviation / tolerance) for a line of 8 survey chords. A flat chart with a
+//     linear parameterization is two triangles.
 //
-// Per chart, the edge rates come from the length of each chart edge and row (sampled on a
-// 9x9 grid), each segment in pixels at the closest the range lets the eye come to it,
-// stretched by the worst off-axis magnification 1 + tan^2 (the frustum's half diagonal). Shared
-// edges are found by welding chart corners (and edge midpoints, for the quad sub-faces of
-// n-gons) and take the larger rate of their two sides, so both sides place the same
-// vertices there: OpenSubdiv's Bfr::Tessellation then triangulates each chart with its
-// four edge rates and two inner rates. Boundary vertices are welded into shared
-// positions. Closed surfaces drop patches that face away from every viewpoint in the range.
+// Per chart, the edge rates come from each chart edge and row sampled on a 9x9 grid (with
+// the chord midpoints between), each chord measured in pixels at the closest the eye
+// comes to it (the representative eye, or every eye of the range), stretched by the worst
+// off-axis magnification 1 + tan^2 (the frustum's half diagonal). Shared edges are found by
+// welding chart corners (and edge midpoints, for the quad sub-faces of n-gons) and take
+// the larger rate of their two sides, so both sides place the same vertices there:
+// OpenSubdiv's Bfr::Tessellation then triangulates each chart with its four edge rates
+// and two inner rates. Boundary vertices are welded into shared positions. Closed
+// surfaces drop patches that face away from every viewpoint in the range.
 //
 // The range's viewpoints form a spherical-shell sector around the object's centre (within
 // `angle` of the representative direction, at distances within `distance_factor`);
@@ -20,20 +32,30 @@
 // The view direction is part of the range too (it may turn by `angle`): a patch is dropped
 // when, from the representative eye, it lies outside the frustum widened by that angle
 // and by the parallax the eye's movement within the range can cause. A facet budget per
-// object bounds the worst case (a ground plane the range's eyes come close to): beyond it
-// every rate is scaled by the same factor, which keeps shared edges matched but breaks the
-// P/2 bound, and is counted.
+// object bounds the worst case: beyond it every rate is scaled by the same factor, which
+// keeps shared edges matched but breaks the bound, and is counted.
 #pragma once
 
 #include <vector>
 
 #include "geometry/surface.h"
 #include "phases/facet_mesh.h"
+#include "scene/scene.h"
 
 namespace mpshade {
 
+enum class DicingTarget {
+    EdgeLength,  // projected edges at most maxEdgePixels
+    Flatness,    // deviation from the surface at most flatnessPixels
+};
+
 struct DicingOptions {
-    float maxEdgePixels = 0.5f;  // P/2: the bound on every facet edge over the range
+    DicingTarget target = DicingTarget::EdgeLength;
+    float maxEdgePixels = 0.5f;   // P/2: the bound on every facet edge (EdgeLength)
+    float flatnessPixels = 0.25f;  // the bound on every facet's deviation (Flatness)
+    // Measure at the closest any eye of the range comes (true), or at the representative
+    // eye only (false).
+    bool overRange = true;
     int maxEdgeRate = 256;       // per patch edge; charts split into patches to stay under it
     int maxSplitDepth = 6;       // charts split into at most 2^6 x 2^6 patches
     int maxPatches = 1 << 14;    // per object

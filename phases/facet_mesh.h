@@ -1,5 +1,5 @@
-// facet_mesh.h -- the static phase's product for one object (patent FIG. 4, claims 22-25):
-// sub-pixel polygonal facets with shared vertices in fixed point, in the object's own
+// facet_mesh.h -- the geometry of the static phase's product for one object (patent FIG. 4,
+// claims 22-24): polygonal facets with shared vertices in fixed point, in the object's own
 // coordinates, and per-vertex data for the dynamic phase.
 //
 // Fixed-point format: each vertex coordinate is a 16-bit unsigned integer q over the
@@ -14,14 +14,11 @@
 #pragma once
 
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "geometry/surface_sample.h"
-#include "scene/scene.h"
-#include "shading/interpreter.h"
 
 namespace mpshade {
 
@@ -87,27 +84,11 @@ struct FacetMesh {
     VertexAttributes attributes;
     std::vector<ChartPoint> attributeChartPoint;  // where each attribute vertex lies
     std::vector<FacetCluster> clusters;           // cover every facet, in order
+    int channels = 0;                             // n-tuple rows in `attributes` (may be empty)
 
-    // The data block (claim 25): the viewpoint the facets were made for, the range of
-    // viewpoints they stay valid for, and the dynamic shader to run on them.
-    glm::vec3 representativeEye{0.0f};                   // object space
-    glm::vec3 representativeForward{0.0f, 0.0f, -1.0f};  // object space, unit
-    bool frustumCulled = false;  // patches outside the range's views were dropped
-    glm::vec3 center{0.0f};      // object space: the centre the range is measured from
-    RangeOptions range;
-    std::shared_ptr<const ShaderKernel> dynamicKernel;
-    int channels = 0;
-
-    // What dicing did.
-    int charts = 0, culledCharts = 0, cappedCharts = 0;
     size_t facetCount() const { return positionIndex.size() / 3; }
     size_t positionCount() const { return qx.size(); }
     size_t bytes() const;
-
-    // Whether a viewpoint (object space) is still inside the range: distance within the
-    // factor, direction around the centre within the angle, and, if patches were
-    // frustum culled, the view direction within the angle too.
-    bool inRange(const glm::vec3& eye, const glm::vec3& forward) const;
 };
 
 }  // namespace mpshade

@@ -1,7 +1,6 @@
 #include "phases/facet_rasterizer.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -9,20 +8,40 @@
 
 namespace mpshade {
 
-void FragmentBuffer::resize(int w, int h, int samplesPerPixel, int k) {
+void VisibilityBuffer::resize(int w, int h, int samplesPerPixel, int k) {
     width = w;
     height = h;
     spp = samplesPerPixel;
     layers = k;
     const size_t n = static_cast<size_t>(w) * h * samplesPerPixel;
-    fragments.resize(n * static_cast<size_t>(k));
-    count.assign(n, 0);
+    count.resize(n);
+    invDepth.resize(n * static_cast<size_t>(k));
+    object.resize(n * static_cast<size_t>(k));
+    facet.resize(n * static_cast<size_t>(k));
 }
 
 namespace {
 
-struct Binned {
-    uint32_t object, facet;
+constexpr int kSub = FixedPointWarp::kSubpixelBits;
+
+// A binned facet: the facet, and which of its clipped triangles (-1: the facet itself).
+struct Item {
+    uint32_t facet;
+    int32_t clip;
+};
+
+// A fixed run of one object's facets, binned by one task into bins of its own, so the
+// facet order within a tile, and the image, do not depend on scheduling.
+struct Chunk {
+    uint32_t object = 0;
+    size_t begin = 0, end = 0;                // facets
+    size_t clusterBegin = 0, clusterEnd = 0;  // clusters covering them (empty: none)
+    std::vector<uint32_t> entryTile;
+    std::vector<Item> entries, sorted;  // in facet order; by tile, facet order within
+    std::vector<uint32_t> tileStart;    // tiles + 1 offsets into sorted
+    std::vector<ScreenTriangle> clipped;
+    RasterStats stats;
+    int64_t longestEdge2 = 0;  // squared, in (1/256 pixel)^2
 };
 
 // The tie rule: a sample exactly on edge (dx, dy) is inside for this direction and not for
@@ -31,129 +50,265 @@ inline bool ownsEdge(int64_t dx, int64_t dy) {
     return dy > 0 || (dy == 0 && dx < 0);
 }
 
-struct PixelBox {
-    int x0, y0, x1, y1;  // inclusive pixels
-};
-
-inline bool facetBox(const WarpedVertices& w, const uint32_t* p, int width, int height,
-                     PixelBox& box) {
-    const int32_t minX = std::min({w.x[p[0]], w.x[p[1]], w.x[p[2]]}),
-                  maxX = std::max({w.x[p[0]], w.x[p[1]], w.x[p[2]]});
-    const int32_t minY = std::min({w.y[p[0]], w.y[p[1]], w.y[p[2]]}),
-                  maxY = std::max({w.y[p[0]], w.y[p[1]], w.y[p[2]]});
-    box.x0 = std::max(0, minX >> FixedPointWarp::kSubpixelBits);
-    box.y0 = std::max(0, minY >> FixedPointWarp::kSubpixelBits);
-    box.x1 = std::min(width - 1, maxX >> FixedPointWarp::kSubpixelBits);
-    box.y1 = std::min(height - 1, maxY >> FixedPointWarp::kSubpixelBits);
-    return box.x0 <= box.x1 && box.y0 <= box.y1;
+inline int64_t signedArea(const ScreenTriangle& t) {
+    return int64_t(t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) -
+           int64_t(t.y[1] - t.y[0]) * (t.x[2] - t.x[0]);
 }
 
-void insertFragment(FragmentBuffer& out, size_t sample, const Fragment& f, RasterStats& stats) {
-    Fragment* list = &out.fragments[sample * static_cast<size_t>(out.layers)];
-    uint8_t& n = out.count[sample];
+inline ScreenTriangle screenTriangle(const WarpedVertices& w, const uint32_t* p) {
+    ScreenTriangle t;
+    for (int i = 0; i < 3; ++i) {
+        t.x[i] = w.x[p[i]];
+        t.y[i] = w.y[p[i]];
+        t.invDepth[i] = w.invDepth[p[i]];
+    }
+    return t;
+}
+
+// A facet's edge functions and depth relative to a tile's origin (ox, oy), in 1/256
+// pixels: e_i(lx, ly) = c_i + a_i lx + b_i ly, inside when every e_i > 0 (the tie rule
+// folded into c_i: e_i are integers, so e_i >= 0 becomes e_i + 1 > 0); 1 / depth =
+// zc + zx lx + zy ly. Every value below 2^53 is an exact integer in double.
+struct Setup {
+    double c[3], a[3], b[3];
+    double zc, zx, zy;
+};
+
+void setUp(const ScreenTriangle& tri, int64_t ox, int64_t oy, Setup& s) {
+    int64_t x[3] = {tri.x[0], tri.x[1], tri.x[2]}, y[3] = {tri.y[0], tri.y[1], tri.y[2]};
+    float w[3] = {tri.invDepth[0], tri.invDepth[1], tri.invDepth[2]};
+    int64_t area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    if (area < 0) {
+        std::swap(x[1], x[2]);
+        std::swap(y[1], y[2]);
+        std::swap(w[1], w[2]);
+        area = -area;
+    }
+    // Edge i runs from vertex i + 1 to i + 2, opposite vertex i; e_i is +area at vertex i.
+    const double invArea = 1.0 / static_cast<double>(area);
+    s.zc = s.zx = s.zy = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3, k = (i + 2) % 3;
+        const int64_t dx = x[k] - x[j], dy = y[k] - y[j];
+        const int64_t c = dx * (oy - y[j]) - dy * (ox - x[j]);
+        s.c[i] = static_cast<double>(c + (ownsEdge(dx, dy) ? 1 : 0));
+        s.a[i] = static_cast<double>(-dy);
+        s.b[i] = static_cast<double>(dx);
+        s.zc += w[i] * static_cast<double>(c) * invArea;
+        s.zx += w[i] * static_cast<double>(-dy) * invArea;
+        s.zy += w[i] * static_cast<double>(dx) * invArea;
+    }
+}
+
+// One row of samples against one facet, single layer: a depth test where the sample is
+// inside. Returns the samples inside. The hot loop of the rasterizer: plain arithmetic on
+// doubles that GCC vectorizes, compiled for AVX2 and for the baseline, chosen at run time.
+__attribute__((target_clones("avx2", "default"))) uint32_t rowDepthTest(
+    const int32_t* fx, const int32_t* fy, size_t n, int32_t ox, int32_t oy, const Setup& s,
+    bool edges, float* inv, uint32_t* object, uint32_t* facet, uint32_t o, uint32_t f) {
+    const double c0 = s.c[0], c1 = s.c[1], c2 = s.c[2];
+    const double a0 = s.a[0], a1 = s.a[1], a2 = s.a[2];
+    const double b0 = s.b[0], b1 = s.b[1], b2 = s.b[2];
+    const double zc = s.zc, zx = s.zx, zy = s.zy;
+    uint32_t inside = 0;
+    if (edges) {
+        for (size_t i = 0; i < n; ++i) {
+            const double lx = fx[i] - ox, ly = fy[i] - oy;
+            const bool in = (c0 + a0 * lx + b0 * ly > 0.0) & (c1 + a1 * lx + b1 * ly > 0.0) &
+                            (c2 + a2 * lx + b2 * ly > 0.0);
+            const float z = static_cast<float>(zc + zx * lx + zy * ly);
+            const bool hit = in & (z > inv[i]);
+            inside += in;
+            inv[i] = hit ? z : inv[i];
+            object[i] = hit ? o : object[i];
+            facet[i] = hit ? f : facet[i];
+        }
+    } else {
+        for (size_t i = 0; i < n; ++i) {
+            const double lx = fx[i] - ox, ly = fy[i] - oy;
+            const float z = static_cast<float>(zc + zx * lx + zy * ly);
+            const bool hit = z > inv[i];
+            inv[i] = hit ? z : inv[i];
+            object[i] = hit ? o : object[i];
+            facet[i] = hit ? f : facet[i];
+        }
+        inside = static_cast<uint32_t>(n);
+    }
+    return inside;
+}
+
+// Per thread: one tile's samples, `layers` slots each, local while the tile is drawn.
+struct TileScratch {
+    std::vector<float> inv;
+    std::vector<uint32_t> object, facet;
+    std::vector<uint8_t> count;
+    void prepare(size_t samples, int layers, float farInv) {
+        const size_t n = samples * static_cast<size_t>(layers);
+        inv.assign(n, farInv);
+        object.assign(n, 0);
+        facet.assign(n, 0);
+        count.assign(samples, 0);
+    }
+};
+
+// Inserts a surface into a sample's k-buffer (nearest first), cut short behind an opaque one.
+void insertLayer(TileScratch& t, size_t sample, int layers, float z, uint32_t o, uint32_t f,
+                 bool opaque, const std::vector<uint8_t>& objectOpaque, RasterStats& stats) {
+    float* inv = &t.inv[sample * static_cast<size_t>(layers)];
+    uint32_t* obj = &t.object[sample * static_cast<size_t>(layers)];
+    uint32_t* fac = &t.facet[sample * static_cast<size_t>(layers)];
+    uint8_t& n = t.count[sample];
     int pos = 0;
-    while (pos < n && list[pos].depth <= f.depth) {
-        if (list[pos].opaque) return;  // hidden behind an opaque fragment
+    while (pos < n && inv[pos] >= z) {
+        if (objectOpaque[obj[pos]]) return;  // hidden behind an opaque surface
         ++pos;
     }
-    if (pos >= out.layers) {
+    if (pos >= layers) {
         ++stats.droppedLayers;
         return;
     }
-    const int keep = f.opaque ? pos : std::min<int>(n, out.layers - 1);
-    if (!f.opaque && n == out.layers) ++stats.droppedLayers;
-    for (int k = keep; k > pos; --k) list[k] = list[k - 1];
-    list[pos] = f;
-    n = static_cast<uint8_t>(f.opaque ? pos + 1 : keep + 1);
+    const int keep = opaque ? pos : std::min<int>(n, layers - 1);
+    if (!opaque && n == layers) ++stats.droppedLayers;
+    for (int k = keep; k > pos; --k) {
+        inv[k] = inv[k - 1];
+        obj[k] = obj[k - 1];
+        fac[k] = fac[k - 1];
+    }
+    inv[pos] = z;
+    obj[pos] = o;
+    fac[pos] = f;
+    n = static_cast<uint8_t>(opaque ? pos + 1 : keep + 1);
 }
 
 }  // namespace
 
-void rasterizeFacets(const std::vector<RasterObject>& objects, const SampleBuffer& samples,
-                     const RasterOptions& options, FragmentBuffer& out, RasterStats& stats) {
-    const int width = samples.width, height = samples.height, spp = samples.spp;
-    out.resize(width, height, spp, options.layers);
-    const int tile = std::max(1, options.tileSize);
+struct FacetRasterizer::State {
+    std::vector<Chunk> chunks;
+    tbb::enumerable_thread_specific<TileScratch> scratch;
+    tbb::enumerable_thread_specific<RasterStats> tileStats;
+    std::vector<uint8_t> objectOpaque;
+};
+
+FacetRasterizer::FacetRasterizer() : state_(std::make_unique<State>()) {}
+FacetRasterizer::~FacetRasterizer() = default;
+
+void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
+                                const SampleLayout& samples, float farDepth,
+                                const RasterOptions& options, VisibilityBuffer& out,
+                                RasterStats& stats) {
+    State& st = *state_;
+    const int width = samples.width(), height = samples.height(), spp = samples.spp();
+    bool allOpaque = true;
+    st.objectOpaque.resize(objects.size());
+    for (size_t o = 0; o < objects.size(); ++o) {
+        st.objectOpaque[o] = objects[o].opaque ? 1 : 0;
+        allOpaque = allOpaque && objects[o].opaque;
+    }
+    const int layers = allOpaque ? 1 : std::clamp(options.layers, 1, 255);
+    out.resize(width, height, spp, layers);
+    const int tile = std::clamp(options.tileSize, 1, 256);
     const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
     const size_t tileCount = static_cast<size_t>(tilesX) * tilesY;
+    const float farInv = farDepth > 0.0f && std::isfinite(farDepth) ? 1.0f / farDepth : 0.0f;
 
-    // Sample positions on the sub-pixel grid.
-    std::vector<int32_t> sx(samples.xy.size() / 2), sy(samples.xy.size() / 2);
-    for (size_t i = 0; i < sx.size(); ++i) {
-        sx[i] = static_cast<int32_t>(std::lround(samples.xy[2 * i] * 256.0f));
-        sy[i] = static_cast<int32_t>(std::lround(samples.xy[2 * i + 1] * 256.0f));
-    }
-
-    // Bin facets into tiles. The facets are cut into fixed chunks, each binned by one task
-    // into bins of its own (no atomics); a tile then takes the chunks' bins in chunk order,
-    // so the facet order, and the image, do not depend on scheduling.
-    struct FacetRange {
-        uint32_t object;
-        size_t begin, end;                // facets
-        size_t clusterBegin, clusterEnd;  // clusters covering them (empty: none)
+    // Chunks: whole clusters per chunk, so a culled cluster is skipped in one step.
+    constexpr size_t kFacetsPerChunk = 1 << 15;
+    size_t chunkCount = 0;
+    auto addChunk = [&](uint32_t o, size_t begin, size_t end, size_t cb, size_t ce) {
+        if (chunkCount == st.chunks.size()) st.chunks.emplace_back();
+        Chunk& c = st.chunks[chunkCount++];
+        c.object = o, c.begin = begin, c.end = end, c.clusterBegin = cb, c.clusterEnd = ce;
     };
-    constexpr size_t kFacetsPerChunk = 1 << 16;
-    std::vector<FacetRange> ranges;
     for (uint32_t o = 0; o < objects.size(); ++o) {
+        if (!objects[o].mesh) continue;
         const FacetMesh& mesh = *objects[o].mesh;
         if (mesh.clusters.empty()) {
             for (size_t f = 0; f < mesh.facetCount(); f += kFacetsPerChunk)
-                ranges.push_back({o, f, std::min(f + kFacetsPerChunk, mesh.facetCount()), 0, 0});
+                addChunk(o, f, std::min(f + kFacetsPerChunk, mesh.facetCount()), 0, 0);
             continue;
         }
-        // Whole clusters per chunk, so a culled cluster is skipped in one step.
         size_t first = 0;
         while (first < mesh.clusters.size()) {
             size_t last = first, facets = 0;
             while (last < mesh.clusters.size() &&
                    (last == first || facets + mesh.clusters[last].facetCount <= kFacetsPerChunk))
                 facets += mesh.clusters[last++].facetCount;
-            ranges.push_back({o, mesh.clusters[first].firstFacet,
-                              mesh.clusters[first].firstFacet + facets, first, last});
+            addChunk(o, mesh.clusters[first].firstFacet, mesh.clusters[first].firstFacet + facets,
+                     first, last);
             first = last;
         }
     }
-    std::vector<std::vector<std::vector<Binned>>> chunkBins(ranges.size());
-    std::vector<RasterStats> chunkStats(ranges.size());
-    tbb::parallel_for(size_t{0}, ranges.size(), [&](size_t c) {
-        const FacetRange& range = ranges[c];
-        const FacetMesh& mesh = *objects[range.object].mesh;
-        const WarpedVertices& w = *objects[range.object].warped;
-        auto& bins = chunkBins[c];
-        bins.resize(tileCount);
-        RasterStats& st = chunkStats[c];
-        st.facets = range.end - range.begin;
+
+    // 1. Bin.
+    tbb::parallel_for(size_t{0}, chunkCount, [&](size_t ci) {
+        Chunk& c = st.chunks[ci];
+        const RasterObject& obj = objects[c.object];
+        const FacetMesh& mesh = *obj.mesh;
+        const WarpedVertices& w = *obj.warped;
+        c.entries.clear();
+        c.entryTile.clear();
+        c.clipped.clear();
+        c.stats = RasterStats{};
+        c.longestEdge2 = 0;
+        const bool measure = obj.longestEdgePixels != nullptr;
+        RasterStats& s = c.stats;
+        s.facets = c.end - c.begin;
+        auto binTriangle = [&](const ScreenTriangle& t, uint32_t f, int32_t clip) {
+            const int64_t area = signedArea(t);
+            if (area == 0) {
+                ++s.facetsDegenerate;
+                return;
+            }
+            // Facets wind counter-clockwise about their normal; the screen's y points
+            // down, so a facet seen from the front has negative area here.
+            if (obj.cullBackFaces && area > 0) {
+                ++s.facetsBackFacing;
+                return;
+            }
+            const int32_t minX = std::min({t.x[0], t.x[1], t.x[2]}),
+                          maxX = std::max({t.x[0], t.x[1], t.x[2]});
+            const int32_t minY = std::min({t.y[0], t.y[1], t.y[2]}),
+                          maxY = std::max({t.y[0], t.y[1], t.y[2]});
+            const int x0 = std::max(0, minX >> kSub), y0 = std::max(0, minY >> kSub);
+            const int x1 = std::min(width - 1, maxX >> kSub), y1 = std::min(height - 1, maxY >> kSub);
+            if (x0 > x1 || y0 > y1) return;
+            for (int ty = y0 / tile; ty <= y1 / tile; ++ty)
+                for (int tx = x0 / tile; tx <= x1 / tile; ++tx) {
+                    c.entryTile.push_back(static_cast<uint32_t>(ty * tilesX + tx));
+                    c.entries.push_back({f, clip});
+                }
+        };
         auto binFacet = [&](size_t f) {
             const uint32_t* p = &mesh.positionIndex[3 * f];
-            if (w.culled[p[0]] | w.culled[p[1]] | w.culled[p[2]]) {
-                ++st.facetsCulled;
+            if (!(w.culled[p[0]] | w.culled[p[1]] | w.culled[p[2]])) {
+                const ScreenTriangle t = screenTriangle(w, p);
+                if (measure)
+                    for (int i = 0; i < 3; ++i) {
+                        const int64_t dx = t.x[(i + 1) % 3] - t.x[i], dy = t.y[(i + 1) % 3] - t.y[i];
+                        c.longestEdge2 = std::max(c.longestEdge2, dx * dx + dy * dy);
+                    }
+                binTriangle(t, static_cast<uint32_t>(f), -1);
                 return;
             }
-            const int64_t area = int64_t(w.x[p[1]] - w.x[p[0]]) * (w.y[p[2]] - w.y[p[0]]) -
-                                 int64_t(w.y[p[1]] - w.y[p[0]]) * (w.x[p[2]] - w.x[p[0]]);
-            if (area == 0) {
-                ++st.facetsDegenerate;
+            ScreenTriangle pieces[6];
+            const int n = obj.warp ? clipFacet(*obj.warp, mesh, w, p, pieces) : 0;
+            if (n == 0) {
+                ++s.facetsCulled;
                 return;
             }
-            // Facets wind counter-clockwise about their normal; the screen's y points down,
-            // so a facet seen from the front has negative area here.
-            if (objects[range.object].cullBackFaces && area > 0) {
-                ++st.facetsBackFacing;
-                return;
+            ++s.facetsClipped;
+            for (int k = 0; k < n; ++k) {
+                const int32_t index = static_cast<int32_t>(c.clipped.size());
+                c.clipped.push_back(pieces[k]);
+                binTriangle(pieces[k], static_cast<uint32_t>(f), index);
             }
-            PixelBox box;
-            if (!facetBox(w, p, width, height, box)) return;
-            for (int ty = box.y0 / tile; ty <= box.y1 / tile; ++ty)
-                for (int tx = box.x0 / tile; tx <= box.x1 / tile; ++tx)
-                    bins[static_cast<size_t>(ty) * tilesX + tx].push_back(
-                        {range.object, static_cast<uint32_t>(f)});
         };
-        const uint8_t* visible = objects[range.object].clusterVisible;
-        if (range.clusterEnd > range.clusterBegin) {
-            for (size_t k = range.clusterBegin; k < range.clusterEnd; ++k) {
+        const uint8_t* visible = obj.clusterVisible;
+        if (c.clusterEnd > c.clusterBegin) {
+            for (size_t k = c.clusterBegin; k < c.clusterEnd; ++k) {
                 const FacetCluster& cluster = mesh.clusters[k];
                 if (visible && !visible[k]) {
-                    st.facetsInCulledClusters += cluster.facetCount;
+                    s.facetsInCulledClusters += cluster.facetCount;
                     continue;
                 }
                 for (size_t f = cluster.firstFacet; f < cluster.firstFacet + cluster.facetCount;
@@ -161,100 +316,145 @@ void rasterizeFacets(const std::vector<RasterObject>& objects, const SampleBuffe
                     binFacet(f);
             }
         } else {
-            for (size_t f = range.begin; f < range.end; ++f) binFacet(f);
+            for (size_t f = c.begin; f < c.end; ++f) binFacet(f);
         }
+        // Counting sort by tile, stable: facet order within each tile.
+        c.tileStart.assign(tileCount + 1, 0);
+        for (uint32_t t : c.entryTile) ++c.tileStart[t + 1];
+        for (size_t t = 0; t < tileCount; ++t) c.tileStart[t + 1] += c.tileStart[t];
+        c.sorted.resize(c.entries.size());
+        std::vector<uint32_t>& next = c.entryTile;  // reused: entries' tiles become cursors
+        for (size_t e = 0; e < c.entries.size(); ++e) {
+            const uint32_t t = next[e];
+            c.sorted[c.tileStart[t]++] = c.entries[e];
+        }
+        for (size_t t = tileCount; t > 0; --t) c.tileStart[t] = c.tileStart[t - 1];
+        c.tileStart[0] = 0;
     });
 
-    tbb::enumerable_thread_specific<RasterStats> tileStats;
+    // 2. Rasterize tiles in parallel.
+    for (RasterStats& s : st.tileStats) s = RasterStats{};
+    const int32_t* fx = samples.fixedX();
+    const int32_t* fy = samples.fixedY();
     tbb::parallel_for(size_t{0}, tileCount, [&](size_t t) {
-        RasterStats& st = tileStats.local();
+        RasterStats& s = st.tileStats.local();
+        TileScratch& scratch = st.scratch.local();
         const int tx0 = static_cast<int>(t % tilesX) * tile,
                   ty0 = static_cast<int>(t / tilesX) * tile;
         const int tx1 = std::min(width, tx0 + tile) - 1, ty1 = std::min(height, ty0 + tile) - 1;
-        for (size_t chunk = 0; chunk < chunkBins.size(); ++chunk)
-            for (const Binned& bin : chunkBins[chunk][t]) {
-                const RasterObject& obj = objects[bin.object];
-                const WarpedVertices& w = *obj.warped;
-                const uint32_t* p = &obj.mesh->positionIndex[3 * static_cast<size_t>(bin.facet)];
-                int64_t x[3] = {w.x[p[0]], w.x[p[1]], w.x[p[2]]},
-                        y[3] = {w.y[p[0]], w.y[p[1]], w.y[p[2]]};
-                float invW[3] = {1.0f / w.depth[p[0]], 1.0f / w.depth[p[1]], 1.0f / w.depth[p[2]]};
-                int64_t area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
-                // Positive orientation; remember which original corners 1 and 2 are.
-                int c1 = 1, c2 = 2;
-                if (area < 0) {
-                    std::swap(x[1], x[2]);
-                    std::swap(y[1], y[2]);
-                    std::swap(invW[1], invW[2]);
-                    std::swap(c1, c2);
-                    area = -area;
-                }
-                ++st.facetsBinned;
-                // Edge k runs from vertex k + 1 to k + 2, opposite vertex k.
-                const int64_t dx[3] = {x[2] - x[1], x[0] - x[2], x[1] - x[0]};
-                const int64_t dy[3] = {y[2] - y[1], y[0] - y[2], y[1] - y[0]};
-                const int64_t ax[3] = {x[1], x[2], x[0]}, ay[3] = {y[1], y[2], y[0]};
-                const bool owns[3] = {ownsEdge(dx[0], dy[0]), ownsEdge(dx[1], dy[1]),
-                                      ownsEdge(dx[2], dy[2])};
-                PixelBox box;
-                facetBox(w, p, width, height, box);
-                box.x0 = std::max(box.x0, tx0), box.y0 = std::max(box.y0, ty0);
-                box.x1 = std::min(box.x1, tx1), box.y1 = std::min(box.y1, ty1);
-                const float invArea = 1.0f / static_cast<float>(area);
-                const int64_t minX = std::min({x[0], x[1], x[2]}),
-                              maxX = std::max({x[0], x[1], x[2]});
-                const int64_t minY = std::min({y[0], y[1], y[2]}),
-                              maxY = std::max({y[0], y[1], y[2]});
-                for (int py = box.y0; py <= box.y1; ++py) {
-                    for (int px = box.x0; px <= box.x1; ++px) {
-                        for (int k = 0; k < spp; ++k) {
-                            const size_t s = samples.index(px, py, k);
-                            const int64_t qx = sx[s], qy = sy[s];
-                            // Most sub-pixel facets hold no sample: reject on the box first.
-                            if (qx < minX || qx > maxX || qy < minY || qy > maxY) continue;
-                            int64_t e[3];
-                            bool inside = true;
-                            for (int i = 0; i < 3; ++i) {
-                                // With positive orientation, e[i] is +area at vertex i and 0
-                                // on edge i: the interior has every e[i] > 0.
-                                e[i] = dx[i] * (qy - ay[i]) - dy[i] * (qx - ax[i]);
-                                inside = inside && (e[i] > 0 || (e[i] == 0 && owns[i]));
-                            }
-                            if (!inside) continue;
-                            // Screen-space weights, then perspective-correct ones.
-                            const float l0 = static_cast<float>(e[0]) * invArea * invW[0];
-                            const float l1 = static_cast<float>(e[1]) * invArea * invW[1];
-                            const float l2 = static_cast<float>(e[2]) * invArea * invW[2];
-                            const float sum = l0 + l1 + l2;
-                            Fragment f;
-                            f.depth = 1.0f / sum;
-                            f.object = bin.object;
-                            f.facet = bin.facet;
-                            const float w1 = (c1 == 1 ? l1 : l2) / sum,
-                                        w2 = (c2 == 2 ? l2 : l1) / sum;
-                            f.b1 = w1;
-                            f.b2 = w2;
-                            f.opaque = obj.opaque ? 1u : 0u;
-                            ++st.fragments;
-                            insertFragment(out, s, f, st);
+        const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
+        const size_t rowSamples = static_cast<size_t>(tw) * spp;
+        scratch.prepare(rowSamples * th, layers, farInv);
+        const int32_t ox = tx0 << kSub, oy = ty0 << kSub;
+        const double cornerX[2] = {0.0, static_cast<double>(tw << kSub)};
+        const double cornerY[2] = {0.0, static_cast<double>(th << kSub)};
+        for (size_t ci = 0; ci < chunkCount; ++ci) {
+            const Chunk& c = st.chunks[ci];
+            const RasterObject& obj = objects[c.object];
+            for (uint32_t e = c.tileStart[t]; e < c.tileStart[t + 1]; ++e) {
+                const Item& item = c.sorted[e];
+                const ScreenTriangle tri =
+                    item.clip >= 0
+                        ? c.clipped[static_cast<size_t>(item.clip)]
+                        : screenTriangle(*obj.warped,
+                                         &obj.mesh->positionIndex[3 * size_t{item.facet}]);
+                Setup su;
+                setUp(tri, ox, oy, su);
+                // The edges at the tile's corners: all inside, the tile is covered whole;
+                // one wholly outside, nothing to do.
+                bool whole = true, outside = false;
+                for (int i = 0; i < 3; ++i) {
+                    double lo = 1e300, hi = -1e300;
+                    for (double cy : cornerY)
+                        for (double cx : cornerX) {
+                            const double edge = su.c[i] + su.a[i] * cx + su.b[i] * cy;
+                            lo = std::min(lo, edge);
+                            hi = std::max(hi, edge);
                         }
+                    whole = whole && lo > 0.0;
+                    outside = outside || hi <= 0.0;
+                }
+                if (outside) continue;
+                ++s.facetsBinned;
+                s.tilesCoveredWhole += whole;
+                const int32_t minX = std::min({tri.x[0], tri.x[1], tri.x[2]}),
+                              maxX = std::max({tri.x[0], tri.x[1], tri.x[2]});
+                const int32_t minY = std::min({tri.y[0], tri.y[1], tri.y[2]}),
+                              maxY = std::max({tri.y[0], tri.y[1], tri.y[2]});
+                const int bx0 = std::max(tx0, minX >> kSub), by0 = std::max(ty0, minY >> kSub);
+                const int bx1 = std::min(tx1, maxX >> kSub), by1 = std::min(ty1, maxY >> kSub);
+                for (int py = by0; py <= by1; ++py) {
+                    const size_t g = samples.index(bx0, py, 0);
+                    const size_t n = static_cast<size_t>(bx1 - bx0 + 1) * spp;
+                    const size_t l = static_cast<size_t>(py - ty0) * rowSamples +
+                                     static_cast<size_t>(bx0 - tx0) * spp;
+                    if (layers == 1) {
+                        s.fragments += rowDepthTest(fx + g, fy + g, n, ox, oy, su, !whole,
+                                                    &scratch.inv[l], &scratch.object[l],
+                                                    &scratch.facet[l], c.object, item.facet);
+                        continue;
+                    }
+                    for (size_t i = 0; i < n; ++i) {
+                        const double lx = fx[g + i] - ox, ly = fy[g + i] - oy;
+                        bool in = true;
+                        for (int k = 0; k < 3; ++k)
+                            in = in && su.c[k] + su.a[k] * lx + su.b[k] * ly > 0.0;
+                        if (!in) continue;
+                        const float z = static_cast<float>(su.zc + su.zx * lx + su.zy * ly);
+                        if (!(z > farInv)) continue;
+                        ++s.fragments;
+                        insertLayer(scratch, l + i, layers, z, c.object, item.facet, obj.opaque,
+                                    st.objectOpaque, s);
                     }
                 }
             }
+        }
+        // Out to the frame's buffer, row by row.
+        for (int py = ty0; py <= ty1; ++py) {
+            const size_t g = samples.index(tx0, py, 0);
+            const size_t l = static_cast<size_t>(py - ty0) * rowSamples;
+            const size_t gl = g * static_cast<size_t>(layers), ll = l * static_cast<size_t>(layers);
+            const size_t nl = rowSamples * static_cast<size_t>(layers);
+            std::copy_n(&scratch.inv[ll], nl, &out.invDepth[gl]);
+            std::copy_n(&scratch.object[ll], nl, &out.object[gl]);
+            std::copy_n(&scratch.facet[ll], nl, &out.facet[gl]);
+            if (layers == 1) {
+                for (size_t i = 0; i < rowSamples; ++i)
+                    out.count[g + i] = scratch.inv[l + i] > farInv ? 1 : 0;
+            } else {
+                std::copy_n(&scratch.count[l], rowSamples, &out.count[g]);
+            }
+        }
     });
     stats = RasterStats{};
-    for (const RasterStats& s : chunkStats) {
+    for (const RasterObject& obj : objects)
+        if (obj.longestEdgePixels) *obj.longestEdgePixels = 0.0f;
+    for (size_t ci = 0; ci < chunkCount; ++ci) {
+        if (float* longest = objects[st.chunks[ci].object].longestEdgePixels)
+            *longest = std::max(*longest, static_cast<float>(std::sqrt(static_cast<double>(
+                                              st.chunks[ci].longestEdge2))) /
+                                              256.0f);
+        const RasterStats& s = st.chunks[ci].stats;
         stats.facets += s.facets;
         stats.facetsCulled += s.facetsCulled;
+        stats.facetsClipped += s.facetsClipped;
         stats.facetsDegenerate += s.facetsDegenerate;
         stats.facetsBackFacing += s.facetsBackFacing;
         stats.facetsInCulledClusters += s.facetsInCulledClusters;
     }
-    for (const RasterStats& s : tileStats) {
+    for (const RasterStats& s : st.tileStats) {
         stats.facetsBinned += s.facetsBinned;
+        stats.tilesCoveredWhole += s.tilesCoveredWhole;
         stats.fragments += s.fragments;
         stats.droppedLayers += s.droppedLayers;
     }
+}
+
+void rasterizeFacets(const std::vector<RasterObject>& objects, const SampleLayout& samples,
+                     float farDepth, const RasterOptions& options, VisibilityBuffer& out,
+                     RasterStats& stats) {
+    FacetRasterizer rasterizer;
+    rasterizer.rasterize(objects, samples, farDepth, options, out, stats);
 }
 
 }  // namespace mpshade

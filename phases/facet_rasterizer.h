@@ -1,68 +1,100 @@
-// facet_rasterizer.h -- the dynamic TSI's sampling: warped facets to sub-pixel samples.
+// facet_rasterizer.h -- the dynamic TSI's sampling: warped facets to a visibility buffer
+// (which facet of which object each sub-pixel sample sees; Burns and Hunt 2013). What the
+// surface looks like there -- barycentric weights, the n-tuple, shading -- is worked out
+// later, once per visible surface, not for every facet a sample is tested against.
 //
-// Watertight: edge functions are evaluated exactly in int64 on 8-bit sub-pixel
-// coordinates (|x| < 2^23, so products stay under 2^47), and a sample exactly on an edge
-// belongs to exactly one of the two facets sharing it (a tie rule on the edge direction
-// that is true for one direction and false for the other, like Direct3D's top-left rule).
-// Since neighbouring facets share the very same warped vertices, no sample falls between
-// them. Each sample keeps its nearest `layers` fragments in depth order (a k-buffer), cut
-// short behind the first opaque one, so translucent surfaces composite front to back.
-// Screen tiles are rasterized in parallel.
+// Watertight: edge functions are exact integers on 8-bit sub-pixel coordinates (|x| <=
+// 2^23, so each is below 2^51), and a sample exactly on an edge belongs to exactly one of
+// the two facets sharing it (a tie rule on the edge direction, true for one direction and
+// false for the other, like Direct3D's top-left rule). Neighbouring facets share the very
+// same warped vertices (facets crossing the near plane or the guard band are clipped with
+// shared crossings, facet_clipping.h), so no sample falls between them.
+//
+// Speed: the screen is cut into tiles rasterized in parallel; facets are binned into them
+// in fixed chunks (deterministic order). Within a tile, a facet's edge functions and
+// depth are evaluated for a row of samples at a time in double lanes (exact for these
+// integers, and vectorized: AVX2 where the CPU has it, chosen at run time, SSE2
+// otherwise); a tile a facet covers whole skips the edge tests. Each sample keeps its
+// nearest `layers` surfaces in depth order (a k-buffer) cut short behind the first opaque
+// one; with every object opaque, one layer and a plain depth test.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "phases/facet_clipping.h"
 #include "phases/facet_mesh.h"
 #include "phases/fixed_point_warp.h"
 #include "phases/sample_pattern.h"
 
 namespace mpshade {
 
-struct Fragment {
-    float depth;      // view depth (world units)
-    uint32_t object;  // index in the frame's object list
-    uint32_t facet;
-    float b1, b2;  // perspective-correct weights of the facet's corners 1 and 2
-    uint32_t opaque;
-};
-
-struct FragmentBuffer {
-    int width = 0, height = 0, spp = 1, layers = 4;
-    std::vector<Fragment> fragments;  // layers per sample, sample order as SampleBuffer
-    std::vector<uint8_t> count;       // fragments kept per sample
-    void resize(int w, int h, int samplesPerPixel, int k);
-};
-
 struct RasterObject {
-    const FacetMesh* mesh = nullptr;
+    const FacetMesh* mesh = nullptr;  // null: nothing to draw
     const WarpedVertices* warped = nullptr;
+    // Clips facets with a corner the warp culled; null: such facets are dropped.
+    const FixedPointWarp* warp = nullptr;
     bool opaque = true;
     // Skip facets that face away from the eye: only for closed, opaque surfaces, whose
     // back faces are always behind a front face.
     bool cullBackFaces = false;
     // Per cluster of the mesh: 0 skips the cluster's facets entirely (null: all visible).
     const uint8_t* clusterVisible = nullptr;
+    // If set: receives the longest projected edge, in pixels, of the facets offered (those
+    // of visible clusters, clipped ones excepted).
+    float* longestEdgePixels = nullptr;
+};
+
+// What each sample sees: up to `layers` surfaces, nearest first.
+struct VisibilityBuffer {
+    int width = 0, height = 0, spp = 1, layers = 1;
+    std::vector<uint8_t> count;  // surfaces kept per sample
+    // `layers` slots per sample: slot sample * layers + l.
+    std::vector<float> invDepth;  // 1 / view depth (world units)
+    std::vector<uint32_t> object, facet;
+    void resize(int w, int h, int samplesPerPixel, int k);
 };
 
 struct RasterStats {
     uint64_t facets = 0;            // offered
-    uint64_t facetsCulled = 0;      // a vertex behind the near plane or outside the guard band
+    uint64_t facetsCulled = 0;      // wholly behind the near plane or outside the guard band
+    uint64_t facetsClipped = 0;     // crossing the near plane or the guard band: clipped
     uint64_t facetsDegenerate = 0;  // zero area on the sub-pixel grid
     uint64_t facetsBackFacing = 0;  // culled as back faces of closed opaque surfaces
     uint64_t facetsInCulledClusters = 0;  // skipped with their whole cluster
     uint64_t facetsBinned = 0;            // facet-tile pairs rasterized
-    uint64_t fragments = 0;               // sample hits kept or tested into the k-buffer
-    uint64_t droppedLayers = 0;           // translucent fragments beyond the k-buffer's depth
+    uint64_t tilesCoveredWhole = 0;       // facet-tile pairs that skipped the edge tests
+    uint64_t fragments = 0;               // sample hits tested against the depth buffer
+    uint64_t droppedLayers = 0;           // translucent surfaces beyond the k-buffer's depth
 };
 
 struct RasterOptions {
     int tileSize = 16;  // pixels
-    int layers = 4;     // fragments kept per sample
+    int layers = 4;     // surfaces kept per sample when some object is translucent
 };
 
-// `samples` supplies the sample positions (its xy); `out` receives the fragments.
-void rasterizeFacets(const std::vector<RasterObject>& objects, const SampleBuffer& samples,
-                     const RasterOptions& options, FragmentBuffer& out, RasterStats& stats);
+// Keeps its bins and tile buffers from frame to frame, so a steady frame allocates nothing.
+class FacetRasterizer {
+  public:
+    FacetRasterizer();
+    ~FacetRasterizer();
+    FacetRasterizer(const FacetRasterizer&) = delete;
+    FacetRasterizer& operator=(const FacetRasterizer&) = delete;
+
+    // farDepth: the far plane's view depth (world units); surfaces beyond it are not seen.
+    void rasterize(const std::vector<RasterObject>& objects, const SampleLayout& samples,
+                   float farDepth, const RasterOptions& options, VisibilityBuffer& out,
+                   RasterStats& stats);
+
+  private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
+
+// One-off convenience: a rasterizer of its own.
+void rasterizeFacets(const std::vector<RasterObject>& objects, const SampleLayout& samples,
+                     float farDepth, const RasterOptions& options, VisibilityBuffer& out,
+                     RasterStats& stats);
 
 }  // namespace mpshade

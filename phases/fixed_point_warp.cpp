@@ -8,11 +8,22 @@
 #include "geometry/error.h"
 
 namespace mpshade {
+namespace {
+
+// Round to the nearest integer, ties to even, for |v| < 2^51: adding 1.5 * 2^52 leaves
+// no fractional bits, and the addition rounds to nearest-even. One add and one subtract
+// in any vector width (no SSE4.1 round instruction needed).
+inline double roundToInteger(double v) {
+    constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
+    return (v + kMagic) - kMagic;
+}
+
+}  // namespace
 
 void WarpedVertices::resize(size_t n) {
     x.resize(n);
     y.resize(n);
-    depth.resize(n);
+    invDepth.resize(n);
     culled.resize(n);
 }
 
@@ -54,15 +65,15 @@ FixedPointWarp::FixedPointWarp(const glm::mat4& objectToWorld, const CameraState
     auto log2up = [](double v) {
         return v > 0.0 ? static_cast<int>(std::ceil(std::log2(v))) : -1000;
     };
-    shift_ = std::min(40 - log2up(maxL), 61 - log2up(maxT));
-    shift_ = std::clamp(shift_, -60, 60);
+    shift_ = std::min(35 - log2up(maxL), 51 - log2up(maxT));
+    shift_ = std::clamp(shift_, -900, 900);
     const double scale = std::ldexp(1.0, shift_);
+    invScale_ = std::ldexp(1.0, -shift_);
     for (int row = 0; row < 3; ++row) {
-        t_[row] = static_cast<int64_t>(std::llround(t[row] * scale));
-        for (int k = 0; k < 3; ++k)
-            l_[row][k] = static_cast<int64_t>(std::llround(l[row][k] * scale));
+        t_[row] = std::nearbyint(t[row] * scale);
+        for (int k = 0; k < 3; ++k) l_[row][k] = std::nearbyint(l[row][k] * scale);
     }
-    nearW_ = std::max<int64_t>(1, static_cast<int64_t>(std::ceil(camera.zNear * scale)));
+    nearW_ = std::max(1.0, std::ceil(static_cast<double>(camera.zNear) * scale));
 
     // The bound at the object's nearest depth in front of the near plane.
     double minW = 1e300;
@@ -76,30 +87,46 @@ FixedPointWarp::FixedPointWarp(const glm::mat4& objectToWorld, const CameraState
     minW = std::max(minW, static_cast<double>(camera.zNear));
     const double roundingUnits = 0.5 * (3.0 * 65535.0 + 1.0);
     const double widest = std::max(camera.width, camera.height);
-    errorBound_ = roundingUnits * (1.0 + widest) / (minW * scale) + 1.0 / 512.0;
+    errorBound_ = roundingUnits * (1.0 + widest) / (minW * scale) + 1.0 / 512.0 + std::ldexp(1.0, -38);
 }
 
 void FixedPointWarp::warp(const uint16_t* qx, const uint16_t* qy, const uint16_t* qz, size_t n,
                           WarpedVertices& out) const {
     out.resize(n);
-    const double invScale = std::ldexp(1.0, -shift_);
+    const double l00 = l_[0][0], l01 = l_[0][1], l02 = l_[0][2], t0 = t_[0];
+    const double l10 = l_[1][0], l11 = l_[1][1], l12 = l_[1][2], t1 = t_[1];
+    const double l20 = l_[2][0], l21 = l_[2][1], l22 = l_[2][2], t2 = t_[2];
+    const double nearW = nearW_, guard = kGuardBand, scale = std::ldexp(1.0, shift_);
+    int32_t* ox = out.x.data();
+    int32_t* oy = out.y.data();
+    float* oinv = out.invDepth.data();
+    uint8_t* oc = out.culled.data();
+    // Every operation below is on doubles holding integers under 2^53 (see the header),
+    // so the sums are exact in any evaluation order and the loop vectorizes.
     for (size_t i = 0; i < n; ++i) {
-        const int64_t a = qx[i], b = qy[i], c = qz[i];
-        const int64_t X = l_[0][0] * a + l_[0][1] * b + l_[0][2] * c + t_[0];
-        const int64_t Y = l_[1][0] * a + l_[1][1] * b + l_[1][2] * c + t_[1];
-        const int64_t W = l_[2][0] * a + l_[2][1] * b + l_[2][2] * c + t_[2];
-        // |W| < 2^62, so the guard band is formed in 128 bits.
-        const __int128 guard = static_cast<__int128>(W) << kGuardBandBits;
-        const bool keep = W >= nearW_ && (X < guard && X > -guard) && (Y < guard && Y > -guard);
-        out.culled[i] = keep ? 0 : 1;
-        if (keep) {
-            out.x[i] = static_cast<int32_t>((static_cast<__int128>(X) << kSubpixelBits) / W);
-            out.y[i] = static_cast<int32_t>((static_cast<__int128>(Y) << kSubpixelBits) / W);
-        } else {
-            out.x[i] = out.y[i] = 0;
-        }
-        out.depth[i] = static_cast<float>(static_cast<double>(W) * invScale);
+        const double a = qx[i], b = qy[i], c = qz[i];
+        const double X = l00 * a + l01 * b + l02 * c + t0;
+        const double Y = l10 * a + l11 * b + l12 * c + t1;
+        const double W = l20 * a + l21 * b + l22 * c + t2;
+        const double band = guard * W;
+        const bool keep = W >= nearW && X < band && X > -band && Y < band && Y > -band;
+        const double safeW = keep ? W : 1.0;
+        const double sx = keep ? roundToInteger(X * 256.0 / safeW) : 0.0;
+        const double sy = keep ? roundToInteger(Y * 256.0 / safeW) : 0.0;
+        ox[i] = static_cast<int32_t>(sx);
+        oy[i] = static_cast<int32_t>(sy);
+        oinv[i] = keep ? static_cast<float>(scale / W) : 0.0f;
+        oc[i] = keep ? 0 : 1;
     }
+}
+
+HomogeneousVertex FixedPointWarp::homogeneous(uint16_t qx, uint16_t qy, uint16_t qz) const {
+    const double a = qx, b = qy, c = qz;
+    HomogeneousVertex v;
+    v.X = (l_[0][0] * a + l_[0][1] * b + l_[0][2] * c + t_[0]) * invScale_;
+    v.Y = (l_[1][0] * a + l_[1][1] * b + l_[1][2] * c + t_[1]) * invScale_;
+    v.W = (l_[2][0] * a + l_[2][1] * b + l_[2][2] * c + t_[2]) * invScale_;
+    return v;
 }
 
 bool FixedPointWarp::warpExact(uint16_t qx, uint16_t qy, uint16_t qz, double& x, double& y) const {

@@ -1,24 +1,30 @@
 // fixed_point_warp.h -- the dynamic TSI's transform (patent col. 5 and claim 26): each
 // frame, one float object-to-screen matrix per object becomes an integer matrix, and the
 // facets' 16-bit vertices go to 8-bit sub-pixel screen coordinates with integer
-// arithmetic only.
+// arithmetic.
 //
 // Bit budget. The screen position is x = X / W with X = x_px * W and W the view depth,
 // both linear in the quantized vertex q (0 <= q_i < 2^16):
 //   X = sum_i L_i q_i + T    (likewise Y and W),
 // with L_i = M_i * step_i and T = M(origin) from the float matrix M. All coefficients are
-// scaled by one power of two 2^s and rounded to int64:
-//   * s is the largest shift with |L_i| 2^s <= 2^40 and |T| 2^s <= 2^61, so each product
-//     L_i q_i fits in 56 bits and X, Y, W in 62 bits: no int64 overflow, for any matrix.
+// scaled by one power of two 2^s and rounded to integers:
+//   * s is the largest shift with |L_i| 2^s <= 2^35 and |T| 2^s <= 2^51, so each product
+//     L_i q_i is an integer below 2^51 in magnitude and every partial sum of X, Y, W is an
+//     integer below 2^53. Such integers are exact in IEEE double, so the integer sums are
+//     carried in double lanes -- exactly, for any matrix, and vectorized -- rather than in
+//     int64 (which has no vector multiply on x86) or int128.
 //   * A vertex is kept only if W >= near (in the same scale) and |X|, |Y| < 2^15 W (a
-//     guard band of 32768 pixels); then x_fixed = (X << 8) / W is at most 2^23 in
-//     magnitude and fits int32; the 71-bit numerator is formed in __int128.
+//     guard band of 32768 pixels). Then X 256 / W is below 2^23 in magnitude; it is formed
+//     by one correctly rounded double division (X 256 is exact: a power-of-two scaling)
+//     and rounded to the nearest integer (ties to even), which is deterministic and off by
+//     at most 1/2 + 2^-30 units of 1/256 pixel -- where the 128-bit integer division it
+//     replaces truncated, off by up to one unit.
 // Error. Rounding each coefficient costs at most 1/2 unit of 2^-s, so |dX|, |dW| <=
 // (3 * 65535 + 1) / 2 units, and the screen error is at most
 //   (|dX| + |x| |dW|) / (W 2^s) pixels,
-// plus 1/512 pixel from rounding x to 8 fractional bits. errorBound() evaluates this at
-// the object's nearest depth and the image's widest coordinate; the tests check the
-// measured error against 1/16 pixel over the valid range.
+// plus 1/512 + 2^-38 pixel from rounding x to 8 fractional bits. errorBound() evaluates
+// this at the object's nearest depth and the image's widest coordinate; the tests check
+// the measured error against it and against 1/16 pixel over the valid range.
 #pragma once
 
 #include <cstdint>
@@ -33,15 +39,23 @@ namespace mpshade {
 
 struct WarpedVertices {
     std::vector<int32_t> x, y;    // pixels, 8 fractional bits (value / 256 = pixel coordinate)
-    std::vector<float> depth;     // view depth W, world units
+    std::vector<float> invDepth;  // 1 / W, W the view depth in world units
     std::vector<uint8_t> culled;  // behind the near plane or outside the guard band
     void resize(size_t n);
+};
+
+// A vertex in homogeneous screen coordinates: x_px = X / W, y_px = Y / W, W the view depth
+// (world units). Double precision; for clipping facets that cross the near plane or the
+// guard band.
+struct HomogeneousVertex {
+    double X = 0.0, Y = 0.0, W = 0.0;
 };
 
 class FixedPointWarp {
   public:
     static constexpr int kSubpixelBits = 8;
     static constexpr int kGuardBandBits = 15;
+    static constexpr double kGuardBand = 32768.0;  // pixels, 2^kGuardBandBits
 
     // objectToWorld places the mesh; camera gives the screen. Bounds: the mesh's format
     // covers the quantized box, whose corners bound W.
@@ -51,8 +65,14 @@ class FixedPointWarp {
     void warp(const uint16_t* qx, const uint16_t* qy, const uint16_t* qz, size_t n,
               WarpedVertices& out) const;
 
-    // The same transform in double precision: the reference the fixed-point path is
-    // measured against. Returns false behind the near plane.
+    // The vertex in homogeneous screen coordinates, from the same integer coefficients
+    // the warp uses (so clipped and unclipped facets agree on shared vertices).
+    HomogeneousVertex homogeneous(uint16_t qx, uint16_t qy, uint16_t qz) const;
+    // The near plane's depth in the scale of homogeneous().
+    double nearDepth() const { return nearW_ * invScale_; }
+
+    // The same transform in double precision from the float matrix: the reference the
+    // fixed-point path is measured against. Returns false behind the near plane.
     bool warpExact(uint16_t qx, uint16_t qy, uint16_t qz, double& x, double& y) const;
 
     int shift() const { return shift_; }
@@ -60,10 +80,11 @@ class FixedPointWarp {
     double errorBound() const { return errorBound_; }
 
   private:
-    double m_[3][4];        // object -> (X, Y, W), double
-    int64_t l_[3][3] = {};  // scaled coefficients of q
-    int64_t t_[3] = {};     // scaled translations
-    int64_t nearW_ = 1;
+    double m_[3][4];       // object -> (X, Y, W), double
+    double l_[3][3] = {};  // scaled coefficients of q: integers, |l| <= 2^35
+    double t_[3] = {};     // scaled translations: integers, |t| <= 2^51
+    double nearW_ = 1.0;   // the near plane, scaled: an integer
+    double invScale_ = 1.0;
     int shift_ = 0;
     double errorBound_ = 0.0;
     FixedPointFormat format_;

@@ -18,16 +18,31 @@ struct FrameStats {
 
     // Multi-phase rendering only (zero for the reference renderer).
     int staticRuns = 0;               // objects (re)processed by the static phase this frame
-    double staticSeconds = 0.0;       // of wallSeconds, spent in the static phase
-    double warpSeconds = 0.0;         // dynamic TSI: fixed-point warp
+    double staticSeconds = 0.0;       // of wallSeconds: static phase (dicing, tile fills)
+    double fillSeconds = 0.0;         // of staticSeconds: shader-map tile fills
+    double warpSeconds = 0.0;         // dynamic TSI: fixed-point warp, culling
     double rasterSeconds = 0.0;       // dynamic TSI: binning and rasterization
-    double shadeSeconds = 0.0;        // interpolation and the dynamic shader
+    double shadeSeconds = 0.0;        // interpolation, probes, the dynamic shader, compositing
+    double resolveSeconds = 0.0;      // the pixel filter
     uint64_t staticInstructions = 0;  // static shader instructions, times lanes
-    uint64_t facets = 0;              // facets of all objects' intermediate representations
+    uint64_t facets = 0;              // facets of the drawn objects' representations
     uint64_t facetsRasterized = 0;    // facet-tile pairs rasterized
-    uint64_t fragments = 0;           // facet-sample hits
+    uint64_t fragments = 0;           // facet-sample hits tested against the depth buffer
     uint64_t verticesWarped = 0;
-    uint64_t facetBytes = 0;  // memory of the intermediate representations
+    uint64_t facetBytes = 0;          // memory of the drawn objects' facets and attributes
+    uint64_t objectsDrawn = 0;        // objects in view this frame
+    // Shader maps: distinct tiles this frame's probes asked for that were not resident,
+    // tiles filled (of them, built from their children), texels filled, and what stays
+    // resident after the frame (tiles and bytes, all maps).
+    uint64_t tilesRequested = 0;
+    uint64_t tilesFilled = 0;
+    uint64_t tilesFromChildren = 0;
+    uint64_t texelsFilled = 0;
+    uint64_t residentTiles = 0;
+    uint64_t residentBytes = 0;
+    uint64_t probes = 0;          // bilinear probes
+    uint64_t probeFallbacks = 0;  // answered from a coarser level (zero when render fills first)
+    int shadePasses = 0;          // shading passes: 1, plus one per round of fills
 };
 
 }  // namespace mpshade

@@ -1,40 +1,54 @@
-// multiphase_renderer.h -- multi-phase rendering with the combined intermediate
-// representation (patent FIG. 2 and FIG. 4): each object's factored shader and facets.
+// multiphase_renderer.h -- multi-phase rendering at constant quality (patent FIG. 2): the
+// policy that drives the static phase (static_phase.h) and the dynamic phase
+// (dynamic_phase.h) frame by frame, as `mpshade render` uses it.
 //
-// Static phase (per object, rarely): dice the surface into sub-pixel facets for the
-// representative viewpoint (dicing.h), evaluate the static part of the object's factored
-// shader at every facet vertex, and keep the n-tuple per vertex -- or, for objects whose
-// scene entry asks for "representation": "shadermap" (the patent's separate
-// representation, FIG. 5), fill a shader map of the static part and probe it per sample
-// with the footprint of the facet's screen-space (u, v) gradient. It runs again for an
-// object only when the viewpoint, in the object's own coordinates, leaves the range
-// (distance factor and angle of the scene's `range`).
-// Dynamic phase (every frame): warp each object's facets in fixed point
-// (fixed_point_warp.h), rasterize them to the same sample positions the reference
-// renderer uses (facet_rasterizer.h), interpolate the n-tuple and geometry to each sample,
-// run the dynamic part, composite front to back and reconstruct pixels with the same
-// filter.
+// Per frame:
+//   1. Objects out of view are skipped: no static work is done for an object until a
+//      frame sees it.
+//   2. The static phase runs, in parallel over objects, for objects in view that have no
+//      representation yet, whose view left the range, whose image size changed, or
+//      (combined representation) whose facets measured longer than P/2 last frame. Auto
+//      objects get their representation chosen at their first run
+//      (representation_choice.h).
+//   3. The dynamic phase warps and rasterizes, then shades; the shader-map tiles its probes
+//      lacked are filled in one batch and only the bands that lacked them are shaded
+//      again, so no sample reads a coarser level than its footprint asks and the image
+//      does not depend on what earlier frames filled. Filled tiles are kept.
 #pragma once
 
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
-#include "phases/dicing.h"
-#include "phases/facet_mesh.h"
-#include "phases/facet_rasterizer.h"
+#include "phases/dynamic_phase.h"
 #include "phases/reference_renderer.h"
-#include "shadermaps/probe.h"
-#include "shading/factoring.h"
+#include "phases/representation_choice.h"
+#include "phases/static_phase.h"
 
 namespace mpshade {
 
 struct MultiphaseOptions {
-    DicingOptions dicing;
-    FactorOptions factor;
-    RasterOptions raster;
-    ShaderMapOptions
-        shaderMap;       // for objects with "representation": "shadermap" (resolution: per object)
-    ProbeOptions probe;  // how those objects' maps are probed
+    StaticPhaseOptions staticPhase;
+    DynamicOptions dynamic;  // its shadingRate is the scene's unless shadingRate is set
+    std::optional<ShadingRate> shadingRate;
+    RepresentationCostModel costModel;
+    // Forces every object's representation (tests, benchmarks); unset: the scene's.
+    std::optional<Representation> representation;
+};
+
+// Per object, for stats.json: what the static phase chose and did.
+struct ObjectReport {
+    std::string name;
+    Representation kind = Representation::Auto;  // Auto: not built yet (never seen)
+    std::string reason;
+    int staticRuns = 0;
+    int framesDrawn = 0;
+    uint64_t facets = 0;  // of its current representation
+    uint64_t facetBytes = 0;
+    uint64_t residentTiles = 0, mapBytes = 0;
+    float longestEdgePixels = 0.0f;  // combined: last frame's longest projected facet edge
+    StaticCosts staticCosts;
 };
 
 class MultiphaseRenderer {
@@ -42,25 +56,42 @@ class MultiphaseRenderer {
     MultiphaseRenderer(const Scene& scene, const MultiphaseOptions& options = {});
     ~MultiphaseRenderer();
 
+    // Tells the renderer which frames will be asked for ([first, last), in order), so
+    // auto can weigh each object's costs over the frames that see it. Optional: without
+    // it every frame of the scene is assumed.
+    void plan(int first, int last, const RenderOptions& options);
+
     // Renders frame `frame`, running the static phase first for objects that need it.
     Image renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
                       const ProgressFn& progress = {});
     SampleBuffer renderSamples(int frame, const RenderOptions& options, FrameStats& stats,
                                const ProgressFn& progress = {});
 
-    // The current intermediate representation of object i (null before its static phase).
-    const FacetMesh* facets(size_t object) const;
+    // The current representation of object i (null before a frame has seen it).
+    const ObjectRepresentation* representation(size_t object) const;
     const FactoredShader& factored(size_t object) const;
+    const ObjectReport& report(size_t object) const { return reports_[object]; }
+    size_t objectCount() const { return reports_.size(); }
 
   private:
-    struct ObjectData;
-    void staticPhase(size_t index, const ObjectState& state, const CameraState& camera,
-                     const ShadingUniforms& uniforms, FrameStats& stats);
+    void render(int frame, const RenderOptions& options, FrameStats& stats,
+                const ProgressFn& progress);
+    Representation chooseKind(size_t object, const ObjectState& state, const CameraState& camera,
+                              int spp);
 
     const Scene& scene_;
     MultiphaseOptions options_;
     SceneResources resources_;
-    std::vector<std::unique_ptr<ObjectData>> objects_;
+    StaticPhase static_;
+    DynamicPhase dynamic_;
+    std::shared_ptr<const SampleLayout> layout_;
+    std::vector<std::unique_ptr<ObjectRepresentation>> representations_;
+    std::vector<Representation> kinds_;     // chosen at the first static run
+    std::vector<float> longestEdge_;        // last frame's measure (combined)
+    std::vector<int> framesSeen_;           // over the planned frames
+    std::vector<double> surfaceArea_;       // object units^2, for auto
+    std::vector<ObjectReport> reports_;
+    FrameState frame_;
 };
 
 }  // namespace mpshade

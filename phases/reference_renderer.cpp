@@ -10,6 +10,8 @@
 #include <tbb/parallel_for.h>
 
 #include <glm/geometric.hpp>
+
+#include "phases/compositing.h"
 #include "shading/shading_batch.h"
 
 namespace mpshade {
@@ -29,9 +31,8 @@ struct Hit {
 
 // Per-thread scratch, reused across tiles so the hot loops never allocate once warm.
 struct Scratch {
-    std::vector<glm::vec3> dir;   // per tile sample, world space
-    std::vector<float> color;     // 3 per tile sample
-    std::vector<float> transmit;  // 3 per tile sample
+    std::vector<glm::vec3> dir;               // per tile sample, world space
+    std::vector<SampleComposite> composite;  // per tile sample
     std::vector<PendingRay> active, next;
     std::vector<Hit> hits;
     std::vector<ChartPoint> chart;
@@ -47,11 +48,21 @@ struct Scratch {
 
 ReferenceRenderer::ReferenceRenderer(const Scene& scene) : scene_(scene), resources_(scene) {}
 
+std::shared_ptr<const SampleLayout> ReferenceRenderer::layoutFor(int width, int height, int spp,
+                                                                 const RenderOptions& options) const {
+    std::lock_guard<std::mutex> lock(layoutMutex_);
+    if (!layout_ || !layout_->matches(width, height, spp, options.seed, options.filter))
+        layout_ = std::make_shared<const SampleLayout>(width, height, spp, options.seed,
+                                                       options.filter);
+    return layout_;
+}
+
 Image ReferenceRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
                                      const ProgressFn& progress) const {
     const SampleBuffer samples = renderSamples(frame, options, stats, progress);
     const auto start = std::chrono::steady_clock::now();
-    Image image = resolvePixels(samples, options.filter);
+    Image image;
+    samples.layout->resolve(samples.rgba.data(), nullptr, image);
     stats.wallSeconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return image;
@@ -71,7 +82,8 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
     const WorldRayScene world(resources_, states);
 
     SampleBuffer samples;
-    samples.resize(width, height, spp);
+    samples.reset(layoutFor(width, height, spp, options));
+    const SampleLayout& layout = *samples.layout;
     const int tile = std::max(1, options.tileSize);
     const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
     const int tileCount = tilesX * tilesY;
@@ -86,19 +98,14 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
         const int tw = x1 - x0;
         const size_t n = static_cast<size_t>(tw) * (y1 - y0) * spp;
         s.dir.resize(n);
-        s.color.assign(3 * n, 0.0f);
-        s.transmit.assign(3 * n, 1.0f);
+        s.composite.assign(n, SampleComposite{});
         s.active.clear();
         for (int py = y0; py < y1; ++py) {
             for (int px = x0; px < x1; ++px) {
                 for (int k = 0; k < spp; ++k) {
                     const size_t local = (static_cast<size_t>(py - y0) * tw + (px - x0)) * spp + k;
                     const size_t global = samples.index(px, py, k);
-                    float x, y;
-                    samplePosition(options.seed, px, py, k, spp, x, y);
-                    samples.xy[2 * global] = x;
-                    samples.xy[2 * global + 1] = y;
-                    s.dir[local] = camera.direction(x, y);
+                    s.dir[local] = camera.direction(layout.x(global), layout.y(global));
                     // Clip to the near and far planes, which are perpendicular to the view axis.
                     const float cosine = glm::dot(s.dir[local], camera.forward);
                     s.active.push_back({static_cast<uint32_t>(local), camera.zNear / cosine,
@@ -177,29 +184,14 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
                     const Hit& hit = s.hits[s.hitOfPoint[p]];
                     const PendingRay& pr = s.active[hit.ray];
                     float ci[3], oi[3];
-                    bool finite = true;
                     for (int k = 0; k < 3; ++k) {
                         ci[k] = out.Ci[k][p];
                         oi[k] = out.Oi[k][p];
-                        finite = finite && std::isfinite(ci[k]) && std::isfinite(oi[k]);
                     }
-                    if (!finite) {
-                        ++s.counters.nonFiniteSamples;
-                        for (int k = 0; k < 3; ++k) {
-                            ci[k] = 0.0f;
-                            oi[k] = 1.0f;
-                        }
-                    }
-                    float* C = &s.color[3 * pr.sample];
-                    float* T = &s.transmit[3 * pr.sample];
-                    float remaining = 0.0f;
-                    for (int k = 0; k < 3; ++k) {
-                        const float o = std::clamp(oi[k], 0.0f, 1.0f);
-                        C[k] += T[k] * o * ci[k];
-                        T[k] *= 1.0f - o;
-                        remaining = std::max(remaining, T[k]);
-                    }
-                    if (remaining > 1e-3f) {
+                    if (!sanitizeShade(ci, oi)) ++s.counters.nonFiniteSamples;
+                    SampleComposite& c = s.composite[pr.sample];
+                    c.over(ci, oi);
+                    if (c.transmittance() > 1e-3f) {
                         // Continue behind this surface; the offset is relative to the distance.
                         s.next.push_back({pr.sample, hit.t * (1.0f + 1e-5f) + 1e-6f, pr.tfar});
                     }
@@ -213,11 +205,8 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
             for (int px = x0; px < x1; ++px) {
                 for (int k = 0; k < spp; ++k) {
                     const size_t local = (static_cast<size_t>(py - y0) * tw + (px - x0)) * spp + k;
-                    float* out = &samples.rgba[4 * samples.index(px, py, k)];
-                    const float* C = &s.color[3 * local];
-                    const float* T = &s.transmit[3 * local];
-                    for (int c = 0; c < 3; ++c) out[c] = C[c] + T[c] * settings.background[c];
-                    out[3] = 1.0f - (T[0] + T[1] + T[2]) / 3.0f;
+                    s.composite[local].finish(settings.background,
+                                              &samples.rgba[4 * samples.index(px, py, k)]);
                 }
             }
         }

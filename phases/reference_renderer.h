@@ -5,6 +5,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <mutex>
 
 #include "phases/frame_stats.h"
 #include "phases/image.h"
@@ -42,8 +44,13 @@ class ReferenceRenderer {
     const SceneResources& resources() const { return resources_; }
 
   private:
+    std::shared_ptr<const SampleLayout> layoutFor(int width, int height, int spp,
+                                                  const RenderOptions& options) const;
+
     const Scene& scene_;
     SceneResources resources_;
+    mutable std::mutex layoutMutex_;
+    mutable std::shared_ptr<const SampleLayout> layout_;  // reused while the size stays
 };
 
 }  // namespace mpshade

@@ -1,8 +1,12 @@
 #include "phases/sample_pattern.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include <tbb/parallel_for.h>
+
+#include "geometry/error.h"
 
 namespace mpshade {
 namespace {
@@ -31,46 +35,193 @@ void samplePosition(uint32_t seed, int px, int py, int k, int spp, float& x, flo
     y = static_cast<float>(py) + (static_cast<float>(k / nx) + jy) / static_cast<float>(ny);
 }
 
-void SampleBuffer::resize(int w, int h, int samplesPerPixel) {
-    width = w;
-    height = h;
-    spp = samplesPerPixel;
-    const size_t n = static_cast<size_t>(w) * h * samplesPerPixel;
-    xy.assign(n * 2, 0.0f);
-    rgba.assign(n * 4, 0.0f);
+SampleLayout::SampleLayout(int width, int height, int spp, uint32_t seed,
+                           const PixelFilter& filter)
+    : width_(width), height_(height), spp_(spp), seed_(seed), stratified_(true), filter_(filter) {
+    MPSHADE_CHECK(width > 0 && height > 0 && spp > 0);
+    xy_.resize(static_cast<size_t>(width) * height * spp * 2);
+    tbb::parallel_for(0, height, [&](int py) {
+        for (int px = 0; px < width; ++px)
+            for (int k = 0; k < spp; ++k) {
+                const size_t s = index(px, py, k);
+                samplePosition(seed, px, py, k, spp, xy_[2 * s], xy_[2 * s + 1]);
+            }
+    });
+    prepareFilter();
 }
 
-Image resolvePixels(const SampleBuffer& samples, const PixelFilter& filter) {
-    Image image(samples.width, samples.height);
-    const float inv2s2 = 1.0f / (2.0f * filter.sigma * filter.sigma);
-    const float tail = std::exp(-filter.radius * filter.radius * inv2s2);
-    const int reach = static_cast<int>(std::ceil(filter.radius));
-    tbb::parallel_for(0, samples.height, [&](int py) {
-        for (int px = 0; px < samples.width; ++px) {
-            const float cx = static_cast<float>(px) + 0.5f, cy = static_cast<float>(py) + 0.5f;
-            double sum[4] = {0, 0, 0, 0}, weight = 0.0;
-            for (int qy = std::max(0, py - reach); qy <= std::min(samples.height - 1, py + reach);
-                 ++qy) {
-                for (int qx = std::max(0, px - reach);
-                     qx <= std::min(samples.width - 1, px + reach); ++qx) {
-                    for (int k = 0; k < samples.spp; ++k) {
-                        const size_t i = samples.index(qx, qy, k);
-                        const float dx = std::fabs(samples.xy[2 * i] - cx);
-                        const float dy = std::fabs(samples.xy[2 * i + 1] - cy);
-                        if (dx >= filter.radius || dy >= filter.radius) continue;
-                        const float w = std::max(0.0f, std::exp(-dx * dx * inv2s2) - tail) *
-                                        std::max(0.0f, std::exp(-dy * dy * inv2s2) - tail);
-                        for (int c = 0; c < 4; ++c) sum[c] += w * samples.rgba[4 * i + c];
-                        weight += w;
+SampleLayout::SampleLayout(int width, int height, int spp, std::vector<float> xy,
+                           const PixelFilter& filter)
+    : width_(width), height_(height), spp_(spp), filter_(filter), xy_(std::move(xy)) {
+    MPSHADE_CHECK(width > 0 && height > 0 && spp > 0);
+    MPSHADE_CHECK(xy_.size() == static_cast<size_t>(width) * height * spp * 2);
+    for (int py = 0; py < height; ++py)
+        for (int px = 0; px < width; ++px)
+            for (int k = 0; k < spp; ++k) {
+                const size_t s = index(px, py, k);
+                MPSHADE_CHECK(xy_[2 * s] >= px && xy_[2 * s] < px + 1.0f);
+                MPSHADE_CHECK(xy_[2 * s + 1] >= py && xy_[2 * s + 1] < py + 1.0f);
+            }
+    prepareFilter();
+}
+
+bool SampleLayout::matches(int width, int height, int spp, uint32_t seed,
+                           const PixelFilter& filter) const {
+    return stratified_ && width == width_ && height == height_ && spp == spp_ &&
+           seed == seed_ && filter == filter_;
+}
+
+void SampleLayout::prepareFilter() {
+    MPSHADE_CHECK(filter_.radius > 0.0f && filter_.radius <= 8.0f && filter_.sigma > 0.0f);
+    const size_t n = count();
+    fx_.resize(n);
+    fy_.resize(n);
+    for (size_t s = 0; s < n; ++s) {
+        fx_[s] = static_cast<int32_t>(std::lround(xy_[2 * s] * 256.0f));
+        fy_[s] = static_cast<int32_t>(std::lround(xy_[2 * s + 1] * 256.0f));
+    }
+    // A sample inside pixel q is at distance in (o - 1/2, o + 1/2] from the centre of
+    // pixel q + o, so it reaches the pixels with |o| < radius + 1/2.
+    reach_ = static_cast<int>(std::ceil(filter_.radius + 0.5f)) - 1;
+    taps_ = 2 * reach_ + 1;
+    const double inv2s2 = 1.0 / (2.0 * filter_.sigma * filter_.sigma);
+    const double tail = std::exp(-static_cast<double>(filter_.radius) * filter_.radius * inv2s2);
+    auto weight = [&](double d) {
+        d = std::fabs(d);
+        return d < filter_.radius ? std::max(0.0, std::exp(-d * d * inv2s2) - tail) : 0.0;
+    };
+    const size_t taps = static_cast<size_t>(taps_);
+    weights_.resize(n * 2 * taps);
+    tbb::parallel_for(0, height_, [&](int py) {
+        for (int px = 0; px < width_; ++px)
+            for (int k = 0; k < spp_; ++k) {
+                const size_t s = index(px, py, k);
+                for (int o = -reach_; o <= reach_; ++o) {
+                    const size_t t = s * 2 * taps + static_cast<size_t>(o + reach_);
+                    weights_[t] = static_cast<float>(weight(xy_[2 * s] - (px + o + 0.5)));
+                    weights_[t + taps] =
+                        static_cast<float>(weight(xy_[2 * s + 1] - (py + o + 0.5)));
+                }
+            }
+    });
+    // Per pixel, its samples' weights summed, towards each pixel in reach (taps x taps,
+    // rows then columns), for pixels whose samples are all alike.
+    pixelWeights_.assign(static_cast<size_t>(width_) * height_ * taps * taps, 0.0f);
+    tbb::parallel_for(0, height_, [&](int py) {
+        for (int px = 0; px < width_; ++px) {
+            float* pw = &pixelWeights_[(static_cast<size_t>(py) * width_ + px) * taps * taps];
+            for (int k = 0; k < spp_; ++k) {
+                const float* w = &weights_[index(px, py, k) * 2 * taps];
+                for (size_t oy = 0; oy < taps; ++oy)
+                    for (size_t ox = 0; ox < taps; ++ox) pw[oy * taps + ox] += w[taps + oy] * w[ox];
+            }
+        }
+    });
+    inverseSum_.assign(static_cast<size_t>(width_) * height_, 0.0f);
+    tbb::parallel_for(0, height_, [&](int py) {
+        for (int px = 0; px < width_; ++px) {
+            double sum = 0.0;
+            for (int qy = std::max(0, py - reach_); qy <= std::min(height_ - 1, py + reach_); ++qy)
+                for (int qx = std::max(0, px - reach_); qx <= std::min(width_ - 1, px + reach_);
+                     ++qx)
+                    for (int k = 0; k < spp_; ++k) {
+                        const size_t s = index(qx, qy, k);
+                        const float* w = &weights_[s * 2 * taps];
+                        sum += static_cast<double>(w[static_cast<size_t>(px - qx + reach_)]) *
+                               w[taps + static_cast<size_t>(py - qy + reach_)];
+                    }
+            inverseSum_[static_cast<size_t>(py) * width_ + px] =
+                sum > 0.0 ? static_cast<float>(1.0 / sum) : 0.0f;
+        }
+    });
+}
+
+namespace {
+
+// Four channels as one SSE/AVX register.
+typedef float Float4 __attribute__((vector_size(16)));
+
+inline Float4 load4(const float* p) {
+    Float4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+inline void store4(float* p, Float4 v) {
+    std::memcpy(p, &v, sizeof v);
+}
+
+}  // namespace
+
+void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out) const {
+    if (out.width != width_ || out.height != height_) out = Image(width_, height_);
+    const size_t taps = static_cast<size_t>(taps_), spp = static_cast<size_t>(spp_);
+    const float* weights = weights_.data();
+    const float* pixelWeights = pixelWeights_.data();
+    const float* inverseSum = inverseSum_.data();
+    float* pixels = out.rgba.data();
+    const int width = width_, height = height_, reach = reach_;
+    // Bands of output rows in parallel. Within a band, every sample of the rows in reach is
+    // read once and added to the pixels it reaches in the band: its y weight towards the
+    // row times its x weight towards the column. A pixel whose samples all hold the same
+    // value (one surface shaded once for the pixel) is added once, with its samples'
+    // weights summed in advance.
+    constexpr int kBand = 8;
+    tbb::parallel_for(0, (height + kBand - 1) / kBand, [&](int band) {
+        const int r0 = band * kBand, r1 = std::min(height, r0 + kBand);
+        std::fill(pixels + static_cast<size_t>(r0) * width * 4,
+                  pixels + static_cast<size_t>(r1) * width * 4, 0.0f);
+        for (int qy = std::max(0, r0 - reach); qy < std::min(height, r1 + reach); ++qy) {
+            const int py0 = std::max(r0, qy - reach), py1 = std::min(r1 - 1, qy + reach);
+            for (int qx = 0; qx < width; ++qx) {
+                const int px0 = std::max(0, qx - reach), px1 = std::min(width - 1, qx + reach);
+                const size_t pixel = static_cast<size_t>(qy) * width + qx;
+                const size_t first = pixel * spp;
+                const bool same = uniform && uniform[pixel];
+                const size_t last = same ? first + 1 : first + spp;
+                if (reach == 1 && !same && qx > 0 && qx + 1 < width) {
+                    // The common case unrolled: a 3 x 3 neighbourhood inside the image.
+                    for (size_t s = first; s < last; ++s) {
+                        const float* w = weights + s * 6;
+                        const Float4 c = load4(rgba + 4 * s);
+                        const Float4 c0 = w[0] * c, c1 = w[1] * c, c2 = w[2] * c;
+                        for (int py = py0; py <= py1; ++py) {
+                            const float wy = w[3 + (py - qy + 1)];
+                            float* o = pixels + (static_cast<size_t>(py) * width + qx - 1) * 4;
+                            store4(o, load4(o) + wy * c0);
+                            store4(o + 4, load4(o + 4) + wy * c1);
+                            store4(o + 8, load4(o + 8) + wy * c2);
+                        }
+                    }
+                    continue;
+                }
+                for (size_t s = first; s < last; ++s) {
+                    const float* w = same ? pixelWeights + pixel * taps * taps
+                                          : weights + s * 2 * taps;
+                    const Float4 c = load4(rgba + 4 * s);
+                    for (int py = py0; py <= py1; ++py) {
+                        const size_t oy = static_cast<size_t>(py - qy + reach);
+                        float* row = pixels + static_cast<size_t>(py) * width * 4;
+                        for (int px = px0; px <= px1; ++px) {
+                            const size_t ox = static_cast<size_t>(px - qx + reach);
+                            const float f = same ? w[oy * taps + ox] : w[taps + oy] * w[ox];
+                            float* o = row + 4 * static_cast<size_t>(px);
+                            store4(o, load4(o) + f * c);
+                        }
                     }
                 }
             }
-            float* out = image.pixel(px, py);
-            for (int c = 0; c < 4; ++c)
-                out[c] = weight > 0.0 ? static_cast<float>(sum[c] / weight) : 0.0f;
         }
+        for (size_t p = static_cast<size_t>(r0) * width; p < static_cast<size_t>(r1) * width; ++p)
+            store4(pixels + 4 * p, load4(pixels + 4 * p) * inverseSum[p]);
     });
-    return image;
+}
+
+void SampleBuffer::reset(std::shared_ptr<const SampleLayout> l) {
+    layout = std::move(l);
+    width = layout->width();
+    height = layout->height();
+    spp = layout->spp();
+    rgba.assign(layout->count() * 4, 0.0f);
 }
 
 }  // namespace mpshade

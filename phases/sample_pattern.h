@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "phases/image.h"
@@ -17,27 +18,75 @@ namespace mpshade {
 // (seed, px, py, k). Returns image coordinates in pixels (continuous, y down).
 void samplePosition(uint32_t seed, int px, int py, int k, int spp, float& x, float& y);
 
-// Per-sample results of one frame: sample k of pixel (px, py) at index
-// (py * width + px) * spp + k.
+// The pixel reconstruction filter: a truncated Gaussian (pbrt-v4's GaussianFilter),
+// f(d) = max(0, exp(-d^2 / (2 sigma^2)) - exp(-r^2 / (2 sigma^2))) separably in x and y.
+struct PixelFilter {
+    float radius = 1.5f;  // pixels, in (0, 8]
+    float sigma = 0.5f;   // pixels, > 0
+    bool operator==(const PixelFilter&) const = default;
+};
+
+// The samples of every frame of one size: their positions (continuous, and on the
+// rasterizer's 1/256-pixel grid) and the reconstruction filter's weights, computed once
+// and reused by every frame (positions do not change from frame to frame, so neither do
+// the weights: a frame's resolve is multiply-adds only). Sample k of pixel (px, py) has
+// index (py * width + px) * spp + k, and lies inside its pixel: px <= x < px + 1.
+class SampleLayout {
+  public:
+    // The stratified pattern of samplePosition().
+    SampleLayout(int width, int height, int spp, uint32_t seed, const PixelFilter& filter = {});
+    // Explicit positions, 2 floats per sample in index order, each inside its pixel.
+    SampleLayout(int width, int height, int spp, std::vector<float> xy,
+                 const PixelFilter& filter = {});
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+    int spp() const { return spp_; }
+    size_t count() const { return xy_.size() / 2; }
+    size_t index(int px, int py, int k) const {
+        return (static_cast<size_t>(py) * width_ + px) * spp_ + k;
+    }
+    float x(size_t s) const { return xy_[2 * s]; }
+    float y(size_t s) const { return xy_[2 * s + 1]; }
+    // On the 1/256-pixel grid: round(x * 256), round(y * 256).
+    const int32_t* fixedX() const { return fx_.data(); }
+    const int32_t* fixedY() const { return fy_.data(); }
+    bool matches(int width, int height, int spp, uint32_t seed, const PixelFilter& filter) const;
+
+    // Pixels from per-sample RGBA (4 floats per sample, index order): each pixel is the
+    // filter-weighted mean of the samples within the filter's radius of its centre.
+    // `uniform` (per pixel, may be null): 1 where every sample of the pixel holds the same
+    // RGBA as its first, which is then read once.
+    void resolve(const float* rgba, const uint8_t* uniform, Image& out) const;
+
+  private:
+    void prepareFilter();
+
+    int width_ = 0, height_ = 0, spp_ = 1;
+    uint32_t seed_ = 0;
+    bool stratified_ = false;
+    PixelFilter filter_;
+    std::vector<float> xy_;
+    std::vector<int32_t> fx_, fy_;
+    // A sample reaches the pixels within `reach_` columns and rows of its own; per sample,
+    // taps_ = 2 reach_ + 1 weights across (towards px - reach_ ... px + reach_), then as many
+    // down.
+    int reach_ = 1, taps_ = 3;
+    std::vector<float> weights_;
+    std::vector<float> pixelWeights_;  // per pixel: taps x taps, its samples' weights summed
+    std::vector<float> inverseSum_;  // per pixel: 1 / the sum of the weights reaching it
+};
+
+// Per-sample results of one frame, in its layout's order.
 struct SampleBuffer {
+    std::shared_ptr<const SampleLayout> layout;
     int width = 0, height = 0, spp = 1;
-    std::vector<float> xy;    // 2 floats per sample: image position
     std::vector<float> rgba;  // 4 floats per sample: composited color over the background, alpha
 
-    void resize(int w, int h, int samplesPerPixel);
+    void reset(std::shared_ptr<const SampleLayout> l);
     size_t index(int px, int py, int k) const {
         return (static_cast<size_t>(py) * width + px) * spp + k;
     }
 };
-
-// The pixel reconstruction filter: a truncated Gaussian (pbrt-v4's GaussianFilter),
-// f(d) = max(0, exp(-d^2 / (2 sigma^2)) - exp(-r^2 / (2 sigma^2))) separably in x and y.
-struct PixelFilter {
-    float radius = 1.5f;  // pixels
-    float sigma = 0.5f;   // pixels
-};
-
-// Each pixel is the filter-weighted mean of the samples within `radius` of its centre.
-Image resolvePixels(const SampleBuffer& samples, const PixelFilter& filter);
 
 }  // namespace mpshade

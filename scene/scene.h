@@ -17,6 +17,11 @@
 
 namespace mpshade {
 
+// How often the dynamic shader runs: once per sub-pixel sample, or once per pixel and
+// visible surface with coverage still per sample (docs/multiphase.md has the figures that
+// chose the default).
+enum class ShadingRate { Sample, Pixel };
+
 struct RenderSettings {
     int width = 640;             // pixels, 1..16384
     int height = 360;            // pixels, 1..16384
@@ -24,6 +29,7 @@ struct RenderSettings {
     float duration = 1.0f;       // seconds, > 0
     int samplesPerPixel = 4;     // 1..1024
     glm::vec3 background{0.0f};  // linear RGB behind everything
+    ShadingRate shadingRate = ShadingRate::Sample;
 };
 
 struct Camera {
@@ -57,7 +63,11 @@ struct ObjectTransform {
     bool animated() const { return translate.varies() || rotate.varies() || scale.varies(); }
 };
 
-enum class Representation { Facets, ShaderMap };
+// How the static phase stores an object (patent FIG. 4 and FIG. 5): facets carrying the
+// n-tuple per vertex (combined), a shader map probed per sample on facets only as fine as
+// the geometric error allows (separate), or whichever costs less for the frames the
+// object is seen in (auto).
+enum class Representation { Auto, Facets, ShaderMap };
 
 struct RangeOptions {
     float distanceFactor = 2.0f;  // the view distance may change by this factor
@@ -72,8 +82,8 @@ struct SceneObject {
     std::shared_ptr<const ShaderAst> shader;
     std::vector<ParamValue> params;  // only the parameters the scene binds
     ObjectTransform transform;
-    Representation representation = Representation::Facets;
-    int shadermapResolution = 0;  // 0: chosen from the screen size
+    Representation representation = Representation::Auto;
+    int shadermapResolution = 0;  // a cap on level 0's texels per chart side; 0: the limit, 2^20
     RangeOptions range;
 };
 

@@ -133,7 +133,8 @@ class SceneLoader {
     }
 
     void settings(const JsonNode& s) {
-        s.allowKeys({"width", "height", "fps", "duration", "samples_per_pixel", "background"});
+        s.allowKeys({"width", "height", "fps", "duration", "samples_per_pixel", "background",
+                     "shading_rate"});
         RenderSettings& r = scene_.settings;
         if (auto n = s.optional("width")) r.width = n->integer(1, 16384);
         if (auto n = s.optional("height")) r.height = n->integer(1, 16384);
@@ -141,6 +142,15 @@ class SceneLoader {
         if (auto n = s.optional("duration")) r.duration = static_cast<float>(n->positive());
         if (auto n = s.optional("samples_per_pixel")) r.samplesPerPixel = n->integer(1, 1024);
         if (auto n = s.optional("background")) r.background = colorOf(*n);
+        if (auto n = s.optional("shading_rate")) {
+            const std::string rate = n->string();
+            if (rate == "sample")
+                r.shadingRate = ShadingRate::Sample;
+            else if (rate == "pixel")
+                r.shadingRate = ShadingRate::Pixel;
+            else
+                n->fail("unknown shading_rate '" + rate + "' (expected sample or pixel)");
+        }
         if (r.fps > 1000.0f) s["fps"].fail("fps must be at most 1000");
         if (r.duration * r.fps > 1.0e6f)
             s["duration"].fail("duration * fps exceeds a million frames");
@@ -404,11 +414,14 @@ class SceneLoader {
             const std::string rep = r->string();
             if (rep == "shadermap")
                 obj.representation = Representation::ShaderMap;
-            else if (rep != "facets")
-                r->fail("unknown representation '" + rep + "' (expected facets or shadermap)");
+            else if (rep == "facets")
+                obj.representation = Representation::Facets;
+            else if (rep != "auto")
+                r->fail("unknown representation '" + rep +
+                        "' (expected auto, facets or shadermap)");
         }
         if (auto r = o.optional("shadermap_resolution"))
-            obj.shadermapResolution = r->integer(1, 65536);
+            obj.shadermapResolution = r->integer(1, 1 << 20);
         if (auto r = o.optional("range")) {
             r->allowKeys({"distance_factor", "angle"});
             if (auto d = r->optional("distance_factor")) {

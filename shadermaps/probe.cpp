@@ -4,11 +4,61 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace mpshade {
 namespace {
 
 constexpr int kMaxChannels = 64;
+constexpr int kMaxTaps = 63;  // Feline: 2 maxAnisotropy - 1, maxAnisotropy capped at 32
+
+// The weight of the coarser of two levels, t in [0, 1], when they are blended only within
+// `width` / 2 of the midpoint between them (width 1: trilinear).
+inline float narrowBlend(float t, float width) {
+    if (width >= 1.0f) return t;
+    if (!(width > 0.0f)) return t < 0.5f ? 0.0f : 1.0f;
+    return std::clamp((t - 0.5f) / width + 0.5f, 0.0f, 1.0f);
+}
+
+// floor(x) for |x| < 2^31, without a library call (SSE2 has no rounding instruction).
+inline float floorOf(float x) {
+    const float t = static_cast<float>(static_cast<int32_t>(x));
+    return t > x ? t - 1.0f : t;
+}
+
+// exp(x) for x <= 0, relative error below 1e-6: 2^(x log2 e) split into an integer power
+// (the exponent bits) and 2^f, f in [0, 1), by a degree-5 least-squares polynomial (1.4e-7
+// on its own). Feline's weights are normalized, so this is far below anything visible, and
+// several times cheaper than std::exp.
+inline float fastExp(float x) {
+    const float t = std::max(x * 1.44269504f, -126.0f);
+    const float fi = floorOf(t);
+    const float f = t - fi;
+    const float p =
+        1.0f +
+        f * (0.6931527f + f * (0.2401532f + f * (0.05582816f + f * (0.008988991f + f * 0.001876627f))));
+    int32_t bits;
+    std::memcpy(&bits, &p, sizeof bits);
+    bits += static_cast<int32_t>(fi) << 23;
+    float r;
+    std::memcpy(&r, &bits, sizeof r);
+    return r;
+}
+
+// log2(x) for finite normal x > 0, absolute error below 3e-5: the exponent bits plus
+// log2 of the mantissa in [1, 2) by a degree-5 least-squares polynomial. It picks mip
+// levels, where 1e-4 of a level is nothing.
+inline float fastLog2(float x) {
+    int32_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    const float e = static_cast<float>(((bits >> 23) & 0xFF) - 127);
+    bits = (bits & 0x007FFFFF) | 0x3F800000;
+    float m;
+    std::memcpy(&m, &bits, sizeof m);
+    const float t = m - 1.0f;
+    return e + t * (1.441826f + t * (-0.7086829f + t * (0.4154247f + t * (-0.1944264f +
+                                                                          t * 0.04588722f))));
+}
 
 // kChannels > 0: the channel count is a compile-time constant, so the per-channel loops
 // unroll and vectorize; 0: any count.
@@ -20,6 +70,98 @@ struct Prober {
     int maxLevel;
     static constexpr bool kFixed = kChannels > 0;
     static constexpr int kArr = kFixed ? kChannels : kMaxChannels;
+    // The last tile looked up: neighbouring lookups mostly read the same tile, and each
+    // lookup otherwise costs a hash-table probe.
+    mutable uint64_t lastKey = ~uint64_t{0};
+    mutable int lastSlot = -1;
+    // The fast path's own cache, one tile per level parity: trilinear and Feline alternate
+    // between two adjacent levels.
+    mutable uint64_t cachedKey[2] = {~uint64_t{0}, ~uint64_t{0}};
+    mutable int cachedSlot[2] = {-1, -1};
+    mutable uint64_t fastProbes = 0;  // bilinear probes on the fast path, for residency
+    mutable bool missed = false;      // the current query lacked a tile
+    // The fast path's constants: per level its width and its tiles per side; the tile's
+    // geometry; float storage with no recency to report.
+    float levelRes[32] = {};
+    int levelTiles[32] = {};
+    int tileShift = 0, border = 1;
+    size_t rowFloats = 0;
+    bool fast = false;
+
+    Prober(const ShaderMap& m, ProbeResidency* r, int channels, int top)
+        : map(m), residency(r), runtimeChannels(channels), maxLevel(top) {
+        for (int level = 0; level <= maxLevel && level < 32; ++level) {
+            levelRes[level] = static_cast<float>(map.resolution(level));
+            levelTiles[level] = map.tilesPerSide(level);
+        }
+        while ((1 << tileShift) < map.options().tileSize) ++tileShift;
+        border = map.options().border;
+        rowFloats = static_cast<size_t>(map.stride()) * static_cast<size_t>(runtimeChannels);
+        fast = !map.options().halfPrecision && !(residency && residency->touched);
+    }
+
+    // The fast path's tile lookup: the float storage of tile (tx, ty) of `level`, or null
+    // if it is not resident.
+    const float* tileAt(int chart, int level, int tx, int ty) const {
+        const uint64_t key = (uint64_t(static_cast<uint32_t>(chart)) << 37) |
+                             (uint64_t(level) << 32) | (uint64_t(tx) << 16) | uint64_t(ty);
+        const int parity = level & 1;
+        if (key != cachedKey[parity]) {
+            cachedKey[parity] = key;
+            cachedSlot[parity] =
+                map.slotOf({static_cast<uint32_t>(chart), static_cast<uint16_t>(level),
+                            static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)});
+        }
+        return cachedSlot[parity] >= 0 ? map.tileFloats(cachedSlot[parity]) : nullptr;
+    }
+
+    // Adds w * the bilinear interpolation of tile data `t` (origin texel (ox, oy) of the
+    // level, borders included in `t`) at texel coordinates (x, y), already clamped.
+    void accumulate(const float* __restrict t, int ox, int oy, float x, float y, float w,
+                    float* __restrict sum) const {
+        const int channels = kFixed ? kChannels : runtimeChannels;
+        const float fx0 = floorOf(x), fy0 = floorOf(y);
+        const int li = static_cast<int>(fx0) - ox + border,
+                  lj = static_cast<int>(fy0) - oy + border;
+        const float fx = x - fx0, fy = y - fy0;
+        const float w00 = w * (1.0f - fx) * (1.0f - fy), w10 = w * fx * (1.0f - fy);
+        const float w01 = w * (1.0f - fx) * fy, w11 = w * fx * fy;
+        const float* t00 = t + static_cast<size_t>(lj) * rowFloats +
+                           static_cast<size_t>(li) * static_cast<size_t>(channels);
+        const float *t10 = t00 + channels, *t01 = t00 + rowFloats, *t11 = t01 + channels;
+        for (int c = 0; c < channels; ++c)
+            sum[c] += w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c];
+    }
+
+    // The fast path of a bilinear probe: adds w * the bilinear interpolation at texel
+    // coordinates (x, y) of `level` (texel centres at integers) to sum, if the tile is
+    // resident in float storage; returns false (nothing added) otherwise.
+    bool tap(int chart, int level, float x, float y, float w, float* sum) const {
+        const float res = levelRes[level];
+        x = std::clamp(x, -0.5f, res - 0.5f);
+        y = std::clamp(y, -0.5f, res - 0.5f);
+        const int n = levelTiles[level] - 1;
+        const int tx = std::min(std::max(static_cast<int>(floorOf(x)), 0) >> tileShift, n);
+        const int ty = std::min(std::max(static_cast<int>(floorOf(y)), 0) >> tileShift, n);
+        const float* t = tileAt(chart, level, tx, ty);
+        if (!t) return false;
+        ++fastProbes;
+        accumulate(t, tx << tileShift, ty << tileShift, x, y, w, sum);
+        return true;
+    }
+
+    int find(uint32_t chart, int level, int i, int j, int& li, int& lj) const {
+        const TileKey key = map.tileOf(chart, level, i, j);
+        const int T = map.options().tileSize;
+        li = i - key.tx * T + border;
+        lj = j - key.ty * T + border;
+        const uint64_t packed = key.packed();
+        if (packed != lastKey) {
+            lastKey = packed;
+            lastSlot = map.slotOf(key);
+        }
+        return lastSlot;
+    }
 
     // Bilinear probe of level `level` at chart (u, v), falling back to coarser resident levels.
     void bilinear(int chart, int level, float u, float v, float* out) const {
@@ -28,20 +170,34 @@ struct Prober {
             const int res = map.resolution(level);
             const float x = std::clamp(u * res - 0.5f, -0.5f, res - 0.5f);
             const float y = std::clamp(v * res - 0.5f, -0.5f, res - 0.5f);
-            const float fx0 = std::floor(x), fy0 = std::floor(y);
+            const float fx0 = floorOf(x), fy0 = floorOf(y);
             const int i0 = static_cast<int>(fx0), j0 = static_cast<int>(fy0);
             int li, lj;
-            const int slot = map.locate(static_cast<uint32_t>(chart), level, std::max(i0, 0),
-                                        std::max(j0, 0), li, lj);
+            const int slot = find(static_cast<uint32_t>(chart), level, std::max(i0, 0),
+                                  std::max(j0, 0), li, lj);
             li += i0 - std::max(i0, 0);
             lj += j0 - std::max(j0, 0);
             if (residency) ++residency->bilinearProbes;
-            if (slot < 0 && level < maxLevel) {
+            if (slot < 0) {
+                missed = true;
                 if (residency) {
+                    ++residency->missingProbes;
+                    const TileKey lacking = map.tileOf(static_cast<uint32_t>(chart), level,
+                                                       std::max(i0, 0), std::max(j0, 0));
+                    // Trilinear and Feline alternate two levels: compare with the last two.
+                    const size_t c = residency->count;
+                    if (c < residency->capacity &&
+                        (c == 0 || !(residency->missing[c - 1] == lacking)) &&
+                        (c < 2 || !(residency->missing[c - 2] == lacking)))
+                        residency->missing[residency->count++] = lacking;
+                    if (residency->stopAtMissing || level >= maxLevel) {
+                        std::fill(out, out + channels, 0.0f);
+                        return;
+                    }
                     ++residency->fallbacks;
-                    if (residency->count < residency->capacity)
-                        residency->missing[residency->count++] = map.tileOf(
-                            static_cast<uint32_t>(chart), level, std::max(i0, 0), std::max(j0, 0));
+                } else if (level >= maxLevel) {
+                    std::fill(out, out + channels, 0.0f);
+                    return;
                 }
                 continue;
             }
@@ -83,46 +239,54 @@ struct Prober {
         }
     }
 
-    // Feline's taps at one level: adds scale * w_i * bilinear(u0 + i du, v0 + i dv) to sum
-    // for i < n, with w_i from the recurrence w_{i+1} = w_i ratio_i, ratio_{i+1} = ratio_i
-    // ratioStep. The taps walk a straight line, so texel coordinates advance by a constant
-    // step and the bilinear weights go straight into the sum.
+    // Feline's taps at one level: adds scale * weight[i] * bilinear(u0 + i du, v0 + i dv) to
+    // sum for i < n. The taps walk a straight line, so texel coordinates advance by a
+    // constant step and the bilinear weights go straight into the sum.
     void lineAccumulate(int chart, int level, float u0, float v0, float du, float dv, int n,
-                        float w, float ratioW, float ratioStep, float scale, float* sum) const {
+                        const float* weight, float scale, float* sum) const {
         const int channels = kFixed ? kChannels : runtimeChannels;
-        const int res = map.resolution(level);
-        const float fres = static_cast<float>(res);
-        float x = u0 * fres - 0.5f, y = v0 * fres - 0.5f;
+        const float fres = levelRes[level];
+        const float x0 = u0 * fres - 0.5f, y0 = v0 * fres - 0.5f;
         const float dx = du * fres, dy = dv * fres;
-        const size_t stride = static_cast<size_t>(map.stride());
-        const size_t row = stride * static_cast<size_t>(channels);
-        for (int i = 0; i < n; ++i, x += dx, y += dy, w *= ratioW, ratioW *= ratioStep) {
-            const float cx = std::clamp(x, -0.5f, fres - 0.5f),
-                        cy = std::clamp(y, -0.5f, fres - 0.5f);
-            const float fx0 = std::floor(cx), fy0 = std::floor(cy);
-            const int i0 = static_cast<int>(fx0), j0 = static_cast<int>(fy0);
-            int li, lj;
-            const int slot = map.locate(static_cast<uint32_t>(chart), level, std::max(i0, 0),
-                                        std::max(j0, 0), li, lj);
-            const float* t = slot >= 0 ? map.tileFloats(slot) : nullptr;
-            const float ws = w * scale;
-            if (!t || residency) {
-                // Missing tiles, half storage, or residency to report: the general path.
-                float value[kArr];
-                bilinear(chart, level, (x + 0.5f) / fres, (y + 0.5f) / fres, value);
-                for (int c = 0; c < channels; ++c) sum[c] += ws * value[c];
-                continue;
+        if (fast) {
+            // Every tap's texels in one tile (the common case: taps span a few texels):
+            // one lookup for the line.
+            const float xe = x0 + static_cast<float>(n - 1) * dx, ye = y0 + static_cast<float>(n - 1) * dy;
+            const float lo = -0.5f, hi = fres - 0.5f;
+            const int ix0 = static_cast<int>(floorOf(std::clamp(std::min(x0, xe), lo, hi)));
+            const int ix1 = static_cast<int>(floorOf(std::clamp(std::max(x0, xe), lo, hi)));
+            const int iy0 = static_cast<int>(floorOf(std::clamp(std::min(y0, ye), lo, hi)));
+            const int iy1 = static_cast<int>(floorOf(std::clamp(std::max(y0, ye), lo, hi)));
+            const int last = levelTiles[level] - 1;
+            const int tx = std::min(std::max(ix0, 0) >> tileShift, last);
+            const int ty = std::min(std::max(iy0, 0) >> tileShift, last);
+            const int ox = tx << tileShift, oy = ty << tileShift;
+            const int size = 1 << tileShift;
+            // Texels ix0 .. ix1 + 1 must lie in the tile with its border.
+            if (ix0 >= ox - border && ix1 + 1 < ox + size + border && iy0 >= oy - border &&
+                iy1 + 1 < oy + size + border) {
+                if (const float* t = tileAt(chart, level, tx, ty)) {
+                    // A local accumulator the compiler can keep in registers.
+                    float acc[kArr];
+                    for (int c = 0; c < channels; ++c) acc[c] = sum[c];
+                    float x = x0, y = y0;
+                    for (int i = 0; i < n; ++i, x += dx, y += dy)
+                        accumulate(t, ox, oy, std::clamp(x, lo, hi), std::clamp(y, lo, hi),
+                                   weight[i] * scale, acc);
+                    for (int c = 0; c < channels; ++c) sum[c] = acc[c];
+                    fastProbes += static_cast<uint64_t>(n);
+                    return;
+                }
             }
-            li += i0 - std::max(i0, 0);
-            lj += j0 - std::max(j0, 0);
-            const float fx = cx - fx0, fy = cy - fy0;
-            const float w00 = ws * (1.0f - fx) * (1.0f - fy), w10 = ws * fx * (1.0f - fy);
-            const float w01 = ws * (1.0f - fx) * fy, w11 = ws * fx * fy;
-            const float* t00 = t + (static_cast<size_t>(lj) * stride + static_cast<size_t>(li)) *
-                                       static_cast<size_t>(channels);
-            const float *t10 = t00 + channels, *t01 = t00 + row, *t11 = t01 + channels;
-            for (int c = 0; c < channels; ++c)
-                sum[c] += w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c];
+        }
+        float x = x0, y = y0;
+        for (int i = 0; i < n; ++i, x += dx, y += dy) {
+            const float ws = weight[i] * scale;
+            if (fast && tap(chart, level, x, y, ws, sum)) continue;
+            // Missing tiles, half storage, or recency to report: the general path.
+            float value[kArr];
+            bilinear(chart, level, (x + 0.5f) / fres, (y + 0.5f) / fres, value);
+            for (int c = 0; c < channels; ++c) sum[c] += ws * value[c];
         }
     }
 
@@ -132,6 +296,15 @@ struct Prober {
         if (lod >= static_cast<float>(maxLevel)) return bilinear(chart, maxLevel, u, v, out);
         const int l0 = static_cast<int>(lod);
         const float t = lod - static_cast<float>(l0);
+        if (fast) {
+            float sum[kArr] = {};
+            if (tap(chart, l0, u * levelRes[l0] - 0.5f, v * levelRes[l0] - 0.5f, 1.0f - t, sum) &&
+                tap(chart, l0 + 1, u * levelRes[l0 + 1] - 0.5f, v * levelRes[l0 + 1] - 0.5f, t,
+                    sum)) {
+                for (int c = 0; c < channels; ++c) out[c] = sum[c];
+                return;
+            }
+        }
         float a[kArr], b[kArr];
         bilinear(chart, l0, u, v, a);
         bilinear(chart, l0 + 1, u, v, b);
@@ -211,7 +384,9 @@ Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy
         f.major = f.minor = 1e30f;
         return f;
     }
-    float la = std::hypot(d[0], d[1]), lb = std::hypot(d[2], d[3]);
+    // Each axis within 1e18 texels: their squares stay finite.
+    for (float& x : d) x = std::clamp(x, -1e18f, 1e18f);
+    float la = std::sqrt(d[0] * d[0] + d[1] * d[1]), lb = std::sqrt(d[2] * d[2] + d[3] * d[3]);
     f.ax = d[0], f.ay = d[1], f.bx = d[2], f.by = d[3];
     if (lb > la) {
         std::swap(f.ax, f.bx);
@@ -244,27 +419,25 @@ template <int C>
 void probeAll(const ShaderMap& map, const ProbeOptions& options,
               std::span<const ProbeQuery> queries, float* out, ProbeResidency* residency) {
     const int channels = C > 0 ? C : std::min(map.channels(), kMaxChannels);
-    const Prober<C> p{map, residency, channels, map.levels() - 1};
+    const Prober<C> p(map, residency, channels, map.levels() - 1);
     const float res0 = static_cast<float>(map.resolution(0));
-    for (size_t k = 0; k < queries.size(); ++k) {
-        ProbeQuery q = queries[k];
-        float* o = out + k * static_cast<size_t>(channels);
+    auto one = [&](ProbeQuery q, float* o) {
         if (!std::isfinite(q.u)) q.u = 0.0f;
         if (!std::isfinite(q.v)) q.v = 0.0f;
         const Footprint f = footprintOf(
             q, res0, options.filter == ProbeFilter::Trilinear ? 1e30f : options.maxAnisotropy);
         if (options.filter == ProbeFilter::Trilinear) {
             p.trilinear(q.chart, std::log2(std::max(f.major, 1e-30f)), q.u, q.v, o);
-            continue;
+            return;
         }
         if (!(f.major < 1e20f)) {
             p.bilinear(q.chart, p.maxLevel, q.u, q.v, o);
-            continue;
+            return;
         }
         if (options.filter == ProbeFilter::EWA) {
             if (!(f.minor > 0.0f)) {
                 p.bilinear(q.chart, 0, q.u, q.v, o);
-                continue;
+                return;
             }
             const float lod = std::clamp(std::log2(f.minor), 0.0f, static_cast<float>(p.maxLevel));
             const int l0 = static_cast<int>(lod);
@@ -277,44 +450,55 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
             } else {
                 std::copy(a, a + channels, o);
             }
-            continue;
+            return;
         }
         // Feline.
         const float minor = std::max(f.minor, 1e-30f);
         const float ratio = std::min(f.major / minor, options.maxAnisotropy);
-        const int n = std::max(1, static_cast<int>(std::lround(2.0f * ratio - 1.0f)));
-        const float lod = std::log2(minor);
+        const int n = std::clamp(static_cast<int>(2.0f * ratio - 0.5f), 1, kMaxTaps);
+        const float lod = fastLog2(minor);
         if (n == 1) {
-            p.trilinear(q.chart, lod, q.u, q.v, o);
-            continue;
+            // Trilinear, its blend narrowed like the taps' below.
+            const float l = std::floor(lod);
+            p.trilinear(q.chart, l + narrowBlend(lod - l, options.levelBlend), q.u, q.v, o);
+            return;
         }
         const float half = f.major - minor;
         const float dirU = f.ax / (f.major * res0),
                     dirV = f.ay / (f.major * res0);  // chart units per texel
-        // Every probe uses the same two levels; weights exp(-2 (d / major)^2) along an
-        // arithmetic progression of d follow a recurrence: two exp() calls per lookup.
+        // Every probe uses the same two levels; probe i, d = -half + i step texels from the
+        // centre, weighs exp(-2 (d / major)^2).
         const float clampedLod = std::clamp(lod, 0.0f, static_cast<float>(p.maxLevel));
         const int l0 = static_cast<int>(clampedLod);
         const int l1 = std::min(l0 + 1, p.maxLevel);
-        const float blend = l1 > l0 ? clampedLod - static_cast<float>(l0) : 0.0f;
+        const float blend =
+            narrowBlend(l1 > l0 ? clampedLod - static_cast<float>(l0) : 0.0f, options.levelBlend);
         const float step = 2.0f * half / static_cast<float>(n - 1);
-        const float gk = 2.0f / (f.major * f.major);
-        float w = std::exp(-gk * half * half);                              // at d = -half
-        float ratioW = std::exp(-gk * (step * step - 2.0f * half * step));  // w(d + step) / w(d)
-        const float ratioStep = std::exp(-2.0f * gk * step * step);
-        float sum[Prober<C>::kArr] = {};
+        const float gk = -2.0f / (f.major * f.major);
+        float weights[kMaxTaps];
         float weight = 0.0f;
-        {
-            float wi = w, ri = ratioW;
-            for (int i = 0; i < n; ++i, wi *= ri, ri *= ratioStep) weight += wi;
+        for (int i = 0; i < n; ++i) {
+            const float d = -half + static_cast<float>(i) * step;
+            weights[i] = fastExp(gk * d * d);
+            weight += weights[i];
         }
+        float sum[Prober<C>::kArr] = {};
         const float u0 = q.u - half * dirU, v0 = q.v - half * dirV;
         const float du = step * dirU, dv = step * dirV;
-        p.lineAccumulate(q.chart, l0, u0, v0, du, dv, n, w, ratioW, ratioStep, 1.0f - blend, sum);
+        if (blend < 1.0f)
+            p.lineAccumulate(q.chart, l0, u0, v0, du, dv, n, weights, 1.0f - blend, sum);
         if (blend > 0.0f)
-            p.lineAccumulate(q.chart, l1, u0, v0, du, dv, n, w, ratioW, ratioStep, blend, sum);
-        for (int c = 0; c < channels; ++c) o[c] = sum[c] / weight;
+            p.lineAccumulate(q.chart, l1, u0, v0, du, dv, n, weights, blend, sum);
+        const float inv = 1.0f / weight;
+        for (int c = 0; c < channels; ++c) o[c] = sum[c] * inv;
+    };
+    uint8_t* queryMissed = residency ? residency->queryMissed : nullptr;
+    for (size_t k = 0; k < queries.size(); ++k) {
+        p.missed = false;
+        one(queries[k], out + k * static_cast<size_t>(channels));
+        if (queryMissed) queryMissed[k] = p.missed ? 1 : 0;
     }
+    if (residency) residency->bilinearProbes += p.fastProbes;
 }
 
 }  // namespace

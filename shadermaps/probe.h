@@ -20,7 +20,10 @@
 // Residency: a probe never fills and never allocates. A bilinear probe whose tile is not
 // resident uses the finest resident coarser level, records the fallback, and reports the
 // tile it lacked into the caller's buffer (while it has room); the tiles it did read go
-// to a second buffer, for the tile cache's recency.
+// to a second buffer, for the tile cache's recency. With `stopAtMissing` (a caller that
+// will fill what was lacking and probe again, as `render` does) it reports the lacking
+// tile and looks no further: the result is then meaningless, and no coarser tile is
+// reported that the repeated probe would not need.
 #pragma once
 
 #include <cstddef>
@@ -36,11 +39,14 @@ enum class ProbeFilter { Trilinear, Feline, EWA };
 struct ProbeOptions {
     ProbeFilter filter = ProbeFilter::Feline;
     float maxAnisotropy = 16.0f;  // Feline and EWA: the longest footprint over the shortest
+    // Feline: the fraction of each level's span over which two levels are blended (1:
+    // trilinear everywhere; less: one level away from the transitions, half the taps).
+    float levelBlend = 1.0f;
 };
 
 struct ProbeQuery {
     int chart = 0;
-    float u = 0.0f, v = 0.0f;                                  // chart coordinates
+    float u = 0.0f, v = 0.0f;  // chart coordinates; a little outside [0, 1] reads the border
     float dudx = 0.0f, dvdx = 0.0f, dudy = 0.0f, dvdy = 0.0f;  // per screen pixel
 };
 
@@ -53,6 +59,9 @@ struct ProbeResidency {
     TileKey* touched = nullptr;  // caller's buffer for the resident tiles read (for an LRU)
     size_t touchedCapacity = 0;
     size_t touchedCount = 0;  // written to touched; a tile read twice in a row is written once
+    bool stopAtMissing = false;
+    uint64_t missingProbes = 0;     // bilinear probes that found their tile lacking
+    uint8_t* queryMissed = nullptr;  // caller's buffer, one per query: 1 where it lacked a tile
 };
 
 // Writes queries.size() * map.channels() floats to out, query by query.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_set>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -11,64 +12,61 @@
 #include "shadermaps/half_float.h"
 
 namespace mpshade {
+namespace {
+
+// Per thread: the fill's batches, reused from tile to tile.
+struct FillScratch {
+    ShadingBatch batch;
+    std::vector<ChartPoint> points;
+    std::vector<SurfaceSample> geometry;
+    std::vector<float> workspace;
+    FillStats stats;
+};
+
+}  // namespace
 
 ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
                      const ShadingUniforms& uniforms, const ShaderMapOptions& options)
-    : surface_(surface), kernel_(staticPart), uniforms_(uniforms), options_(options) {
-    MPSHADE_CHECK(options.resolution > 0 && (options.resolution & (options.resolution - 1)) == 0);
-    MPSHADE_CHECK(options.tileSize > 0 && options.border >= 1);
+    : surface_(surface),
+      kernel_(staticPart),
+      params_(uniforms.params.begin(), uniforms.params.end()),
+      lights_(uniforms.lights.begin(), uniforms.lights.end()),
+      uniforms_(uniforms),
+      options_(options) {
+    uniforms_.params = params_;
+    uniforms_.lights = lights_;
+    MPSHADE_CHECK(options.resolution > 0 && (options.resolution & (options.resolution - 1)) == 0 &&
+                  options.resolution <= (1 << 20));
+    MPSHADE_CHECK(options.tileSize > 0 && (options.tileSize & (options.tileSize - 1)) == 0);
+    MPSHADE_CHECK(options.resolution / options.tileSize <= (1 << 16));
+    MPSHADE_CHECK(options.border >= 1 && options.supersampleLimit >= 1);
     charts_ = chartCount(surface);
+    MPSHADE_CHECK(charts_ < (1 << 26));
     if (options.seamless) adjacency_ = std::make_unique<ChartAdjacency>(surface);
     channels_ = static_cast<int>(staticPart.program().channelOutputs.size());
     levels_ = 0;
     for (int r = options.resolution; r >= 1; r >>= 1) ++levels_;
-    MPSHADE_CHECK((options.tileSize & (options.tileSize - 1)) == 0);
-    while ((1 << tileShift_) > options.tileSize) --tileShift_;
+    tileShift_ = 0;
     while ((1 << tileShift_) < options.tileSize) ++tileShift_;
     stride_ = options.tileSize + 2 * options.border;
     tileValues_ = static_cast<size_t>(stride_) * stride_ * static_cast<size_t>(channels_);
-    for (int level = 0; level < levels_; ++level) tilesPerSide_.push_back(tilesPerSide(level));
-    levelOffset_.resize(static_cast<size_t>(levels_) + 1, 0);
-    for (int level = 0; level < levels_; ++level) {
-        const size_t side = static_cast<size_t>(tilesPerSide(level));
-        levelOffset_[static_cast<size_t>(level) + 1] =
-            levelOffset_[static_cast<size_t>(level)] + side * side;
-    }
-    tilesPerChart_ = levelOffset_.back();
-    slot_.assign(tilesPerChart_ * static_cast<size_t>(charts_), -1);
-    const int coarsest = std::max(0, levels_ - options.alwaysResidentLevels);
-    fillLevels(coarsest, levels_ - 1);
+    for (int level = 0; level < levels_; ++level)
+        tilesPerSide_.push_back((resolution(level) + options.tileSize - 1) / options.tileSize);
+    if (options.alwaysResidentLevels > 0)
+        fillLevels(std::max(0, levels_ - options.alwaysResidentLevels), levels_ - 1);
 }
 
-int ShaderMap::tilesPerSide(int level) const {
-    return (resolution(level) + options_.tileSize - 1) / options_.tileSize;
-}
-
-size_t ShaderMap::tileIndex(const TileKey& key) const {
-    return static_cast<size_t>(key.chart) * tilesPerChart_ + levelOffset_[key.level] +
-           static_cast<size_t>(key.ty) * static_cast<size_t>(tilesPerSide(key.level)) + key.tx;
-}
-
-int ShaderMap::slotOf(const TileKey& key) const {
-    return slot_[tileIndex(key)];
-}
-
-TileKey ShaderMap::tileOf(uint32_t chart, int level, int i, int j) const {
-    const int n = tilesPerSide(level);
-    const int tx = std::clamp(i / options_.tileSize, 0, n - 1),
-              ty = std::clamp(j / options_.tileSize, 0, n - 1);
-    return {chart, static_cast<uint16_t>(level), static_cast<uint16_t>(tx),
-            static_cast<uint16_t>(ty)};
+size_t ShaderMap::tileBytes() const {
+    return tileValues_ * (options_.halfPrecision ? sizeof(uint16_t) : sizeof(float));
 }
 
 size_t ShaderMap::bytes() const {
-    return data_.size() * sizeof(float) + halfData_.size() * sizeof(uint16_t) +
-           slot_.size() * sizeof(int32_t);
+    return data_.size() * sizeof(float) + halfData_.size() * sizeof(uint16_t) + table_.bytes();
 }
 
 void ShaderMap::texel(const TileKey& key, int slot, int i, int j, float* out) const {
-    const int li = i - key.tx * options_.tileSize + options_.border;
-    const int lj = j - key.ty * options_.tileSize + options_.border;
+    const int li = i - (key.tx << tileShift_) + options_.border;
+    const int lj = j - (key.ty << tileShift_) + options_.border;
     const size_t at = ((static_cast<size_t>(slot) * stride_ + static_cast<size_t>(lj)) * stride_ +
                        static_cast<size_t>(li)) *
                       static_cast<size_t>(channels_);
@@ -80,76 +78,109 @@ void ShaderMap::texel(const TileKey& key, int slot, int i, int j, float* out) co
     }
 }
 
-void ShaderMap::fillTile(const TileKey& key, int slot, ShadingBatch& scratch, FillStats& stats) {
+void ShaderMap::store(size_t at, float value) {
+    if (options_.halfPrecision)
+        halfData_[at] = floatToHalf(value);
+    else
+        data_[at] = value;
+}
+
+void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, ShadingBatch& scratch,
+                         std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
+                         std::vector<float>& workspace, FillStats& stats) {
     const int res = resolution(key.level);
+    const int T = options_.tileSize, border = options_.border;
     const int k = options_.prefilter == Prefilter::Box
-                      ? std::min(1 << key.level, options_.supersampleLimit)
+                      ? std::min(1 << std::min<int>(key.level, 20), options_.supersampleLimit)
                       : 1;
-    const int texels = stride_ * stride_;
     // Only the texels this level has, plus the border: a level smaller than a tile leaves
     // the rest of the tile unused (probes clamp to the level).
-    const int validW = std::min(stride_, res - key.tx * options_.tileSize + 2 * options_.border);
-    const int validH = std::min(stride_, res - key.ty * options_.tileSize + 2 * options_.border);
-    const size_t n =
-        static_cast<size_t>(validW) * static_cast<size_t>(validH) * static_cast<size_t>(k * k);
-    // Chart points of every (super)sample of every valid texel, borders included.
-    std::vector<ChartPoint> points(n);
-    size_t p = 0;
+    const int validW = std::min(stride_, res - key.tx * T + 2 * border);
+    const int validH = std::min(stride_, res - key.ty * T + 2 * border);
+    const size_t channels = static_cast<size_t>(channels_);
+    const size_t base = static_cast<size_t>(slot) * tileValues_;
+    auto texelAt = [&](int li, int lj) {
+        return base + (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) * channels;
+    };
+    // Interior texels from the four children where they are resident: the mean of the
+    // 2 x 2 texels of the level below each covers.
+    auto interior = [&](int i, int j) {
+        return fromChildren && i >= key.tx * T && i < (key.tx + 1) * T && i < res &&
+               j >= key.ty * T && j < (key.ty + 1) * T && j < res;
+    };
+    if (fromChildren) {
+        float child[4][64];
+        std::vector<float> wide;
+        float* c4[4];
+        if (channels > 64) {
+            wide.resize(4 * channels);
+            for (int q = 0; q < 4; ++q) c4[q] = wide.data() + q * channels;
+        } else {
+            for (int q = 0; q < 4; ++q) c4[q] = child[q];
+        }
+        for (int lj = 0; lj < validH; ++lj)
+            for (int li = 0; li < validW; ++li) {
+                const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
+                if (!interior(i, j)) continue;
+                for (int q = 0; q < 4; ++q) {
+                    const int ci = 2 * i + (q & 1), cj = 2 * j + (q >> 1);
+                    const TileKey ck = tileOf(key.chart, key.level - 1, ci, cj);
+                    texel(ck, slotOf(ck), ci, cj, c4[q]);
+                }
+                const size_t at = texelAt(li, lj);
+                for (size_t c = 0; c < channels; ++c)
+                    store(at + c, 0.25f * ((c4[0][c] + c4[1][c]) + (c4[2][c] + c4[3][c])));
+            }
+        ++stats.tilesFromChildren;
+    }
+    // The rest evaluated: chart points of every (super)sample of every texel left.
+    points.clear();
     for (int lj = 0; lj < validH; ++lj)
         for (int li = 0; li < validW; ++li) {
-            const int i = key.tx * options_.tileSize + li - options_.border;
-            const int j = key.ty * options_.tileSize + lj - options_.border;
+            const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
+            if (interior(i, j)) continue;
             for (int sj = 0; sj < k; ++sj)
                 for (int si = 0; si < k; ++si) {
-                    const float u = (static_cast<float>(i) +
-                                     (static_cast<float>(si) + 0.5f) / static_cast<float>(k)) /
-                                    res;
-                    const float v = (static_cast<float>(j) +
-                                     (static_cast<float>(sj) + 0.5f) / static_cast<float>(k)) /
-                                    res;
-                    points[p++] =
-                        adjacency_
-                            ? adjacency_->resolve(static_cast<int>(key.chart), u, v)
-                            : ChartPoint{static_cast<int>(key.chart), std::clamp(u, 0.0f, 1.0f),
-                                         std::clamp(v, 0.0f, 1.0f)};
+                    const float u =
+                        (static_cast<float>(i) + (static_cast<float>(si) + 0.5f) / k) / res;
+                    const float v =
+                        (static_cast<float>(j) + (static_cast<float>(sj) + 0.5f) / k) / res;
+                    points.push_back(adjacency_ ? adjacency_->resolve(static_cast<int>(key.chart),
+                                                                      u, v)
+                                                : ChartPoint{static_cast<int>(key.chart),
+                                                             std::clamp(u, 0.0f, 1.0f),
+                                                             std::clamp(v, 0.0f, 1.0f)});
                 }
         }
-    std::vector<SurfaceSample> geometry(n);
-    evaluateBatch(surface_, points, geometry);
-    scratch.resize(n, static_cast<size_t>(channels_));
-    for (size_t i = 0; i < n; ++i) {
-        const glm::vec3 toP = geometry[i].P - uniforms_.eye;
-        const float len = std::sqrt(toP.x * toP.x + toP.y * toP.y + toP.z * toP.z);
-        scratch.setPoint(i, geometry[i], points[i],
-                         len > 0.0f ? toP / len : glm::vec3(0.0f, 0.0f, -1.0f));
-    }
-    std::vector<float> workspace;
-    ShadingCounters counters;
-    kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters);
-    float* const* channelOut = scratch.out.channels;
-    // Box-average the supersamples of each texel into the tile, channel-interleaved.
-    const size_t base =
-        static_cast<size_t>(slot) * static_cast<size_t>(texels) * static_cast<size_t>(channels_);
-    const float inv = 1.0f / static_cast<float>(k * k);
-    for (int lj = 0; lj < validH; ++lj)
-        for (int li = 0; li < validW; ++li) {
-            const size_t first =
-                (static_cast<size_t>(lj) * static_cast<size_t>(validW) + static_cast<size_t>(li)) *
-                static_cast<size_t>(k * k);
-            const size_t texel =
-                static_cast<size_t>(lj) * static_cast<size_t>(stride_) + static_cast<size_t>(li);
-            for (int c = 0; c < channels_; ++c) {
-                float sum = 0.0f;
-                for (int s = 0; s < k * k; ++s)
-                    sum += channelOut[static_cast<size_t>(c)][first + static_cast<size_t>(s)];
-                const size_t at =
-                    base + texel * static_cast<size_t>(channels_) + static_cast<size_t>(c);
-                if (options_.halfPrecision)
-                    halfData_[at] = floatToHalf(sum * inv);
-                else
-                    data_[at] = sum * inv;
-            }
+    const size_t n = points.size();
+    if (n > 0) {
+        geometry.resize(n);
+        evaluateBatch(surface_, points, geometry);
+        scratch.resize(n, channels);
+        for (size_t p = 0; p < n; ++p) {
+            const glm::vec3 toP = geometry[p].P - uniforms_.eye;
+            const float len = std::sqrt(toP.x * toP.x + toP.y * toP.y + toP.z * toP.z);
+            scratch.setPoint(p, geometry[p], points[p],
+                             len > 0.0f ? toP / len : glm::vec3(0.0f, 0.0f, -1.0f));
         }
+        ShadingCounters counters;
+        kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters);
+        float* const* channelOut = scratch.out.channels;
+        const float inv = 1.0f / static_cast<float>(k * k);
+        size_t first = 0;
+        for (int lj = 0; lj < validH; ++lj)
+            for (int li = 0; li < validW; ++li) {
+                const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
+                if (interior(i, j)) continue;
+                const size_t at = texelAt(li, lj);
+                for (size_t c = 0; c < channels; ++c) {
+                    float sum = 0.0f;
+                    for (int s = 0; s < k * k; ++s) sum += channelOut[c][first + static_cast<size_t>(s)];
+                    store(at + c, sum * inv);
+                }
+                first += static_cast<size_t>(k * k);
+            }
+    }
     ++stats.tiles;
     stats.texels += static_cast<uint64_t>(validW) * static_cast<uint64_t>(validH);
     stats.programRuns += n;
@@ -157,30 +188,53 @@ void ShaderMap::fillTile(const TileKey& key, int slot, ShadingBatch& scratch, Fi
 
 void ShaderMap::fill(std::span<const TileKey> keys) {
     std::lock_guard<std::mutex> lock(fillMutex_);
-    // Assign slots to the new tiles first, growing the storage once.
-    std::vector<std::pair<TileKey, int>> work;
+    std::vector<TileKey> work;
+    std::unordered_set<uint64_t> seen;
     for (const TileKey& key : keys) {
-        int32_t& slot = slot_[tileIndex(key)];
-        if (slot >= 0) continue;
-        slot = static_cast<int32_t>(residentTiles_++);
-        work.emplace_back(key, slot);
+        MPSHADE_CHECK(key.chart < static_cast<uint32_t>(charts_) && key.level < levels_ &&
+                      key.tx < tilesPerSide(key.level) && key.ty < tilesPerSide(key.level));
+        if (table_.find(key.packed()) >= 0 || !seen.insert(key.packed()).second) continue;
+        work.push_back(key);
     }
     if (work.empty()) return;
-    const size_t perTile = static_cast<size_t>(stride_) * stride_ * static_cast<size_t>(channels_);
-    if (options_.halfPrecision)
-        halfData_.resize(residentTiles_ * perTile);
-    else
-        data_.resize(residentTiles_ * perTile);
-    tbb::enumerable_thread_specific<ShadingBatch> scratch;
-    tbb::enumerable_thread_specific<FillStats> stats;
-    tbb::parallel_for(size_t{0}, work.size(), [&](size_t w) {
-        enableFlushToZero();
-        fillTile(work[w].first, work[w].second, scratch.local(), stats.local());
-    });
-    for (const FillStats& s : stats) {
-        fillStats_.tiles += s.tiles;
-        fillStats_.texels += s.texels;
-        fillStats_.programRuns += s.programRuns;
+    std::stable_sort(work.begin(), work.end(),
+                     [](const TileKey& a, const TileKey& b) { return a.level < b.level; });
+    tbb::enumerable_thread_specific<FillScratch> scratch;
+    for (size_t begin = 0; begin < work.size();) {
+        size_t end = begin;
+        while (end < work.size() && work[end].level == work[begin].level) ++end;
+        // Slots for this level's tiles, storage grown once; whether each can be built from
+        // its children (resident now, this batch's finer levels included).
+        std::vector<std::pair<int, bool>> plan(end - begin);
+        for (size_t w = begin; w < end; ++w) {
+            const TileKey& key = work[w];
+            bool children = key.level > 0;
+            for (int q = 0; q < 4 && children; ++q) {
+                const int ctx = std::min(2 * key.tx + (q & 1), tilesPerSide(key.level - 1) - 1);
+                const int cty = std::min(2 * key.ty + (q >> 1), tilesPerSide(key.level - 1) - 1);
+                children = slotOf({key.chart, static_cast<uint16_t>(key.level - 1),
+                                   static_cast<uint16_t>(ctx), static_cast<uint16_t>(cty)}) >= 0;
+            }
+            plan[w - begin] = {static_cast<int>(residentTiles_++), children};
+        }
+        if (options_.halfPrecision)
+            halfData_.resize(residentTiles_ * tileValues_);
+        else
+            data_.resize(residentTiles_ * tileValues_);
+        for (size_t w = begin; w < end; ++w) table_.insert(work[w].packed(), plan[w - begin].first);
+        tbb::parallel_for(begin, end, [&](size_t w) {
+            enableFlushToZero();
+            FillScratch& s = scratch.local();
+            fillTile(work[w], plan[w - begin].first, plan[w - begin].second, s.batch, s.points,
+                     s.geometry, s.workspace, s.stats);
+        });
+        begin = end;
+    }
+    for (const FillScratch& s : scratch) {
+        fillStats_.tiles += s.stats.tiles;
+        fillStats_.tilesFromChildren += s.stats.tilesFromChildren;
+        fillStats_.texels += s.stats.texels;
+        fillStats_.programRuns += s.stats.programRuns;
     }
 }
 

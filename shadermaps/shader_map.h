@@ -3,11 +3,16 @@
 // texel centres, populated on demand, one tile at a time.
 //
 // Layout. Every chart of the surface is a square of R x R texels at level 0 (R a power of
-// two), with its own pyramid down to 1 x 1, so coarse levels never mix charts. Level L is
-// R / 2^L texels wide, cut into square tiles of `tileSize` texels; each tile also stores a
-// `border` of texels around it, so a bilinear lookup anywhere in the tile reads one tile.
-// Texel (i, j) of level L covers chart coordinates [i, i + 1] / (R / 2^L) (likewise j);
-// its value is the static program at the texel centre.
+// two up to 2^20), with its own pyramid down to 1 x 1, so coarse levels never mix charts.
+// Level L is R / 2^L texels wide, cut into square tiles of `tileSize` texels; each tile
+// also stores a `border` of texels around it, so a bilinear lookup anywhere in the tile
+// reads one tile. Texel (i, j) of level L covers chart coordinates [i, i + 1] / (R / 2^L)
+// (likewise j); its value is the static program at the texel centre.
+//
+// Virtual resolution: R is large enough for the finest footprint any frame asks (by
+// default the limit, 2^20, where a float chart coordinate still places a lookup within
+// 1/16 texel); tiles exist only once asked for and filled, found through a hash table
+// (tile_table.h), so an unused fine level costs nothing.
 //
 // No seams: border texels beyond a chart's edge are evaluated on the chart across that
 // edge (geometry/chart_adjacency.h), the shader being procedural, so a probe straddling a
@@ -16,12 +21,15 @@
 // clamps to the edge.
 //
 // Prefiltering: point-sampled coarse levels alias high-frequency patterns; with
-// `Prefilter::Box` a texel of level L > 0 is the mean of the static program over a
-// k x k grid inside it (k = min(2^L, supersampleLimit)).
+// `Prefilter::Box` a texel of level L > 0 is the mean of the static program over a k x k
+// grid inside it (k = min(2^L, supersampleLimit)). A tile whose four children (the level
+// below) are resident is instead the mean of their texels -- the same k x k means where
+// 2^L <= supersampleLimit (up to float rounding), and a wider box above -- at a fraction
+// of the cost: only its border is evaluated.
 //
-// Residency: tiles exist only once filled. The coarsest `alwaysResidentLevels` levels of
-// every chart are filled at construction, so a probe always finds data (it falls back to
-// the finest resident coarser level, patent col. 10).
+// Residency: the coarsest `alwaysResidentLevels` levels of every chart are filled at
+// construction (the finest of them evaluated, the rest built from it), so a probe always
+// finds data: it falls back to the finest resident coarser level (patent col. 10).
 #pragma once
 
 #include <algorithm>
@@ -35,18 +43,22 @@
 #include "geometry/surface.h"
 #include "shading/interpreter.h"
 #include "shading/shading_batch.h"
+#include "shadermaps/tile_table.h"
 
 namespace mpshade {
 
 enum class Prefilter { Point, Box };
 
 struct ShaderMapOptions {
-    int resolution = 256;        // level-0 texels per chart side; a power of two
-    int tileSize = 16;           // texels per tile side; a power of two
-    int border = 2;              // texels around each tile
+    int resolution = 1 << 20;    // level-0 texels per chart side; a power of two, <= 2^20
+    int tileSize = 16;           // texels per tile side; a power of two, resolution / tileSize <= 2^16
+    int border = 1;              // texels around each tile, >= 1
     bool halfPrecision = false;  // store channels as binary16 (see half_float.h for the error)
     Prefilter prefilter = Prefilter::Box;
-    int supersampleLimit = 4;      // at most k x k program samples per texel when prefiltering
+    // At most k x k program samples per evaluated texel. 1 (point samples; coarser levels
+    // from their children where resident) measured the least error against 64-sample
+    // references as well as the least work (docs/shader-maps.md).
+    int supersampleLimit = 1;
     int alwaysResidentLevels = 6;  // 1x1 .. 32x32 per chart, filled at construction
     bool seamless = true;          // borders from the neighbouring chart; false: clamp to edge
 };
@@ -57,10 +69,15 @@ struct TileKey {
     uint16_t level = 0;
     uint16_t tx = 0, ty = 0;
     bool operator==(const TileKey&) const = default;
+    // 26 bits of chart, 5 of level, 16 each of tx and ty.
+    uint64_t packed() const {
+        return (uint64_t{chart} << 37) | (uint64_t{level} << 32) | (uint64_t{tx} << 16) | ty;
+    }
 };
 
 struct FillStats {
     uint64_t tiles = 0;
+    uint64_t tilesFromChildren = 0;  // of tiles: built from the four tiles of the level below
     uint64_t texels = 0;
     uint64_t programRuns = 0;  // static program evaluations (texels x supersamples)
 };
@@ -68,33 +85,41 @@ struct FillStats {
 class ShaderMap {
   public:
     // `staticPart` computes the channels (its channelOutputs); `uniforms` are the static
-    // phase's (representative) values. The surface and kernel must outlive the map.
+    // phase's (representative) values, copied. The surface and kernel must outlive the map.
     ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
               const ShadingUniforms& uniforms, const ShaderMapOptions& options = {});
 
     int channels() const { return channels_; }
+    int charts() const { return charts_; }
     int levels() const { return levels_; }
     int resolution(int level) const { return options_.resolution >> level; }
-    int tilesPerSide(int level) const;
+    int tilesPerSide(int level) const { return tilesPerSide_[static_cast<size_t>(level)]; }
     const ShaderMapOptions& options() const { return options_; }
 
     bool resident(const TileKey& key) const { return slotOf(key) >= 0; }
-    // Fills the tiles that are not resident yet (batched and parallel).
+    // Fills the tiles that are not resident yet: batched, in parallel, finest level first
+    // so coarser tiles can be built from their children.
     void fill(std::span<const TileKey> keys);
     // Fills every tile of the levels in [first, last] (inclusive) of every chart.
     void fillLevels(int first, int last);
     const FillStats& fillStats() const { return fillStats_; }
     size_t residentTiles() const { return residentTiles_; }
     size_t bytes() const;
+    size_t tileBytes() const;  // storage of one tile
 
-    // The tile holding texel (i, j) of a level, and where in its storage that texel lies.
-    TileKey tileOf(uint32_t chart, int level, int i, int j) const;
+    // The tile holding texel (i, j) of a level (clamped to the level).
+    TileKey tileOf(uint32_t chart, int level, int i, int j) const {
+        const int n = tilesPerSide(level);
+        return {chart, static_cast<uint16_t>(level),
+                static_cast<uint16_t>(std::clamp(i >> tileShift_, 0, n - 1)),
+                static_cast<uint16_t>(std::clamp(j >> tileShift_, 0, n - 1))};
+    }
 
     // Reads the channels of texel (i, j), which must lie in the tile `key` or its border:
     // i in [tx * T - border, (tx + 1) * T + border) (likewise j). Writes channels() floats.
     void texel(const TileKey& key, int slot, int i, int j, float* out) const;
     // The storage slot of a resident tile, or -1.
-    int slotOf(const TileKey& key) const;
+    int slotOf(const TileKey& key) const { return table_.find(key.packed()); }
 
     // Direct access for probes: a tile's texels, row-major with borders, channels
     // interleaved; stride() texels per row. Exactly one of the two is non-null.
@@ -110,33 +135,31 @@ class ShaderMap {
     // The slot holding texel (i, j) of a level (clamped to the level), or -1 if that tile is
     // not resident; (li, lj) receive the texel's position in the tile's storage.
     int locate(uint32_t chart, int level, int i, int j, int& li, int& lj) const {
-        const int n = tilesPerSide_[static_cast<size_t>(level)];
-        const int tx = std::clamp(i >> tileShift_, 0, n - 1),
-                  ty = std::clamp(j >> tileShift_, 0, n - 1);
-        li = i - (tx << tileShift_) + options_.border;
-        lj = j - (ty << tileShift_) + options_.border;
-        return slot_[static_cast<size_t>(chart) * tilesPerChart_ +
-                     levelOffset_[static_cast<size_t>(level)] +
-                     static_cast<size_t>(ty) * static_cast<size_t>(n) + static_cast<size_t>(tx)];
+        const TileKey key = tileOf(chart, level, i, j);
+        li = i - (key.tx << tileShift_) + options_.border;
+        lj = j - (key.ty << tileShift_) + options_.border;
+        return table_.find(key.packed());
     }
 
   private:
-    size_t tileIndex(const TileKey& key) const;
-    void fillTile(const TileKey& key, int slot, ShadingBatch& scratch, FillStats& stats);
+    void fillTile(const TileKey& key, int slot, bool fromChildren, ShadingBatch& scratch,
+                  std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
+                  std::vector<float>& workspace, FillStats& stats);
+    void store(size_t at, float value);
 
     const Surface& surface_;
     std::unique_ptr<ChartAdjacency> adjacency_;
     const ShaderKernel& kernel_;
+    std::vector<float> params_;
+    std::vector<LightSample> lights_;
     ShadingUniforms uniforms_;
     ShaderMapOptions options_;
-    int charts_ = 0, channels_ = 0, levels_ = 0,
-        stride_ = 0;                   // stride_: texels per tile side with borders
-    std::vector<size_t> levelOffset_;  // first tile index of each level (per chart block)
-    int tileShift_ = 4;                // log2(tileSize)
-    size_t tileValues_ = 0;            // floats (or halves) per tile
+    int charts_ = 0, channels_ = 0, levels_ = 0;
+    int stride_ = 0;         // texels per tile side with borders
+    int tileShift_ = 4;      // log2(tileSize)
+    size_t tileValues_ = 0;  // floats (or halves) per tile
     std::vector<int> tilesPerSide_;
-    size_t tilesPerChart_ = 0;
-    std::vector<int32_t> slot_;       // tile index -> storage slot, or -1
+    TileTable table_;
     std::vector<float> data_;         // float storage
     std::vector<uint16_t> halfData_;  // half storage
     size_t residentTiles_ = 0;

@@ -40,8 +40,8 @@ TEST(ReferenceRenderer, SphereCoverageMatchesItsSilhouette) {
     const float tanHalf = std::tan(20.0f * 3.14159265f / 180.0f);
     const float radiusPx = std::tan(std::asin(1.0f / 6.0f)) / tanHalf * 48.0f;
     int wrong = 0, boundary = 0;
-    for (size_t i = 0; i < samples.xy.size() / 2; ++i) {
-        const float dx = samples.xy[2 * i] - 48.0f, dy = samples.xy[2 * i + 1] - 48.0f;
+    for (size_t i = 0; i < samples.layout->count(); ++i) {
+        const float dx = samples.layout->x(i) - 48.0f, dy = samples.layout->y(i) - 48.0f;
         const float r = std::sqrt(dx * dx + dy * dy);
         const bool covered = samples.rgba[4 * i + 3] > 0.5f;
         if (std::fabs(r - radiusPx) < 0.05f) {
@@ -119,19 +119,73 @@ TEST(ReferenceRenderer, NonFiniteShaderResultsAreCountedAndZeroed) {
 }
 
 TEST(PixelFilter, PreservesAConstantImage) {
-    SampleBuffer samples;
-    samples.resize(7, 5, 3);
-    for (int y = 0; y < 5; ++y)
-        for (int x = 0; x < 7; ++x)
-            for (int k = 0; k < 3; ++k) {
-                const size_t i = samples.index(x, y, k);
-                samplePosition(1, x, y, k, 3, samples.xy[2 * i], samples.xy[2 * i + 1]);
-                for (int c = 0; c < 4; ++c) samples.rgba[4 * i + c] = 0.25f * (c + 1);
-            }
-    const Image image = resolvePixels(samples, {});
+    const SampleLayout layout(7, 5, 3, 1u);
+    std::vector<float> rgba(layout.count() * 4);
+    for (size_t i = 0; i < layout.count(); ++i)
+        for (int c = 0; c < 4; ++c) rgba[4 * i + c] = 0.25f * (c + 1);
+    Image image;
+    layout.resolve(rgba.data(), nullptr, image);
     for (int y = 0; y < 5; ++y)
         for (int x = 0; x < 7; ++x)
             for (int c = 0; c < 4; ++c) ASSERT_NEAR(image.pixel(x, y)[c], 0.25f * (c + 1), 1e-6f);
+}
+
+TEST(PixelFilter, MatchesTheTruncatedGaussianComputedDirectly) {
+    // One bright sample among dark ones: each pixel it reaches gets exactly its filter
+    // weight over the pixel's total, computed here from the formula in double precision.
+    const int w = 6, h = 5, spp = 2;
+    std::vector<float> xy;
+    for (int py = 0; py < h; ++py)
+        for (int px = 0; px < w; ++px)
+            for (int k = 0; k < spp; ++k)
+                xy.push_back(px + 0.2f + 0.55f * k), xy.push_back(py + 0.7f - 0.45f * k);
+    const PixelFilter filter{1.5f, 0.5f};
+    const SampleLayout layout(w, h, spp, xy, filter);
+    const size_t bright = layout.index(2, 2, 1);
+    std::vector<float> rgba(layout.count() * 4, 0.0f);
+    rgba[4 * bright] = 1.0f;
+    auto g = [&](double d) {
+        const double s2 = 2.0 * 0.5 * 0.5;
+        return std::fabs(d) < 1.5 ? std::max(0.0, std::exp(-d * d / s2) - std::exp(-2.25 / s2))
+                                  : 0.0;
+    };
+    Image image;
+    layout.resolve(rgba.data(), nullptr, image);
+    for (int py = 0; py < h; ++py)
+        for (int px = 0; px < w; ++px) {
+            double total = 0.0, mine = 0.0;
+            for (size_t s = 0; s < layout.count(); ++s) {
+                const double wgt = g(layout.x(s) - (px + 0.5)) * g(layout.y(s) - (py + 0.5));
+                total += wgt;
+                if (s == bright) mine = wgt;
+            }
+            EXPECT_NEAR(image.pixel(px, py)[0], mine / total, 1e-6) << px << "," << py;
+        }
+    // The bright sample at (2.75, 2.25) reaches the pixels around (2, 2) only.
+    EXPECT_GT(image.pixel(3, 1)[0], 0.0f);
+    EXPECT_EQ(image.pixel(0, 2)[0], 0.0f);
+    EXPECT_EQ(image.pixel(2, 4)[0], 0.0f);
+}
+
+TEST(PixelFilter, UniformPixelsResolveAsTheirSamples) {
+    // Marking pixels whose samples are alike must not change the image: the summed weights
+    // stand in for the samples exactly.
+    const SampleLayout layout(9, 7, 4, 5u);
+    std::vector<float> rgba(layout.count() * 4);
+    std::vector<uint8_t> uniform(9 * 7);
+    for (int py = 0; py < 7; ++py)
+        for (int px = 0; px < 9; ++px) {
+            const bool alike = (px + py) % 3 != 0;
+            uniform[static_cast<size_t>(py) * 9 + px] = alike ? 1 : 0;
+            for (int k = 0; k < 4; ++k)
+                for (int c = 0; c < 4; ++c)
+                    rgba[4 * layout.index(px, py, k) + c] =
+                        0.1f * c + 0.03f * px + 0.05f * py + (alike ? 0.0f : 0.07f * k);
+        }
+    Image a, b;
+    layout.resolve(rgba.data(), nullptr, a);
+    layout.resolve(rgba.data(), uniform.data(), b);
+    for (size_t i = 0; i < a.rgba.size(); ++i) ASSERT_NEAR(a.rgba[i], b.rgba[i], 1e-6f);
 }
 
 TEST(SamplePattern, StratifiesWithinThePixel) {

@@ -1,0 +1,394 @@
+#include "phases/dynamic_phase.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <glm/geometric.hpp>
+
+#include "phases/compositing.h"
+
+namespace mpshade {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Per cluster: whether any of it can be seen this frame. Off screen: its bounding sphere is
+// wholly outside a side plane or in front of the near plane. Facing away: every normal of
+// its cone points away from the eye for every point of its sphere (normal-cone culling).
+void clusterVisibility(const FacetMesh& mesh, const ObjectState& state, const CameraState& camera,
+                       bool backFaces, std::vector<uint8_t>& visible) {
+    const float tx = camera.tanHalfFovY * camera.aspect, ty = camera.tanHalfFovY;
+    const glm::vec3 planes[4] = {glm::normalize(camera.right - tx * camera.forward),
+                                 glm::normalize(-camera.right - tx * camera.forward),
+                                 glm::normalize(camera.up - ty * camera.forward),
+                                 glm::normalize(-camera.up - ty * camera.forward)};
+    visible.assign(mesh.clusters.size(), 1);
+    for (size_t k = 0; k < mesh.clusters.size(); ++k) {
+        const FacetCluster& c = mesh.clusters[k];
+        const glm::vec3 d = glm::vec3(state.objectToWorld * glm::vec4(c.center, 1.0f)) - camera.eye;
+        const float r = c.radius * state.scale;
+        bool out = glm::dot(d, camera.forward) < camera.zNear - r;
+        for (const glm::vec3& n : planes) out = out || glm::dot(d, n) > r;
+        if (!out && backFaces && c.coneHalfAngle < 1.5f) {
+            const glm::vec3 toCluster = c.center - state.eye;  // object space
+            const float distance = glm::length(toCluster);
+            if (distance > c.radius) {
+                const float spread =
+                    c.coneHalfAngle + std::asin(std::min(1.0f, c.radius / distance));
+                out = spread < 1.5707963f &&
+                      glm::dot(c.coneAxis, toCluster / distance) > std::sin(spread);
+            }
+        }
+        visible[k] = out ? 0 : 1;
+    }
+}
+
+constexpr size_t kBatch = 1024;  // shading points per run of the dynamic shader
+
+}  // namespace
+
+// A band's shading points and results, kept while it is unfinished (its points whose
+// probes lacked tiles are shaded again after the fill, the rest are not) and reused from
+// frame to frame; and per thread, the buffers of one batch.
+struct DynamicPhase::Band {
+    struct State {
+        bool built = false;
+        std::vector<uint32_t> object, facet;  // per shading point
+        std::vector<float> x, y;              // per shading point, pixels
+        std::vector<uint32_t> fragmentPoint;  // per visibility slot of the band
+        std::vector<float> color, opacity;    // 3 per shading point
+        std::vector<uint32_t> pending;        // points still to shade
+    };
+    struct Scratch {
+        std::vector<uint32_t> order, objectStart, cursor, stillPending;
+        std::vector<uint32_t> batchFacet;
+        std::vector<float> batchX, batchY, batchColor, batchOpacity;
+        std::vector<uint8_t> batchMissed;
+        SurfaceShadingScratch surface;
+        SurfaceShadingCounters counters;
+        std::vector<ObjectFrameCost> costs;  // per object
+    };
+    std::vector<State> states;
+    tbb::enumerable_thread_specific<Scratch> scratch;
+};
+
+DynamicPhase::DynamicPhase(const Scene& scene)
+    : scene_(scene), scratch_(std::make_unique<Band>()) {}
+DynamicPhase::~DynamicPhase() = default;
+
+void DynamicPhase::begin(const FrameState& frame,
+                         std::span<const ObjectRepresentation* const> objects,
+                         std::shared_ptr<const SampleLayout> layout,
+                         const DynamicOptions& options) {
+    auto start = Clock::now();
+    frame_ = &frame;
+    objects_.assign(objects.begin(), objects.end());
+    layout_ = std::move(layout);
+    options_ = options;
+    stats_ = DynamicFrameStats{};
+    const size_t n = objects_.size();
+    costs_.assign(n, ObjectFrameCost{});
+    warps_.resize(n);
+    warped_.resize(n);
+    clusterVisible_.resize(n);
+    views_.assign(n, ObjectView{});
+    const CameraState& camera = frame.camera;
+    // The camera ray through screen position (x, y): d0 + x dx + y dy (world space).
+    const float tx = camera.tanHalfFovY * camera.aspect, ty = camera.tanHalfFovY;
+    const glm::vec3 d0 = camera.forward - tx * camera.right + ty * camera.up;
+    const glm::vec3 ddx = (2.0f * tx / static_cast<float>(camera.width)) * camera.right;
+    const glm::vec3 ddy = (-2.0f * ty / static_cast<float>(camera.height)) * camera.up;
+    const float footprint =
+        options.footprintScale *
+        (options.shadingRate == ShadingRate::Sample
+             ? 1.0f / std::sqrt(static_cast<float>(layout_->spp()))
+             : 0.5f);
+    tbb::parallel_for(size_t{0}, n, [&](size_t i) {
+        const ObjectRepresentation* rep = objects_[i];
+        if (!rep) return;
+        const ObjectState& state = frame.objects[i];
+        const FacetMesh& mesh = rep->mesh;
+        warps_[i] = std::make_unique<FixedPointWarp>(state.objectToWorld, camera, mesh.format);
+        warps_[i]->warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.positionCount(),
+                        warped_[i]);
+        clusterVisibility(mesh, state, camera, rep->opaque && rep->closed, clusterVisible_[i]);
+        ObjectView& v = views_[i];
+        v.rep = rep;
+        v.uniforms = &frame.uniforms[i];
+        v.eye = state.eye;
+        const glm::mat3 toObject(state.worldToObject);
+        v.d0 = toObject * d0;
+        v.dx = toObject * ddx;
+        v.dy = toObject * ddy;
+        v.footprintScale = footprint;
+        ObjectFrameCost& c = costs_[i];
+        c.drawn = true;
+        c.facets = mesh.facetCount();
+        c.verticesWarped = mesh.positionCount();
+    });
+    for (size_t i = 0; i < n; ++i)
+        if (objects_[i]) {
+            stats_.facets += costs_[i].facets;
+            stats_.verticesWarped += costs_[i].verticesWarped;
+            stats_.facetBytes += objects_[i]->bytes();
+        }
+    stats_.warpSeconds = secondsSince(start);
+
+    start = Clock::now();
+    std::vector<RasterObject> raster(n);
+    for (size_t i = 0; i < n; ++i) {
+        const ObjectRepresentation* rep = objects_[i];
+        if (!rep) continue;
+        raster[i] = {&rep->mesh,
+                     &warped_[i],
+                     warps_[i].get(),
+                     rep->opaque,
+                     rep->opaque && rep->closed,
+                     clusterVisible_[i].data(),
+                     rep->kind == Representation::Facets ? &costs_[i].longestEdgePixels : nullptr};
+    }
+    rasterizer_.rasterize(raster, *layout_, camera.zFar, options.raster, visibility_,
+                          stats_.raster);
+    stats_.rasterSeconds = secondsSince(start);
+    if (samples_.layout != layout_) {
+        samples_.reset(layout_);
+        uniform_.assign(static_cast<size_t>(layout_->width()) * layout_->height(), 0);
+    }
+    const int bands = (layout_->height() + options_.bandRows - 1) / options_.bandRows;
+    bandDone_.assign(static_cast<size_t>(bands), 0);
+    scratch_->states.resize(static_cast<size_t>(bands));
+    for (Band::State& state : scratch_->states) state.built = false;
+    for (Band::Scratch& s : scratch_->scratch) s.costs.assign(n, ObjectFrameCost{});
+}
+
+bool DynamicPhase::complete() const {
+    return std::all_of(bandDone_.begin(), bandDone_.end(), [](uint8_t d) { return d != 0; });
+}
+
+std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
+    const auto start = Clock::now();
+    ++stats_.shadePasses;
+    tbb::enumerable_thread_specific<std::vector<TileRequest>> lacking;
+    tbb::parallel_for(size_t{0}, bandDone_.size(), [&](size_t b) {
+        if (!bandDone_[b]) shadeBand(b, acceptFallbacks, lacking.local());
+    });
+    std::vector<TileRequest> all;
+    for (const std::vector<TileRequest>& l : lacking) all.insert(all.end(), l.begin(), l.end());
+    std::sort(all.begin(), all.end(), [](const TileRequest& a, const TileRequest& b) {
+        return a.object != b.object ? a.object < b.object : a.key.packed() < b.key.packed();
+    });
+    all.erase(std::unique(all.begin(), all.end(),
+                          [](const TileRequest& a, const TileRequest& b) {
+                              return a.object == b.object && a.key == b.key;
+                          }),
+              all.end());
+    for (const TileRequest& r : all) ++costs_[r.object].tilesLacked;
+    if (complete()) {
+        // Sum the per-thread counters once every band is done.
+        for (Band::Scratch& s : scratch_->scratch) {
+            for (size_t i = 0; i < costs_.size() && i < s.costs.size(); ++i) {
+                costs_[i].shadingPoints += s.costs[i].shadingPoints;
+                costs_[i].probes += s.costs[i].probes;
+                costs_[i].probeFallbacks += s.costs[i].probeFallbacks;
+                s.costs[i] = ObjectFrameCost{};
+            }
+            stats_.instructions += s.counters.instructions;
+            stats_.nonFinite += s.counters.nonFinite;
+            s.counters = SurfaceShadingCounters{};
+        }
+        stats_.shadingPoints = stats_.probes = stats_.probeFallbacks = 0;
+        for (const ObjectFrameCost& c : costs_) {
+            stats_.shadingPoints += c.shadingPoints;
+            stats_.probes += c.probes;
+            stats_.probeFallbacks += c.probeFallbacks;
+        }
+    }
+    stats_.shadeSeconds += secondsSince(start);
+    return all;
+}
+
+void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& lacking) {
+    Band::State& st = scratch_->states[band];
+    Band::Scratch& s = scratch_->scratch.local();
+    if (s.costs.size() != objects_.size()) s.costs.assign(objects_.size(), ObjectFrameCost{});
+    const SampleLayout& layout = *layout_;
+    const VisibilityBuffer& vis = visibility_;
+    const int width = layout.width(), spp = layout.spp(), layers = vis.layers;
+    const int row0 = static_cast<int>(band) * options_.bandRows;
+    const int row1 = std::min(layout.height(), row0 + options_.bandRows);
+    const size_t firstSample = layout.index(0, row0, 0);
+    const size_t endSample = layout.index(0, row1, 0);
+    const size_t firstSlot = firstSample * static_cast<size_t>(layers);
+
+    // 1. Shading points, once per frame.
+    if (!st.built) {
+        st.object.clear(), st.facet.clear(), st.x.clear(), st.y.clear();
+        st.fragmentPoint.resize((endSample - firstSample) * static_cast<size_t>(layers));
+        auto addPoint = [&](uint32_t o, uint32_t f, float x, float y) {
+            st.object.push_back(o);
+            st.facet.push_back(f);
+            st.x.push_back(x);
+            st.y.push_back(y);
+            return static_cast<uint32_t>(st.object.size() - 1);
+        };
+        if (options_.shadingRate == ShadingRate::Sample) {
+            for (size_t smp = firstSample; smp < endSample; ++smp)
+                for (int l = 0; l < vis.count[smp]; ++l) {
+                    const size_t slot = smp * layers + l;
+                    st.fragmentPoint[slot - firstSlot] =
+                        addPoint(vis.object[slot], vis.facet[slot], layout.x(smp), layout.y(smp));
+                }
+        } else {
+            struct Group {
+                uint32_t object;
+                int layer;
+                float sx, sy;
+                int count;
+            };
+            Group groups[64];
+            uint8_t member[256];  // per (sample, layer) of the pixel: its group
+            for (int py = row0; py < row1; ++py)
+                for (int px = 0; px < width; ++px) {
+                    const size_t first = layout.index(px, py, 0);
+                    int groupCount = 0;
+                    for (int k = 0; k < spp && k * layers < 256; ++k)
+                        for (int l = 0; l < vis.count[first + k]; ++l) {
+                            const uint32_t o = vis.object[(first + k) * layers + l];
+                            int g = 0;
+                            while (g < groupCount &&
+                                   !(groups[g].object == o && groups[g].layer == l))
+                                ++g;
+                            if (g == groupCount) {
+                                if (groupCount == 64)
+                                    g = 0;  // more surfaces than that: merge
+                                else
+                                    groups[groupCount++] = {o, l, 0.0f, 0.0f, 0};
+                            }
+                            groups[g].sx += layout.x(first + k);
+                            groups[g].sy += layout.y(first + k);
+                            ++groups[g].count;
+                            member[k * layers + l] = static_cast<uint8_t>(g);
+                        }
+                    uint32_t pointOf[64];
+                    for (int g = 0; g < groupCount; ++g) {
+                        const float cx = groups[g].sx / groups[g].count,
+                                    cy = groups[g].sy / groups[g].count;
+                        // The facet of the member sample nearest the centroid.
+                        uint32_t facet = 0;
+                        float best = 1e30f;
+                        for (int k = 0; k < spp && k * layers < 256; ++k)
+                            for (int l = 0; l < vis.count[first + k]; ++l) {
+                                if (member[k * layers + l] != g) continue;
+                                const float dx = layout.x(first + k) - cx,
+                                            dy = layout.y(first + k) - cy;
+                                if (dx * dx + dy * dy < best) {
+                                    best = dx * dx + dy * dy;
+                                    facet = vis.facet[(first + k) * layers + l];
+                                }
+                            }
+                        pointOf[g] = addPoint(groups[g].object, facet, cx, cy);
+                    }
+                    for (int k = 0; k < spp && k * layers < 256; ++k)
+                        for (int l = 0; l < vis.count[first + k]; ++l)
+                            st.fragmentPoint[(first + k) * layers + l - firstSlot] =
+                                pointOf[member[k * layers + l]];
+                }
+        }
+        const size_t points = st.object.size();
+        st.color.resize(3 * points);
+        st.opacity.resize(3 * points);
+        st.pending.resize(points);
+        for (uint32_t p = 0; p < points; ++p) st.pending[p] = p;
+        st.built = true;
+    }
+
+    // 2. The pending points by object (counting sort), each object's in batches; those
+    //    whose probes lacked tiles stay pending.
+    const size_t objects = objects_.size();
+    s.objectStart.assign(objects + 1, 0);
+    for (uint32_t p : st.pending) ++s.objectStart[st.object[p] + 1];
+    for (size_t o = 0; o < objects; ++o) s.objectStart[o + 1] += s.objectStart[o];
+    s.order.resize(st.pending.size());
+    s.cursor.assign(s.objectStart.begin(), s.objectStart.end() - 1);
+    for (uint32_t p : st.pending) s.order[s.cursor[st.object[p]]++] = p;
+    s.batchFacet.resize(kBatch);
+    s.batchX.resize(kBatch), s.batchY.resize(kBatch);
+    s.batchColor.resize(3 * kBatch), s.batchOpacity.resize(3 * kBatch);
+    s.batchMissed.resize(kBatch);
+    s.stillPending.clear();
+    for (size_t o = 0; o < objects; ++o) {
+        if (s.objectStart[o + 1] == s.objectStart[o]) continue;
+        SurfaceShadingCounters counters;
+        s.surface.missing.clear();
+        for (size_t b = s.objectStart[o]; b < s.objectStart[o + 1]; b += kBatch) {
+            const size_t m = std::min(kBatch, s.objectStart[o + 1] - b);
+            for (size_t i = 0; i < m; ++i) {
+                const uint32_t p = s.order[b + i];
+                s.batchFacet[i] = st.facet[p];
+                s.batchX[i] = st.x[p];
+                s.batchY[i] = st.y[p];
+            }
+            const SurfacePoints batch{s.batchFacet.data(), s.batchX.data(), s.batchY.data(), m};
+            const size_t missed = shadeSurfacePoints(
+                views_[o], options_.probe, !acceptFallbacks, batch, s.batchColor.data(),
+                s.batchOpacity.data(), s.batchMissed.data(), s.surface, counters);
+            for (size_t i = 0; i < m; ++i) {
+                const uint32_t p = s.order[b + i];
+                if (missed > 0 && s.batchMissed[i]) {
+                    s.stillPending.push_back(p);
+                    continue;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    st.color[3 * p + k] = s.batchColor[3 * i + k];
+                    st.opacity[3 * p + k] = s.batchOpacity[3 * i + k];
+                }
+            }
+        }
+        for (const TileKey& key : s.surface.missing)
+            lacking.push_back({static_cast<uint32_t>(o), key});
+        ObjectFrameCost& cost = s.costs[o];
+        cost.probes += counters.probes;
+        cost.probeFallbacks += counters.fallbacks;
+        s.counters.instructions += counters.instructions;
+        s.counters.nonFinite += counters.nonFinite;
+    }
+    st.pending.swap(s.stillPending);
+    if (!st.pending.empty()) return;  // shaded again once the lacking tiles are filled
+
+    // 3. Composite every sample front to back over the background; note the pixels whose
+    //    samples all came out alike (the resolve reads those once).
+    const glm::vec3 background = scene_.settings.background;
+    for (size_t smp = firstSample; smp < endSample; ++smp) {
+        SampleComposite c;
+        for (int l = 0; l < vis.count[smp]; ++l) {
+            const uint32_t p = st.fragmentPoint[smp * layers + l - firstSlot];
+            c.over(&st.color[3 * p], &st.opacity[3 * p]);
+        }
+        c.finish(background, &samples_.rgba[4 * smp]);
+    }
+    for (size_t pixel = firstSample / spp; pixel < endSample / spp; ++pixel) {
+        const float* first = &samples_.rgba[4 * pixel * spp];
+        bool same = true;
+        for (int k = 1; k < spp && same; ++k)
+            same = std::memcmp(first, first + 4 * k, 4 * sizeof(float)) == 0;
+        uniform_[pixel] = same ? 1 : 0;
+    }
+    for (uint32_t o : st.object) ++s.costs[o].shadingPoints;
+    st.built = false;
+    bandDone_[band] = 1;
+}
+
+void DynamicPhase::resolve(Image& out) {
+    const auto start = Clock::now();
+    layout_->resolve(samples_.rgba.data(), uniform_.data(), out);
+    stats_.resolveSeconds = secondsSince(start);
+}
+
+}  // namespace mpshade

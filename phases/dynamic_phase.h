@@ -1,0 +1,118 @@
+// dynamic_phase.h -- the patent's dynamic phase (FIG. 2, 230): every frame, over read-only
+// object representations, the dynamic TSI (the fixed-point warp, fixed_point_warp.h, and
+// rasterization to a visibility buffer, facet_rasterizer.h) and the dynamic shader on
+// what each sample sees (surface_points.h), composited front to back and filtered into
+// pixels.
+//
+// Shading runs in bands of pixel rows, in parallel. A band whose probes lack shader-map
+// tiles is left unshaded and the tiles are handed back, so a caller wanting constant
+// quality fills them and calls shade() again (only those bands are redone); a caller
+// keeping a frame rate accepts the coarser levels instead (acceptFallbacks).
+//
+// Shading rate. Per sample: every visible surface of every sample is a shading point at
+// that sample. Per pixel: the samples of a pixel that see the same object (at the same
+// depth layer) share one shading point at their centroid, on the facet of the sample
+// nearest to it; coverage stays per sample, so edges are as antialiased as the
+// reference's, while the dynamic shader and the probes run about spp times less often.
+// The probe footprint is 1/sqrt(spp) pixel per sample (the sample's stratum), and half a
+// pixel per pixel, times footprintScale.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "phases/facet_rasterizer.h"
+#include "phases/object_representation.h"
+#include "phases/sample_pattern.h"
+#include "phases/scene_resources.h"
+#include "phases/surface_points.h"
+
+namespace mpshade {
+
+struct DynamicOptions {
+    RasterOptions raster;
+    // Feline capped at 2:1 (three taps), levels blended only within 1/8 level of their
+    // midpoint: measured the best speed for its error against 64-sample references
+    // (docs/multiphase.md).
+    ProbeOptions probe{ProbeFilter::Feline, 2.0f, 0.25f};
+    ShadingRate shadingRate = ShadingRate::Sample;
+    // Multiplies each shading point's probe footprint: 1/sqrt(spp) pixel per sample, or half
+    // a pixel per pixel (measured the least error of each rate; docs/multiphase.md).
+    float footprintScale = 1.0f;
+    int bandRows = 4;  // pixel rows per unit of shading work
+};
+
+// What one object cost this frame.
+struct ObjectFrameCost {
+    bool drawn = false;
+    uint64_t facets = 0;         // in its representation
+    uint64_t verticesWarped = 0;
+    uint64_t shadingPoints = 0;  // runs of the dynamic shader
+    uint64_t probes = 0, probeFallbacks = 0;
+    uint64_t tilesLacked = 0;  // distinct tiles its probes asked for that were not resident
+    // Combined representation: the longest projected facet edge among its visible
+    // clusters, in pixels (the static phase dices again beyond maxEdgePixels).
+    float longestEdgePixels = 0.0f;
+};
+
+struct DynamicFrameStats {
+    double warpSeconds = 0.0, rasterSeconds = 0.0, shadeSeconds = 0.0, resolveSeconds = 0.0;
+    int shadePasses = 0;  // shade() calls this frame
+    uint64_t facets = 0, verticesWarped = 0, facetBytes = 0;
+    RasterStats raster;
+    uint64_t shadingPoints = 0, instructions = 0, nonFinite = 0;
+    uint64_t probes = 0, probeFallbacks = 0;
+};
+
+class DynamicPhase {
+  public:
+    explicit DynamicPhase(const Scene& scene);
+    ~DynamicPhase();
+    DynamicPhase(const DynamicPhase&) = delete;
+    DynamicPhase& operator=(const DynamicPhase&) = delete;
+
+    // Starts a frame: warps and rasterizes every object that has a representation (null:
+    // not drawn this frame). The representations, the frame state and the layout must
+    // stay alive and unchanged until finish().
+    void begin(const FrameState& frame, std::span<const ObjectRepresentation* const> objects,
+               std::shared_ptr<const SampleLayout> layout, const DynamicOptions& options);
+    // Shades the bands not yet shaded. Returns the tiles lacking, deduplicated; with
+    // acceptFallbacks every band is done (lacking tiles fell back to coarser levels),
+    // otherwise bands that lacked tiles stay undone until a later call.
+    std::vector<TileRequest> shade(bool acceptFallbacks = false);
+    bool complete() const;
+    // The composited samples (after shade() completed every band).
+    const SampleBuffer& samples() const { return samples_; }
+    // Filters the samples into pixels.
+    void resolve(Image& out);
+
+    const DynamicFrameStats& stats() const { return stats_; }
+    const std::vector<ObjectFrameCost>& objectCosts() const { return costs_; }
+    const VisibilityBuffer& visibility() const { return visibility_; }
+
+  private:
+    struct Band;
+    void shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& lacking);
+
+    const Scene& scene_;
+    const FrameState* frame_ = nullptr;
+    std::vector<const ObjectRepresentation*> objects_;
+    std::shared_ptr<const SampleLayout> layout_;
+    DynamicOptions options_;
+    FacetRasterizer rasterizer_;
+    std::vector<std::unique_ptr<FixedPointWarp>> warps_;
+    std::vector<WarpedVertices> warped_;
+    std::vector<std::vector<uint8_t>> clusterVisible_;
+    std::vector<ObjectView> views_;
+    VisibilityBuffer visibility_;
+    SampleBuffer samples_;
+    std::vector<uint8_t> uniform_;  // per pixel: every sample alike
+    std::vector<uint8_t> bandDone_;
+    std::unique_ptr<Band> scratch_;
+    DynamicFrameStats stats_;
+    std::vector<ObjectFrameCost> costs_;
+};
+
+}  // namespace mpshade

@@ -1,0 +1,269 @@
+#include "phases/static_phase.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <glm/geometric.hpp>
+
+#include "scene/variability.h"
+#include "shading/builtins.h"
+#include "shading/shading_batch.h"
+
+namespace mpshade {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The shading-input rows of a geometric global, in VertexAttributes' order; -1 for those
+// the facet itself supplies (P, from where the sample's ray meets it; I, from P and the eye).
+int rowOf(GlobalId id) {
+    switch (id) {
+        case GlobalId::N:
+            return VertexAttributes::Nx;
+        case GlobalId::Ng:
+            return VertexAttributes::Ngx;
+        case GlobalId::dPdu:
+            return VertexAttributes::dPdux;
+        case GlobalId::dPdv:
+            return VertexAttributes::dPdvx;
+        case GlobalId::u:
+            return VertexAttributes::U;
+        case GlobalId::v:
+            return VertexAttributes::V;
+        case GlobalId::s:
+            return VertexAttributes::S;
+        case GlobalId::t:
+            return VertexAttributes::T;
+        default:
+            return -1;
+    }
+}
+
+bool isOpaque(const IrProgram& dynamicPart) {
+    for (int v : dynamicPart.oi) {
+        const Inst* def = nullptr;
+        for (const Inst& inst : dynamicPart.insts)
+            if (inst.result <= v && v < inst.result + inst.nout) def = &inst;
+        if (!def || def->op != Op::Const || def->constant != 1.0f) return false;
+    }
+    return true;
+}
+
+bool readsFrame(const IrProgram& program, const ShaderBinding& binding) {
+    for (const Inst& inst : program.insts) {
+        switch (inst.op) {
+            case Op::Global: {
+                const auto id = static_cast<GlobalId>(inst.imm);
+                if (id == GlobalId::I || id == GlobalId::E || id == GlobalId::time) return true;
+                break;
+            }
+            case Op::Param:
+            case Op::LightAmbient:
+                return true;
+            case Op::Diffuse:
+            case Op::Specular:
+            case Op::Phong: {
+                const size_t light = static_cast<size_t>(inst.imm);
+                if (light < binding.lights.size() && binding.lights[light].movesRelativeToObject)
+                    return true;
+                break;
+            }
+            default:
+                break;
+        }
+    }
+    return false;
+}
+
+// Per-thread scratch for the static shading of vertices.
+struct VertexScratch {
+    ShadingBatch batch;
+    std::vector<float> workspace;
+};
+
+constexpr size_t kChunk = 1024;
+
+}  // namespace
+
+StaticPhase::StaticPhase(const Scene& scene, const SceneResources& resources,
+                         const StaticPhaseOptions& options)
+    : scene_(scene), resources_(resources), options_(options) {
+    for (const SceneObject& obj : scene.objects) {
+        auto s = std::make_unique<ObjectShading>();
+        const ShaderBinding binding = bindingOf(scene, obj);
+        s->factored = forObject(scene, obj,
+                                [&] { return factorShader(*obj.shader, binding, options.factor); });
+        s->staticKernel = std::make_unique<ShaderKernel>(s->factored.staticPart);
+        s->dynamicKernel = std::make_shared<const ShaderKernel>(s->factored.dynamicPart);
+        s->opaque = isOpaque(s->factored.dynamicPart);
+        s->closed = isClosed(*obj.surface);
+        s->staticReadsFrame = readsFrame(s->factored.staticPart, binding);
+        for (const Inst& inst : s->factored.dynamicPart.insts) {
+            if (inst.op != Op::Global) continue;
+            const int row = rowOf(static_cast<GlobalId>(inst.imm));
+            if (row < 0) continue;
+            for (int k = 0; k < inst.nout; ++k)
+                if (std::find(s->geometryRows.begin(), s->geometryRows.end(), row + k) ==
+                    s->geometryRows.end())
+                    s->geometryRows.push_back(row + k);
+        }
+        objects_.push_back(std::move(s));
+    }
+}
+
+StaticPhase::~StaticPhase() = default;
+
+std::unique_ptr<ObjectRepresentation> StaticPhase::build(
+    size_t index, Representation kind, const ObjectState& state, const CameraState& camera,
+    const ShadingUniforms& uniforms, const ObjectRepresentation* previous,
+    StaticCosts& costs) const {
+    const auto start = Clock::now();
+    const ObjectShading& obj = *objects_[index];
+    const SceneObject& sceneObject = scene_.objects[index];
+    const Surface& surface = *sceneObject.surface;
+    const bool useMap = kind == Representation::ShaderMap;
+    DicingView view;
+    view.eye = state.eye;
+    view.pixelsPerUnit = 0.5f * static_cast<float>(camera.height) / camera.tanHalfFovY;
+    // A length at angle a off the view axis projects up to 1 / cos^2 a = 1 + tan^2 a
+    // times longer than on the axis; a is at most the frustum's half diagonal.
+    const float tx = camera.tanHalfFovY * camera.aspect, ty = camera.tanHalfFovY;
+    view.fovSlack = 1.0f + tx * tx + ty * ty;
+    view.nearDistance = camera.zNear / state.scale;
+    view.forward = glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
+    view.halfDiagonalFov = std::atan(std::sqrt(tx * tx + ty * ty));
+    const DicingOptions& dicing = useMap ? options_.separateDicing : options_.combinedDicing;
+    const DicedSurface diced = diceSurface(surface, view, sceneObject.range, dicing);
+
+    auto rep = std::make_unique<ObjectRepresentation>();
+    rep->kind = useMap ? Representation::ShaderMap : Representation::Facets;
+    rep->representativeEye = state.eye;
+    rep->representativeForward = view.forward;
+    rep->center = surfaceBounds(surface).center();
+    rep->range = sceneObject.range;
+    rep->frustumCulled = dicing.frustumCull;
+    rep->imageHeight = camera.height;
+    rep->maxEdgePixels = useMap ? 0.0f : dicing.maxEdgePixels;
+    rep->dynamicKernel = obj.dynamicKernel;
+    rep->geometryRows = obj.geometryRows;
+    rep->opaque = obj.opaque;
+    rep->closed = obj.closed;
+    rep->charts = diced.charts;
+    rep->patches = diced.patches;
+    rep->culledPatches = diced.culledCharts;
+    rep->frustumCulledPatches = diced.frustumCulled;
+    rep->cappedPatches = diced.cappedCharts;
+
+    FacetMesh& mesh = rep->mesh;
+    mesh.format = diced.format;
+    mesh.qx = diced.qx;
+    mesh.qy = diced.qy;
+    mesh.qz = diced.qz;
+    mesh.attributeIndex = diced.triangles;
+    mesh.positionIndex.resize(diced.triangles.size());
+    for (size_t k = 0; k < diced.triangles.size(); ++k)
+        mesh.positionIndex[k] = diced.positionOf[diced.triangles[k]];
+    mesh.attributeChartPoint = diced.attributePoints;
+    mesh.clusters = diced.clusters;
+    const size_t channels = obj.factored.staticPart.channelOutputs.size();
+    mesh.channels = useMap ? 0 : static_cast<int>(channels);
+
+    // Geometry the dynamic part reads, and (combined) the n-tuple from the static part.
+    const size_t n = diced.attributePoints.size();
+    VertexAttributes& attr = mesh.attributes;
+    attr.count = n;
+    attr.rows.assign(VertexAttributes::kGeometryRows + static_cast<size_t>(mesh.channels), {});
+    for (int row : obj.geometryRows) attr.rows[static_cast<size_t>(row)].resize(n);
+    for (int c = 0; c < mesh.channels; ++c)
+        attr.rows[VertexAttributes::kGeometryRows + static_cast<size_t>(c)].resize(n);
+    tbb::enumerable_thread_specific<VertexScratch> scratch;
+    std::atomic<uint64_t> instructions{0};
+    tbb::parallel_for(size_t{0}, (n + kChunk - 1) / kChunk, [&](size_t chunk) {
+        enableFlushToZero();
+        VertexScratch& b = scratch.local();
+        const size_t begin = chunk * kChunk, m = std::min(kChunk, n - begin);
+        b.batch.resize(m, useMap ? 0 : channels);
+        for (size_t i = 0; i < m; ++i) {
+            const SurfaceSample& g = diced.attributeGeometry[begin + i];
+            const ChartPoint& at = diced.attributePoints[begin + i];
+            const glm::vec3 I = glm::normalize(g.P - state.eye);
+            b.batch.setPoint(i, g, at, I);
+            for (int row : obj.geometryRows) {
+                // VertexAttributes rows follow the shading batch's first 15 rows, then
+                // u v s t (the batch's rows U..T, after I).
+                const int src = row < VertexAttributes::U ? row : row + 3;
+                attr.rows[static_cast<size_t>(row)][begin + i] = b.batch.row(src)[i];
+            }
+        }
+        if (useMap) return;
+        ShadingCounters counters;
+        obj.staticKernel->run(uniforms, b.batch.in, m, b.batch.out, b.workspace, counters);
+        instructions += counters.instructions;
+        for (size_t c = 0; c < channels; ++c)
+            std::copy(b.batch.out.channels[c], b.batch.out.channels[c] + m,
+                      attr.rows[VertexAttributes::kGeometryRows + c].begin() + begin);
+    });
+    costs.instructions += instructions;
+    if (!useMap) {
+        costs.programRuns += n;
+    } else if (previous && previous->map && !obj.staticReadsFrame) {
+        rep->map = previous->map;  // still valid: its tiles are kept
+    } else {
+        ShaderMapOptions mapOptions = options_.shaderMap;
+        int cap = sceneObject.shadermapResolution > 0 ? sceneObject.shadermapResolution
+                                                      : mapOptions.resolution;
+        int resolution = 1;
+        while (resolution < cap && resolution < (1 << 20)) resolution *= 2;
+        mapOptions.resolution = resolution;
+        mapOptions.tileSize = std::min(mapOptions.tileSize, resolution);
+        rep->map = std::make_shared<ShaderMap>(surface, *obj.staticKernel, uniforms, mapOptions);
+        const FillStats& f = rep->map->fillStats();
+        costs.tilesFilled += f.tiles;
+        costs.tilesFromChildren += f.tilesFromChildren;
+        costs.texelsFilled += f.texels;
+        costs.programRuns += f.programRuns;
+        costs.instructions += f.programRuns * obj.staticKernel->instructionCount();
+    }
+    ++costs.runs;
+    costs.seconds += std::chrono::duration<double>(Clock::now() - start).count();
+    return rep;
+}
+
+void StaticPhase::fill(std::span<const TileRequest> requests,
+                       std::span<const ObjectRepresentation* const> representations,
+                       StaticCosts& costs) const {
+    if (requests.empty()) return;
+    const auto start = Clock::now();
+    std::map<uint32_t, std::vector<TileKey>> perObject;
+    for (const TileRequest& r : requests) perObject[r.object].push_back(r.key);
+    struct Work {
+        ShaderMap* map;
+        std::vector<TileKey>* keys;
+        size_t instructionsPerRun;
+    };
+    std::vector<Work> work;
+    for (auto& [object, keys] : perObject) {
+        const ObjectRepresentation* rep = representations[object];
+        if (rep && rep->map)
+            work.push_back({rep->map.get(), &keys, objects_[object]->staticKernel->instructionCount()});
+    }
+    std::vector<FillStats> before(work.size());
+    for (size_t w = 0; w < work.size(); ++w) before[w] = work[w].map->fillStats();
+    tbb::parallel_for(size_t{0}, work.size(), [&](size_t w) { work[w].map->fill(*work[w].keys); });
+    for (size_t w = 0; w < work.size(); ++w) {
+        const FillStats& after = work[w].map->fillStats();
+        costs.instructions += (after.programRuns - before[w].programRuns) * work[w].instructionsPerRun;
+        costs.tilesFilled += after.tiles - before[w].tiles;
+        costs.tilesFromChildren += after.tilesFromChildren - before[w].tilesFromChildren;
+        costs.texelsFilled += after.texels - before[w].texels;
+        costs.programRuns += after.programRuns - before[w].programRuns;
+    }
+    costs.seconds += std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace mpshade

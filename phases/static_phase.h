@@ -1,0 +1,84 @@
+// static_phase.h -- the patent's static phase (FIG. 2, 220): per object, rarely, the
+// static TSI (dicing, dicing.h) and the static shader S_s, stored as the object's
+// intermediate representation (object_representation.h); and, on demand, the shader-map
+// tiles frames ask for.
+//
+// What is fixed for the whole render is worked out once per object (ObjectShading): its
+// shader factored for its binding, both parts compiled, and what the dynamic part reads.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "phases/dicing.h"
+#include "phases/object_representation.h"
+#include "phases/scene_resources.h"
+#include "shading/factoring.h"
+
+namespace mpshade {
+
+struct StaticPhaseOptions {
+    FactorOptions factor;
+    // The combined representation: edges under P/2 at the representative view.
+    DicingOptions combinedDicing = {DicingTarget::EdgeLength, 0.5f, 0.25f, false};
+    // The separate representation: within 1/4 pixel of the surface over the range.
+    DicingOptions separateDicing = {DicingTarget::Flatness, 0.5f, 0.25f, true};
+    ShaderMapOptions shaderMap;  // resolution: capped per object by the scene
+};
+
+// One object's shading, as both phases need it, fixed for the whole render.
+struct ObjectShading {
+    FactoredShader factored;
+    std::unique_ptr<ShaderKernel> staticKernel;
+    std::shared_ptr<const ShaderKernel> dynamicKernel;
+    // VertexAttributes rows the dynamic part reads (P and I come from the facet itself).
+    std::vector<int> geometryRows;
+    bool opaque = true;  // the dynamic part's Oi is the constant 1
+    bool closed = false;  // the surface bounds a solid
+    // The static part reads the view, the time or an animated input (through bake()): its
+    // values hold for the representative view only, so a new static run needs new ones.
+    bool staticReadsFrame = false;
+};
+
+// What static work cost (accumulated).
+struct StaticCosts {
+    int runs = 0;  // representations built
+    double seconds = 0.0;
+    uint64_t instructions = 0;  // static shader instructions, times lanes
+    uint64_t tilesFilled = 0, tilesFromChildren = 0, texelsFilled = 0, programRuns = 0;
+};
+
+class StaticPhase {
+  public:
+    StaticPhase(const Scene& scene, const SceneResources& resources,
+                const StaticPhaseOptions& options = {});
+    ~StaticPhase();
+
+    const ObjectShading& shading(size_t object) const { return *objects_[object]; }
+    const StaticPhaseOptions& options() const { return options_; }
+
+    // Object `object`'s representation for the view of `camera` (its representative view).
+    // `previous` (may be null) lends its shader map when the static part does not read the
+    // frame. Safe to call for different objects in parallel.
+    std::unique_ptr<ObjectRepresentation> build(size_t object, Representation kind,
+                                                const ObjectState& state,
+                                                const CameraState& camera,
+                                                const ShadingUniforms& uniforms,
+                                                const ObjectRepresentation* previous,
+                                                StaticCosts& costs) const;
+
+    // Fills the requested tiles lacking from the representations' maps: each map's tiles
+    // in one batch (finest level first), maps in parallel.
+    void fill(std::span<const TileRequest> requests,
+              std::span<const ObjectRepresentation* const> representations,
+              StaticCosts& costs) const;
+
+  private:
+    const Scene& scene_;
+    const SceneResources& resources_;
+    StaticPhaseOptions options_;
+    std::vector<std::unique_ptr<ObjectShading>> objects_;
+};
+
+}  // namespace mpshade

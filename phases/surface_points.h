@@ -1,0 +1,70 @@
+// surface_points.h -- the dynamic phase's shading of visible surface points: for each point
+// (a facet and a screen position), where the camera ray through that position meets the
+// facet, the attributes there, the n-tuple (interpolated from the facet's vertices, or
+// probed from the shader map with the point's footprint), and the dynamic shader S_d.
+//
+// Barycentric weights come from intersecting the ray with the facet in object space
+// (Moller and Trumbore 1997) rather than from the rasterizer: they are perspective
+// correct by construction, exact for facets clipped at the near plane (whose corners
+// may be behind the eye), and need not be carried for every sample a facet is tested
+// against. With the ray direction linear in the screen position, d = d0 + x dx + y dy,
+// each weight is a ratio of two linear functions of (x, y), so its screen derivatives --
+// and the chart coordinates' footprint for the probe -- are exact for the facet's plane.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "phases/object_representation.h"
+#include "shadermaps/probe.h"
+#include "shading/shading_batch.h"
+
+namespace mpshade {
+
+// One object as this frame sees it. Object space throughout.
+struct ObjectView {
+    const ObjectRepresentation* rep = nullptr;
+    const ShadingUniforms* uniforms = nullptr;
+    glm::vec3 eye{0.0f};
+    // The (unnormalized) direction of the ray through screen position (x, y) pixels.
+    glm::vec3 d0{0.0f}, dx{0.0f}, dy{0.0f};
+    float footprintScale = 1.0f;  // multiplies the probe footprint of one pixel
+};
+
+// Points to shade: facet and screen position (pixels), n of each.
+struct SurfacePoints {
+    const uint32_t* facet = nullptr;
+    const float* x = nullptr;
+    const float* y = nullptr;
+    size_t n = 0;
+};
+
+struct SurfaceShadingScratch {
+    ShadingBatch batch;
+    std::vector<ProbeQuery> queries;
+    std::vector<float> probed, workspace;
+    std::vector<TileKey> lacking;  // the probes' report buffer
+    std::vector<TileKey> missing;  // lacking tiles of the calls since it was cleared
+};
+
+struct SurfaceShadingCounters {
+    uint64_t instructions = 0;
+    uint64_t nonFinite = 0;  // results that were NaN or infinite (made opaque black)
+    uint64_t probes = 0;     // bilinear probes of shader maps
+    uint64_t fallbacks = 0;  // of them, answered from a coarser level
+    uint64_t missingProbes = 0;
+};
+
+// Shades points.n points of `view`'s object into color and opacity (3 floats per point
+// each, sanitized: compositing.h). Tiles the probes lacked are added to scratch.missing.
+// With stopAtMissing, a point whose probes lacked a tile gets missed[i] = 1 and a
+// meaningless result (it is to be shaded again once the tiles are filled); otherwise
+// lacking tiles fall back to coarser levels. Returns how many points missed.
+size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, bool stopAtMissing,
+                          const SurfacePoints& points, float* color, float* opacity,
+                          uint8_t* missed, SurfaceShadingScratch& scratch,
+                          SurfaceShadingCounters& counters);
+
+}  // namespace mpshade
