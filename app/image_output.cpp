@@ -10,6 +10,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "geometry/error.h"
+
 namespace mpshade {
 namespace {
 
@@ -27,6 +29,28 @@ float linearToSrgb(float c) {
 }
 
 }  // namespace
+
+Image readImage(const std::string& path) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw InputError({path, 0, 0, {}}, "cannot read the image: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || spec.width > 65536 ||
+        spec.height > 65536)
+        throw InputError({path, 0, 0, {}}, "not an image mpshade can compare (size or channels)");
+    std::vector<float> pixels(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data()))
+        throw InputError({path, 0, 0, {}}, "cannot read the image: " + in->geterror());
+    Image image(spec.width, spec.height);
+    const size_t n = static_cast<size_t>(spec.width) * spec.height;
+    const int c = spec.nchannels;
+    for (size_t i = 0; i < n; ++i) {
+        const float* p = &pixels[i * static_cast<size_t>(c)];
+        float* o = &image.rgba[4 * i];
+        for (int k = 0; k < 3; ++k) o[k] = c >= 3 ? p[k] : p[0];
+        o[3] = c == 4 ? p[3] : (c == 2 ? p[1] : 1.0f);
+    }
+    return image;
+}
 
 void writeExr(const Image& image, const std::string& path) {
     OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::HALF);

@@ -1,4 +1,4 @@
-// image_output.h -- writes frames with OpenImageIO: linear half-float RGBA OpenEXR, and an
+// image_output.h -- reads images and writes frames with OpenImageIO: linear half-float RGBA OpenEXR, and an
 // sRGB-encoded 8-bit PNG for viewing. Kept apart so only this file pays for OIIO's headers.
 #pragma once
 
@@ -11,5 +11,9 @@ namespace mpshade {
 // Throws std::runtime_error with OpenImageIO's message on failure.
 void writeExr(const Image& image, const std::string& path);
 void writePng(const Image& image, const std::string& path);
+// Reads any image OpenImageIO reads as linear RGBA floats (alpha 1 if it has none; the
+// first three channels as RGB, a single channel as grey). Throws InputError naming the
+// file when it cannot.
+Image readImage(const std::string& path);
 
 }  // namespace mpshade

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/compare_command.h"
 #include "app/factor_command.h"
 #include "app/render_command.h"
 
@@ -47,6 +48,14 @@ int main(int argc, char** argv) {
     factorCmd->add_flag("--json", factor.json, "Machine-readable output");
     factorCmd->add_flag("--dump", factor.dump, "Also print the IR of both parts");
 
+    mpshade::CompareCommandOptions compare;
+    CLI::App* compareCmd = app.add_subcommand(
+        "compare", "The error of an image against a reference image (PSNR, RMSE, largest error)");
+    compareCmd->add_option("image", compare.test, "Image measured (EXR, PNG, ...)")->required();
+    compareCmd->add_option("reference", compare.reference, "Image it is measured against")
+        ->required();
+    compareCmd->add_flag("--json", compare.json, "Machine-readable output");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -62,6 +71,7 @@ int main(int argc, char** argv) {
     try {
         if (renderCmd->parsed()) return mpshade::runRenderCommand(render);
         if (factorCmd->parsed()) return mpshade::runFactorCommand(factor);
+        if (compareCmd->parsed()) return mpshade::runCompareCommand(compare);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "mpshade: internal error: %s\n", e.what());
         return 1;

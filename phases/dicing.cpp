@@ -208,28 +208,43 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
             };
             const bool flatness = options.target == DicingTarget::Flatness;
             // Chord from survey point (i0, j0) to (i0 + 2 di, j0 + 2 dj).
+            const bool projected =
+                options.target == DicingTarget::EdgeLength && !options.overRange && view.projects;
+            auto project = [&](const glm::vec3& p, double& x, double& y) {
+                double h[3];
+                for (int r = 0; r < 3; ++r)
+                    h[r] = view.screen[r][0] * p.x + view.screen[r][1] * p.y +
+                           view.screen[r][2] * p.z + view.screen[r][3];
+                if (!(h[2] > view.nearW)) return false;
+                x = h[0] / h[2], y = h[1] / h[2];
+                return true;
+            };
             auto chord = [&](int i0, int j0, int di, int dj) {
                 const SurfaceSample &a = at(i0, j0), &m = at(i0 + di, j0 + dj),
                                     &b = at(i0 + 2 * di, j0 + 2 * dj);
+                double ax, ay, mx, my, bx, by;
+                if (projected && project(a.P, ax, ay) && project(m.P, mx, my) &&
+                    project(b.P, bx, by))
+                    return static_cast<float>(std::hypot(mx - ax, my - ay) +
+                                              std::hypot(bx - mx, by - my));
                 const float length = glm::length(m.P - a.P) + glm::length(b.P - m.P);
                 const float scale = pixelsPerUnitAt(m.P, 0.5f * length);
                 return flatness ? glm::length(m.P - 0.5f * (a.P + b.P)) * scale : length * scale;
             };
-            // The rate a line of kGrid chords needs.
+            // The rate a line of kGrid chords needs. Its facets split every chord alike (the
+            // tessellation is uniform in the chart), so the longest chord -- or the one
+            // deviating most -- decides.
             const float edgeTarget = options.maxEdgePixels / std::sqrt(2.0f);  // diagonals too
-            auto rate = [&](float sumPixels, float maxPixels) {
+            auto rate = [&](float maxPixels) {
                 const float r = flatness ? kGrid * std::sqrt(maxPixels / options.flatnessPixels)
-                                         : sumPixels / edgeTarget;
+                                         : kGrid * maxPixels / edgeTarget;
                 return static_cast<int>(std::clamp(std::ceil(r), 1.0f, 1e6f));
             };
             auto line = [&](int i0, int j0, int di, int dj) {
-                float sum = 0.0f, most = 0.0f;
-                for (int k = 0; k < kGrid; ++k) {
-                    const float p = chord(i0 + 2 * k * di, j0 + 2 * k * dj, di, dj);
-                    sum += p;
-                    most = std::max(most, p);
-                }
-                return rate(sum, most);
+                float most = 0.0f;
+                for (int k = 0; k < kGrid; ++k)
+                    most = std::max(most, chord(i0 + 2 * k * di, j0 + 2 * k * dj, di, dj));
+                return rate(most);
             };
             sv.desired[0] = line(0, 0, 1, 0);
             sv.desired[1] = line(kFine, 0, 0, 1);
@@ -246,7 +261,7 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
                 for (int j = 0; j < kFine; j += 2)
                     for (int i = 0; i < kFine; i += 2)
                         most = std::max({most, chord(i, j, 1, 1), chord(i + 2, j, -1, 1)});
-                const int r = rate(0.0f, most);
+                const int r = rate(most);
                 sv.innerU = std::max(sv.innerU, r);
                 sv.innerV = std::max(sv.innerV, r);
             }
@@ -261,6 +276,16 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
                 const int mj = (int(kCorner[c][1]) + int(kCorner[n][1])) * kFine / 2;
                 sv.middle[c] = welder.weld(at(mi, mj).P);
             }
+        }
+        if (options.surveyOnly) {
+            // The estimate from the whole charts' rates, uncapped: no splitting needed.
+            out.patches = static_cast<int>(patches.size());
+            for (const ChartSurvey& sv : survey)
+                if (!sv.culled)
+                    out.estimatedFacets +=
+                        2.0 * std::max({sv.innerU, sv.desired[0], sv.desired[2]}) *
+                        std::max({sv.innerV, sv.desired[1], sv.desired[3]});
+            return out;
         }
         if (worst <= options.maxEdgeRate || depth >= options.maxSplitDepth ||
             patches.size() * 4 > static_cast<size_t>(options.maxPatches))
@@ -324,6 +349,7 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
         innerRates(sv, ru, rv);
         estimate += 2.0 * ru * rv;
     }
+    out.estimatedFacets = estimate;
     if (estimate > static_cast<double>(options.maxFacets)) {
         out.rateScale =
             static_cast<float>(std::sqrt(static_cast<double>(options.maxFacets) / estimate));

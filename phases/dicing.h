@@ -62,6 +62,9 @@ struct DicingOptions {
     size_t maxFacets =
         4'000'000;  // per object; beyond it every rate scales down alike (counted as capped)
     bool frustumCull = true;  // drop patches no view of the range can see
+    // Survey the whole charts only: DicedSurface has estimatedFacets (from their rates,
+    // uncapped) and the patch count, nothing else.
+    bool surveyOnly = false;
 };
 
 // The representative view in the object's own coordinates.
@@ -73,6 +76,14 @@ struct DicingView {
     float nearDistance = 0.01f;  // the near plane, object units
     glm::vec3 forward{0.0f, 0.0f, -1.0f};  // unit view direction
     float halfDiagonalFov = 0.7f;          // radians: the frustum's half angle across its diagonal
+    // The representative view's projection (object -> X, Y, W; x_px = X / W), and the near
+    // plane's depth W. With `projects`, EdgeLength measured at the representative eye takes
+    // the chords' projected lengths -- exact for that view, where the bound above also
+    // counts foreshortening and the worst off-axis stretch -- for chords in front of the
+    // near plane.
+    bool projects = false;
+    double screen[3][4] = {};
+    double nearW = 0.0;
 };
 
 struct DicedSurface {
@@ -87,6 +98,7 @@ struct DicedSurface {
         cappedCharts = 0;    // culled and capped count patches
     int frustumCulled = 0;   // patches outside every view of the range
     float rateScale = 1.0f;  // < 1 when the facet budget cut every rate
+    double estimatedFacets = 0.0;  // from the surveyed rates, before the budget
 };
 
 DicedSurface diceSurface(const Surface& surface, const DicingView& view, const RangeOptions& range,

@@ -33,14 +33,14 @@ namespace mpshade {
 
 struct DynamicOptions {
     RasterOptions raster;
-    // Feline capped at 2:1 (three taps), levels blended only within 1/8 level of their
-    // midpoint: measured the best speed for its error against 64-sample references
-    // (docs/multiphase.md).
-    ProbeOptions probe{ProbeFilter::Feline, 2.0f, 0.25f};
+    // Feline capped at 4:1 with one tap per unit of anisotropy, levels blended only within
+    // 1/8 level of their midpoint: measured the best speed for its error against 64-sample
+    // references (docs/multiphase.md).
+    ProbeOptions probe{ProbeFilter::Feline, 4.0f, 0.25f, 1.0f};
     ShadingRate shadingRate = ShadingRate::Sample;
-    // Multiplies each shading point's probe footprint: 1/sqrt(spp) pixel per sample, or half
-    // a pixel per pixel (measured the least error of each rate; docs/multiphase.md).
-    float footprintScale = 1.0f;
+    // Multiplies each shading point's probe footprint of 1/sqrt(spp) pixel per sample, or
+    // half a pixel per pixel: 3/4 measured the least error (docs/multiphase.md).
+    float footprintScale = 0.75f;
     int bandRows = 4;  // pixel rows per unit of shading work
 };
 

@@ -27,9 +27,7 @@ void WarpedVertices::resize(size_t n) {
     culled.resize(n);
 }
 
-FixedPointWarp::FixedPointWarp(const glm::mat4& objectToWorld, const CameraState& camera,
-                               const FixedPointFormat& format)
-    : format_(format) {
+void objectToScreen(const glm::mat4& objectToWorld, const CameraState& camera, double out[3][4]) {
     // World -> (X, Y, W): W = forward . (p - eye), X = x_px W, Y = y_px W.
     const double w2 = camera.width * 0.5, h2 = camera.height * 0.5;
     const double th = camera.tanHalfFovY, ta = camera.tanHalfFovY * camera.aspect;
@@ -49,8 +47,14 @@ FixedPointWarp::FixedPointWarp(const glm::mat4& objectToWorld, const CameraState
         for (int c = 0; c < 4; ++c) {
             double s = c == 3 ? rows[row][3] : 0.0;
             for (int k = 0; k < 3; ++k) s += rows[row][k] * o[c][k];
-            m_[row][c] = s;
+            out[row][c] = s;
         }
+}
+
+FixedPointWarp::FixedPointWarp(const glm::mat4& objectToWorld, const CameraState& camera,
+                               const FixedPointFormat& format)
+    : format_(format) {
+    objectToScreen(objectToWorld, camera, m_);
     // Coefficients of q, and the translation at the quantization origin.
     double l[3][3], t[3], maxL = 0.0, maxT = 0.0;
     for (int row = 0; row < 3; ++row) {

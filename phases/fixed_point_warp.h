@@ -51,6 +51,11 @@ struct HomogeneousVertex {
     double X = 0.0, Y = 0.0, W = 0.0;
 };
 
+// The object-to-screen transform of a camera in homogeneous form: rows giving X, Y and W
+// (x_px = X / W, y_px = Y / W, W the view depth in world units) from object coordinates
+// (x, y, z, 1).
+void objectToScreen(const glm::mat4& objectToWorld, const CameraState& camera, double rows[3][4]);
+
 class FixedPointWarp {
   public:
     static constexpr int kSubpixelBits = 8;

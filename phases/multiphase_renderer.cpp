@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
 #include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 namespace mpshade {
 namespace {
@@ -34,23 +36,6 @@ bool inView(const Surface& surface, const ObjectState& state, const CameraState&
     return true;
 }
 
-// The surface's area (object units^2), from |dPdu x dPdv| on an 8 x 8 grid per chart.
-double surfaceArea(const Surface& surface) {
-    constexpr int kGrid = 8;
-    std::vector<ChartPoint> points;
-    const int charts = chartCount(surface);
-    for (int chart = 0; chart < charts; ++chart)
-        for (int j = 0; j < kGrid; ++j)
-            for (int i = 0; i < kGrid; ++i)
-                points.push_back({chart, (i + 0.5f) / kGrid, (j + 0.5f) / kGrid});
-    std::vector<SurfaceSample> samples(points.size());
-    evaluateBatch(surface, points, samples);
-    double area = 0.0;
-    for (const SurfaceSample& s : samples)
-        area += glm::length(glm::cross(s.dPdu, s.dPdv)) / (kGrid * kGrid);
-    return area;
-}
-
 }  // namespace
 
 MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptions& options)
@@ -63,6 +48,8 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
                   if (const char* e = std::getenv("MPX_SS")) o.shaderMap.supersampleLimit = std::stoi(e);
                   if (const char* e = std::getenv("MPX_TILE")) o.shaderMap.tileSize = std::stoi(e);
                   if (std::getenv("MPX_HALF")) o.shaderMap.halfPrecision = true;
+                  if (const char* e = std::getenv("MPX_FLAT")) o.separateDicing.flatnessPixels = std::stof(e);
+                  if (const char* e = std::getenv("MPX_EDGE")) o.combinedDicing.maxEdgePixels = std::stof(e);
                   return o;
               }()),
       dynamic_(scene) {
@@ -70,8 +57,7 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
     representations_.resize(n);
     kinds_.assign(n, Representation::Auto);
     longestEdge_.assign(n, 0.0f);
-    framesSeen_.assign(n, scene.frameCount());
-    surfaceArea_.assign(n, -1.0);
+    framesSeen_.assign(n, {});
     reports_.resize(n);
     for (size_t i = 0; i < n; ++i) reports_[i].name = scene.objects[i].name;
 }
@@ -87,53 +73,104 @@ const FactoredShader& MultiphaseRenderer::factored(size_t object) const {
 }
 
 void MultiphaseRenderer::plan(int first, int last, const RenderOptions& options) {
-    std::fill(framesSeen_.begin(), framesSeen_.end(), 0);
+    planFirst_ = first;
+    layoutWidth_ = options.width > 0 ? options.width : scene_.settings.width;
+    layoutHeight_ = options.height > 0 ? options.height : scene_.settings.height;
+    for (std::vector<int>& seen : framesSeen_) seen.assign(static_cast<size_t>(std::max(0, last - first)), 0);
+    const int w = options.width > 0 ? options.width : scene_.settings.width;
+    const int h = options.height > 0 ? options.height : scene_.settings.height;
     for (int f = first; f < last; ++f) {
         const float t = scene_.frameTime(f);
-        const int w = options.width > 0 ? options.width : scene_.settings.width;
-        const int h = options.height > 0 ? options.height : scene_.settings.height;
         const CameraState camera = cameraAt(scene_, t, w, h);
-        for (size_t i = 0; i < scene_.objects.size(); ++i)
-            if (inView(*scene_.objects[i].surface, objectAt(scene_.objects[i], t, camera), camera))
-                ++framesSeen_[i];
+        for (size_t i = 0; i < scene_.objects.size(); ++i) {
+            const bool seen =
+                inView(*scene_.objects[i].surface, objectAt(scene_.objects[i], t, camera), camera);
+            framesSeen_[i][static_cast<size_t>(f - first)] =
+                (f > first ? framesSeen_[i][static_cast<size_t>(f - first - 1)] : 0) + (seen ? 1 : 0);
+        }
     }
 }
 
-Representation MultiphaseRenderer::chooseKind(size_t i, const ObjectState& state,
+Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectState& state,
                                               const CameraState& camera, int spp) {
     const SceneObject& obj = scene_.objects[i];
     Representation asked = options_.representation.value_or(obj.representation);
+    if (const char* e = std::getenv("MPX_REP")) asked = static_cast<Representation>(std::stoi(e));
     if (asked != Representation::Auto) {
         reports_[i].reason = options_.representation ? "forced by the renderer's options"
                                                      : "the scene asks for it";
         return asked;
     }
-    if (surfaceArea_[i] < 0.0) surfaceArea_[i] = surfaceArea(*obj.surface);
     const ObjectShading& shading = static_.shading(i);
+    const ObjectRepresentation* previous = representations_[i].get();
     ObjectCostInputs in;
-    const float ppu = 0.5f * static_cast<float>(camera.height) / camera.tanHalfFovY;
+    in.combinedFacets = static_.combinedFacets(i, state, camera);
+    // The screen area: the object's bounding sphere, projected, within the screen.
     const Bounds3 b = surfaceBounds(*obj.surface);
-    const float distance = std::max(glm::length(state.eye - b.center()) - 0.5f * b.diagonal(),
-                                    camera.zNear / state.scale);
-    const double scale = static_cast<double>(ppu) / std::max(distance, 0.25f * glm::length(state.eye - b.center()));
-    in.surfacePixels = surfaceArea_[i] * scale * scale;
-    in.coveredPixels = std::min(static_cast<double>(camera.width) * camera.height,
-                                in.surfacePixels * (shading.closed ? 0.25 : 0.5));
-    in.closed = shading.closed;
+    const float ppu = 0.5f * static_cast<float>(camera.height) / camera.tanHalfFovY;
+    const float distance = std::max(glm::length(state.eye - b.center()), 1e-20f);
+    const float radius = 0.5f * b.diagonal();
+    const double projected =
+        distance > radius ? 3.14159265 * std::pow(ppu * radius / distance, 2.0) : 1e30;
+    in.coveredPixels = std::min(static_cast<double>(camera.width) * camera.height, projected);
     in.charts = chartCount(*obj.surface);
-    in.frames = std::max(1, framesSeen_[i]);
+    in.frames = std::max(1, framesSeenFrom(i, frame));
+    in.combinedRuns = predictedCombinedRuns(i, frame, state);
+    in.screenPixels = static_cast<double>(camera.width) * camera.height;
     in.staticCostUnits = shading.factored.staticCost;
-    const int k = std::max(1, options_.staticPhase.shaderMap.supersampleLimit);
-    in.supersamples = k * k;
     in.samplesPerPixel = spp;
     in.shadingRate = options_.dynamic.shadingRate;
     const int tile = options_.staticPhase.shaderMap.tileSize +
                      2 * options_.staticPhase.shaderMap.border;
     in.pinnedBytes = static_cast<double>(in.charts) * 9.0 * tile * tile *
                      shading.factored.staticPart.channelOutputs.size() * sizeof(float);
+    in.haveMap = previous && previous->map;
     const RepresentationChoice choice = chooseRepresentation(in, options_.costModel);
     reports_[i].reason = choice.reason;
     return choice.kind;
+}
+
+int MultiphaseRenderer::predictedCombinedRuns(size_t object, int frame,
+                                              const ObjectState& state) const {
+    // Facets diced for the view at P/2 are diced again when the eye comes closer (their
+    // projected edges grow) or leaves the range: count those events along the planned
+    // frames that see the object.
+    const std::vector<int>& seen = framesSeen_[object];
+    if (seen.empty()) return 1;
+    const SceneObject& obj = scene_.objects[object];
+    const Bounds3 b = surfaceBounds(*obj.surface);
+    const glm::vec3 center = b.center();
+    const float radius = 0.5f * b.diagonal();
+    auto distance = [&](const glm::vec3& eye) {
+        return std::max(glm::length(eye - center) - radius, 1e-3f * radius);
+    };
+    float diced = distance(state.eye);
+    glm::vec3 direction = glm::normalize(state.eye - center);
+    int runs = 1;
+    const int last = planFirst_ + static_cast<int>(seen.size());
+    for (int f = std::max(frame + 1, planFirst_); f < last; ++f) {
+        const size_t k = static_cast<size_t>(f - planFirst_);
+        if (seen[k] == (k > 0 ? seen[k - 1] : 0)) continue;  // not seen in frame f
+        const float t = scene_.frameTime(f);
+        const CameraState camera = cameraAt(scene_, t, layoutWidth_, layoutHeight_);
+        const glm::vec3 eye = objectAt(obj, t, camera).eye;
+        const float d = distance(eye);
+        const glm::vec3 dir = glm::normalize(eye - center);
+        if (d < 0.95f * diced || d > obj.range.distanceFactor * diced ||
+            glm::dot(dir, direction) < std::cos(glm::radians(obj.range.angle))) {
+            ++runs;
+            diced = d;
+            direction = dir;
+        }
+    }
+    return runs;
+}
+
+int MultiphaseRenderer::framesSeenFrom(size_t object, int frame) const {
+    const std::vector<int>& seen = framesSeen_[object];
+    if (seen.empty()) return scene_.frameCount() - frame;  // no plan: assume every frame
+    const int first = std::clamp(frame - planFirst_, 0, static_cast<int>(seen.size()) - 1);
+    return seen.back() - (first > 0 ? seen[static_cast<size_t>(first) - 1] : 0);
 }
 
 void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameStats& stats,
@@ -150,6 +187,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     DynamicOptions dynamicOptions = options_.dynamic;
     if (const char* e = std::getenv("MPX_FOOT")) dynamicOptions.footprintScale = std::stof(e);
     if (const char* e = std::getenv("MPX_ANISO")) dynamicOptions.probe.maxAnisotropy = std::stof(e);
+    if (const char* e = std::getenv("MPX_TPR")) dynamicOptions.probe.tapsPerRatio = std::stof(e);
     if (const char* e = std::getenv("MPX_BLEND")) dynamicOptions.probe.levelBlend = std::stof(e);
     if (const char* e = std::getenv("MPX_FILTER")) dynamicOptions.probe.filter = static_cast<ProbeFilter>(std::stoi(e));
     if (options_.shadingRate)
@@ -176,9 +214,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
             stale.push_back(i);
     }
     const auto staticStart = Clock::now();
-    for (size_t i : stale)
-        if (kinds_[i] == Representation::Auto)
-            kinds_[i] = chooseKind(i, frame_.objects[i], camera, frame_.spp);
+    for (size_t i : stale) kinds_[i] = chooseKind(i, frame, frame_.objects[i], camera, frame_.spp);
     std::vector<StaticCosts> costs(stale.size());
     tbb::parallel_for(size_t{0}, stale.size(), [&](size_t k) {
         const size_t i = stale[k];
@@ -187,6 +223,11 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
                           representations_[i].get(), costs[k]);
         longestEdge_[i] = 0.0f;
     });
+    if (std::getenv("MPX_LOG"))
+        for (size_t k = 0; k < stale.size(); ++k)
+            std::fprintf(stderr, "frame %d static %s kind %d %.3f s facets %zu\n", frame,
+                         scene_.objects[stale[k]].name.c_str(), static_cast<int>(kinds_[stale[k]]),
+                         costs[k].seconds, representations_[stale[k]]->mesh.facetCount());
     for (size_t k = 0; k < stale.size(); ++k) {
         ObjectReport& r = reports_[stale[k]];
         r.kind = kinds_[stale[k]];

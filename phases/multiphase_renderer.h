@@ -76,8 +76,10 @@ class MultiphaseRenderer {
   private:
     void render(int frame, const RenderOptions& options, FrameStats& stats,
                 const ProgressFn& progress);
-    Representation chooseKind(size_t object, const ObjectState& state, const CameraState& camera,
-                              int spp);
+    Representation chooseKind(size_t object, int frame, const ObjectState& state,
+                              const CameraState& camera, int spp);
+    int framesSeenFrom(size_t object, int frame) const;
+    int predictedCombinedRuns(size_t object, int frame, const ObjectState& state) const;
 
     const Scene& scene_;
     MultiphaseOptions options_;
@@ -86,10 +88,13 @@ class MultiphaseRenderer {
     DynamicPhase dynamic_;
     std::shared_ptr<const SampleLayout> layout_;
     std::vector<std::unique_ptr<ObjectRepresentation>> representations_;
-    std::vector<Representation> kinds_;     // chosen at the first static run
-    std::vector<float> longestEdge_;        // last frame's measure (combined)
-    std::vector<int> framesSeen_;           // over the planned frames
-    std::vector<double> surfaceArea_;       // object units^2, for auto
+    std::vector<Representation> kinds_;  // chosen at each static run
+    std::vector<float> longestEdge_;     // last frame's measure (combined)
+    // Per object, over the planned frames from planFirst_: how many of the frames up to
+    // each see it (a running count; empty without a plan).
+    std::vector<std::vector<int>> framesSeen_;
+    int planFirst_ = 0;
+    int layoutWidth_ = 0, layoutHeight_ = 0;  // the planned image size
     std::vector<ObjectReport> reports_;
     FrameState frame_;
 };

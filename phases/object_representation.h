@@ -36,7 +36,9 @@ struct ObjectRepresentation {
     RangeOptions range;
     bool frustumCulled = false;  // patches outside the range's views were dropped
     int imageHeight = 0;         // pixels: the image the facets were diced for
-    // Combined: the projected edge length (pixels) beyond which the facets are diced again.
+    // Combined: the projected edge length (pixels) beyond which the facets are diced again:
+    // P/2, or a little over the longest edge they had at the representative view if that
+    // was more (the dicing survey measures between grid points).
     float maxEdgePixels = 0.0f;
     // The dynamic shader (S_d) and what it reads of the facets.
     std::shared_ptr<const ShaderKernel> dynamicKernel;

@@ -12,39 +12,44 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     const double points = in.coveredPixels * (in.shadingRate == ShadingRate::Pixel
                                                   ? 1.0
                                                   : static_cast<double>(in.samplesPerPixel));
-    // Combined: sub-pixel facets over the surface (its front only, for closed surfaces),
-    // a vertex per two facets.
-    const double facets =
-        model.facetsPerSquarePixel * in.surfacePixels * (in.closed ? 0.5 : 1.0);
-    const double facetsStatic = 0.5 * facets * staticPointNs;
-    const double facetsFrame = facets * model.facetNs + points * model.vertexPointNs;
-    // Separate: the texels frames ask for and the always-resident levels, each evaluated
-    // with supersamples; a few facets per chart.
-    const double runs = (in.coveredPixels * model.texelsPerPixel +
-                         in.charts * model.pinnedTexelsPerChart) *
-                        std::max(1, in.supersamples);
+    // Combined: a vertex per two facets, shaded again at every run.
+    const double facetsStatic =
+        0.5 * in.combinedFacets * staticPointNs * std::max(1, in.combinedRuns);
+    const double facetsFrame = in.combinedFacets * model.facetNs + points * model.vertexPointNs;
+    // Separate: the texels frames ask for and the always-resident levels, unless built.
+    const double runs =
+        in.haveMap ? 0.0
+                   : in.coveredPixels * model.texelsPerCoveredPixel +
+                         in.charts * model.pinnedTexelsPerChart;
     const double mapStatic = runs * staticPointNs;
-    const double mapFrame = 8.0 * in.charts * model.facetNs + points * model.mapPointNs;
+    const double mapFrame = points * model.mapPointNs;
 
     RepresentationChoice c;
     c.facetsSeconds = (facetsStatic + frames * facetsFrame) * 1e-9;
     c.mapSeconds = (mapStatic + frames * mapFrame) * 1e-9;
-    char text[256];
-    if (in.pinnedBytes > model.mapBytesPerChartLimit) {
+    char text[320];
+    if (in.pinnedBytes > model.maxPinnedBytes && !in.haveMap) {
         c.kind = Representation::Facets;
         std::snprintf(text, sizeof text,
                       "auto: facets; a shader map's always-resident levels of %d charts would "
                       "take %.0f MB",
                       in.charts, in.pinnedBytes / 1048576.0);
+    } else if (in.combinedFacets > model.maxFacetsPerScreenPixel * in.screenPixels) {
+        c.kind = Representation::ShaderMap;
+        std::snprintf(text, sizeof text,
+                      "auto: shadermap; facets would number %.3g, over %.0f per screen pixel",
+                      in.combinedFacets, model.maxFacetsPerScreenPixel);
     } else {
         c.kind = c.mapSeconds <= c.facetsSeconds ? Representation::ShaderMap
                                                  : Representation::Facets;
         std::snprintf(text, sizeof text,
                       "auto: %s; estimated over %d frames: shader map %.3f s (%.3f static + "
-                      "%.2f ms a frame), facets %.3f s (%.3f static + %.2f ms a frame)",
+                      "%.2f ms a frame), facets %.3f s (%.3f static in %d runs + %.2f ms a "
+                      "frame, %.3g facets)",
                       c.kind == Representation::ShaderMap ? "shadermap" : "facets",
                       static_cast<int>(frames), c.mapSeconds, mapStatic * 1e-9, mapFrame * 1e-6,
-                      c.facetsSeconds, facetsStatic * 1e-9, facetsFrame * 1e-6);
+                      c.facetsSeconds, facetsStatic * 1e-9, std::max(1, in.combinedRuns),
+                      facetsFrame * 1e-6, in.combinedFacets);
     }
     c.reason = text;
     return c;

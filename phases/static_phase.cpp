@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
 
+#include "phases/fixed_point_warp.h"
 #include "scene/variability.h"
 #include "shading/builtins.h"
 #include "shading/shading_batch.h"
@@ -118,15 +119,7 @@ StaticPhase::StaticPhase(const Scene& scene, const SceneResources& resources,
 
 StaticPhase::~StaticPhase() = default;
 
-std::unique_ptr<ObjectRepresentation> StaticPhase::build(
-    size_t index, Representation kind, const ObjectState& state, const CameraState& camera,
-    const ShadingUniforms& uniforms, const ObjectRepresentation* previous,
-    StaticCosts& costs) const {
-    const auto start = Clock::now();
-    const ObjectShading& obj = *objects_[index];
-    const SceneObject& sceneObject = scene_.objects[index];
-    const Surface& surface = *sceneObject.surface;
-    const bool useMap = kind == Representation::ShaderMap;
+DicingView StaticPhase::dicingView(const ObjectState& state, const CameraState& camera) {
     DicingView view;
     view.eye = state.eye;
     view.pixelsPerUnit = 0.5f * static_cast<float>(camera.height) / camera.tanHalfFovY;
@@ -137,6 +130,31 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(
     view.nearDistance = camera.zNear / state.scale;
     view.forward = glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
     view.halfDiagonalFov = std::atan(std::sqrt(tx * tx + ty * ty));
+    view.projects = true;
+    objectToScreen(state.objectToWorld, camera, view.screen);
+    view.nearW = camera.zNear;
+    return view;
+}
+
+double StaticPhase::combinedFacets(size_t object, const ObjectState& state,
+                                   const CameraState& camera) const {
+    DicingOptions survey = options_.combinedDicing;
+    survey.surveyOnly = true;
+    const SceneObject& sceneObject = scene_.objects[object];
+    return diceSurface(*sceneObject.surface, dicingView(state, camera), sceneObject.range, survey)
+        .estimatedFacets;
+}
+
+std::unique_ptr<ObjectRepresentation> StaticPhase::build(
+    size_t index, Representation kind, const ObjectState& state, const CameraState& camera,
+    const ShadingUniforms& uniforms, const ObjectRepresentation* previous,
+    StaticCosts& costs) const {
+    const auto start = Clock::now();
+    const ObjectShading& obj = *objects_[index];
+    const SceneObject& sceneObject = scene_.objects[index];
+    const Surface& surface = *sceneObject.surface;
+    const bool useMap = kind == Representation::ShaderMap;
+    const DicingView view = dicingView(state, camera);
     const DicingOptions& dicing = useMap ? options_.separateDicing : options_.combinedDicing;
     const DicedSurface diced = diceSurface(surface, view, sceneObject.range, dicing);
 
@@ -148,7 +166,7 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(
     rep->range = sceneObject.range;
     rep->frustumCulled = dicing.frustumCull;
     rep->imageHeight = camera.height;
-    rep->maxEdgePixels = useMap ? 0.0f : dicing.maxEdgePixels;
+    rep->maxEdgePixels = 0.0f;
     rep->dynamicKernel = obj.dynamicKernel;
     rep->geometryRows = obj.geometryRows;
     rep->opaque = obj.opaque;
@@ -172,6 +190,27 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(
     mesh.clusters = diced.clusters;
     const size_t channels = obj.factored.staticPart.channelOutputs.size();
     mesh.channels = useMap ? 0 : static_cast<int>(channels);
+    if (!useMap) {
+        // The longest projected edge the facets have at the representative view, measured
+        // as the dynamic phase measures it: the survey between grid points can miss a
+        // little, so the facets are diced again when their edges outgrow P/2 or, if dicing
+        // overshot it, what they started at.
+        const FixedPointWarp warp(state.objectToWorld, camera, mesh.format);
+        WarpedVertices warped;
+        warp.warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.positionCount(), warped);
+        int64_t longest = 0;
+        for (size_t f = 0; f < mesh.facetCount(); ++f) {
+            const uint32_t* p = &mesh.positionIndex[3 * f];
+            if (warped.culled[p[0]] | warped.culled[p[1]] | warped.culled[p[2]]) continue;
+            for (int i = 0; i < 3; ++i) {
+                const int64_t dx = warped.x[p[(i + 1) % 3]] - warped.x[p[i]];
+                const int64_t dy = warped.y[p[(i + 1) % 3]] - warped.y[p[i]];
+                longest = std::max(longest, dx * dx + dy * dy);
+            }
+        }
+        const float atDicing = static_cast<float>(std::sqrt(static_cast<double>(longest))) / 256.0f;
+        rep->maxEdgePixels = std::max(dicing.maxEdgePixels, 1.05f * atDicing);
+    }
 
     // Geometry the dynamic part reads, and (combined) the n-tuple from the static part.
     const size_t n = diced.attributePoints.size();

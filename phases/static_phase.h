@@ -68,6 +68,11 @@ class StaticPhase {
                                                 const ObjectRepresentation* previous,
                                                 StaticCosts& costs) const;
 
+    // The facets the combined representation of object `object` would have at this view
+    // (the dicing survey's estimate, before any budget): for choosing a representation.
+    double combinedFacets(size_t object, const ObjectState& state,
+                          const CameraState& camera) const;
+
     // Fills the requested tiles lacking from the representations' maps: each map's tiles
     // in one batch (finest level first), maps in parallel.
     void fill(std::span<const TileRequest> requests,
@@ -75,6 +80,8 @@ class StaticPhase {
               StaticCosts& costs) const;
 
   private:
+    static DicingView dicingView(const ObjectState& state, const CameraState& camera);
+
     const Scene& scene_;
     const SceneResources& resources_;
     StaticPhaseOptions options_;

@@ -455,7 +455,10 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
         // Feline.
         const float minor = std::max(f.minor, 1e-30f);
         const float ratio = std::min(f.major / minor, options.maxAnisotropy);
-        const int n = std::clamp(static_cast<int>(2.0f * ratio - 0.5f), 1, kMaxTaps);
+        const int n = options.tapsPerRatio >= 2.0f
+                          ? std::clamp(static_cast<int>(2.0f * ratio - 0.5f), 1, kMaxTaps)
+                          : std::clamp(static_cast<int>(options.tapsPerRatio * ratio + 0.5f), 1,
+                                       kMaxTaps);
         const float lod = fastLog2(minor);
         if (n == 1) {
             // Trilinear, its blend narrowed like the taps' below.

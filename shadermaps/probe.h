@@ -42,6 +42,9 @@ struct ProbeOptions {
     // Feline: the fraction of each level's span over which two levels are blended (1:
     // trilinear everywhere; less: one level away from the transitions, half the taps).
     float levelBlend = 1.0f;
+    // Feline: taps per unit of anisotropy; 2 is McCormack et al.'s 2 ratio - 1 taps, one
+    // minor axis apart; fewer spread the same line more thinly.
+    float tapsPerRatio = 2.0f;
 };
 
 struct ProbeQuery {

@@ -224,7 +224,9 @@ TEST(FacetRasterizer, OpaqueDepthTestCoversTheSameSamples) {
     ASSERT_EQ(opaque.layers, 1);
     for (size_t s = 0; s < g.layout->count(); ++s) {
         ASSERT_EQ(opaque.count[s], layered.count[s]) << s;
-        if (opaque.count[s]) ASSERT_EQ(opaque.facet[s], layered.facet[s * layered.layers]);
+        if (opaque.count[s]) {
+            ASSERT_EQ(opaque.facet[s], layered.facet[s * layered.layers]);
+        }
     }
     // Surfaces beyond the far plane are not seen: 1 / depth here is 0.2 .. 0.211.
     VisibilityBuffer far;
