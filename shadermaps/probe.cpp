@@ -421,16 +421,34 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
     const int channels = C > 0 ? C : std::min(map.channels(), kMaxChannels);
     const Prober<C> p(map, residency, channels, map.levels() - 1);
     const float res0 = static_cast<float>(map.resolution(0));
+    // The last Feline setup, for queries with the same footprint.
+    struct FelineSetup {
+        int chart = -1;
+        float dudx = 0.0f, dvdx = 0.0f, dudy = 0.0f, dvdy = 0.0f;
+        int n = 1, l0 = 0, l1 = 0;
+        float blend = 0.0f, offsetU = 0.0f, offsetV = 0.0f, du = 0.0f, dv = 0.0f;
+        float weights[kMaxTaps] = {};
+    } setup;
     auto one = [&](ProbeQuery q, float* o) {
         if (!std::isfinite(q.u)) q.u = 0.0f;
         if (!std::isfinite(q.v)) q.v = 0.0f;
-        const Footprint f = footprintOf(
+        // Footprints within 1/64 of each other (the level moves by under 0.023, the line
+        // by under 1/64 of its length) share a setup.
+        const float tolerance =
+            (1.0f / 64.0f) * std::max({std::fabs(setup.dudx), std::fabs(setup.dvdx),
+                                       std::fabs(setup.dudy), std::fabs(setup.dvdy)});
+        const bool sameFeline =
+            options.filter == ProbeFilter::Feline && q.chart == setup.chart &&
+            std::fabs(q.dudx - setup.dudx) <= tolerance &&
+            std::fabs(q.dvdx - setup.dvdx) <= tolerance &&
+            std::fabs(q.dudy - setup.dudy) <= tolerance && std::fabs(q.dvdy - setup.dvdy) <= tolerance;
+        const Footprint f = sameFeline ? Footprint{} : footprintOf(
             q, res0, options.filter == ProbeFilter::Trilinear ? 1e30f : options.maxAnisotropy);
         if (options.filter == ProbeFilter::Trilinear) {
             p.trilinear(q.chart, std::log2(std::max(f.major, 1e-30f)), q.u, q.v, o);
             return;
         }
-        if (!(f.major < 1e20f)) {
+        if (!sameFeline && !(f.major < 1e20f)) {
             p.bilinear(q.chart, p.maxLevel, q.u, q.v, o);
             return;
         }
@@ -452,48 +470,48 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
             }
             return;
         }
-        // Feline.
-        const float minor = std::max(f.minor, 1e-30f);
-        const float ratio = std::min(f.major / minor, options.maxAnisotropy);
-        const int n = options.tapsPerRatio >= 2.0f
+        // Feline. Its setup depends on the footprint only: neighbouring queries (the
+        // samples of a pixel on one facet) mostly share it, so it is kept from the last.
+        if (!sameFeline) {
+            setup.chart = q.chart;
+            setup.dudx = q.dudx, setup.dvdx = q.dvdx, setup.dudy = q.dudy, setup.dvdy = q.dvdy;
+            const float minor = std::max(f.minor, 1e-30f);
+            const float ratio = std::min(f.major / minor, options.maxAnisotropy);
+            setup.n = options.tapsPerRatio >= 2.0f
                           ? std::clamp(static_cast<int>(2.0f * ratio - 0.5f), 1, kMaxTaps)
                           : std::clamp(static_cast<int>(options.tapsPerRatio * ratio + 0.5f), 1,
                                        kMaxTaps);
-        const float lod = fastLog2(minor);
-        if (n == 1) {
-            // Trilinear, its blend narrowed like the taps' below.
-            const float l = std::floor(lod);
-            p.trilinear(q.chart, l + narrowBlend(lod - l, options.levelBlend), q.u, q.v, o);
-            return;
-        }
-        const float half = f.major - minor;
-        const float dirU = f.ax / (f.major * res0),
-                    dirV = f.ay / (f.major * res0);  // chart units per texel
-        // Every probe uses the same two levels; probe i, d = -half + i step texels from the
-        // centre, weighs exp(-2 (d / major)^2).
-        const float clampedLod = std::clamp(lod, 0.0f, static_cast<float>(p.maxLevel));
-        const int l0 = static_cast<int>(clampedLod);
-        const int l1 = std::min(l0 + 1, p.maxLevel);
-        const float blend =
-            narrowBlend(l1 > l0 ? clampedLod - static_cast<float>(l0) : 0.0f, options.levelBlend);
-        const float step = 2.0f * half / static_cast<float>(n - 1);
-        const float gk = -2.0f / (f.major * f.major);
-        float weights[kMaxTaps];
-        float weight = 0.0f;
-        for (int i = 0; i < n; ++i) {
-            const float d = -half + static_cast<float>(i) * step;
-            weights[i] = fastExp(gk * d * d);
-            weight += weights[i];
+            const float lod = std::clamp(fastLog2(minor), 0.0f, static_cast<float>(p.maxLevel));
+            setup.l0 = static_cast<int>(lod);
+            setup.l1 = std::min(setup.l0 + 1, p.maxLevel);
+            setup.blend = setup.l1 > setup.l0
+                              ? narrowBlend(lod - static_cast<float>(setup.l0), options.levelBlend)
+                              : 0.0f;
+            // Probe i, d = -half + i step texels from the centre, weighs exp(-2 (d / major)^2).
+            const int n = setup.n;
+            const float half = n > 1 ? f.major - minor : 0.0f;
+            const float step = n > 1 ? 2.0f * half / static_cast<float>(n - 1) : 0.0f;
+            const float dirU = f.ax / (f.major * res0), dirV = f.ay / (f.major * res0);
+            setup.offsetU = -half * dirU, setup.offsetV = -half * dirV;
+            setup.du = step * dirU, setup.dv = step * dirV;
+            const float gk = -2.0f / (f.major * f.major);
+            float total = 0.0f;
+            for (int i = 0; i < n; ++i) {
+                const float d = -half + static_cast<float>(i) * step;
+                setup.weights[i] = n > 1 ? fastExp(gk * d * d) : 1.0f;
+                total += setup.weights[i];
+            }
+            for (int i = 0; i < n; ++i) setup.weights[i] /= total;
         }
         float sum[Prober<C>::kArr] = {};
-        const float u0 = q.u - half * dirU, v0 = q.v - half * dirV;
-        const float du = step * dirU, dv = step * dirV;
-        if (blend < 1.0f)
-            p.lineAccumulate(q.chart, l0, u0, v0, du, dv, n, weights, 1.0f - blend, sum);
-        if (blend > 0.0f)
-            p.lineAccumulate(q.chart, l1, u0, v0, du, dv, n, weights, blend, sum);
-        const float inv = 1.0f / weight;
-        for (int c = 0; c < channels; ++c) o[c] = sum[c] * inv;
+        const float u0 = q.u + setup.offsetU, v0 = q.v + setup.offsetV;
+        if (setup.blend < 1.0f)
+            p.lineAccumulate(q.chart, setup.l0, u0, v0, setup.du, setup.dv, setup.n,
+                             setup.weights, 1.0f - setup.blend, sum);
+        if (setup.blend > 0.0f)
+            p.lineAccumulate(q.chart, setup.l1, u0, v0, setup.du, setup.dv, setup.n,
+                             setup.weights, setup.blend, sum);
+        for (int c = 0; c < channels; ++c) o[c] = sum[c];
     };
     uint8_t* queryMissed = residency ? residency->queryMissed : nullptr;
     for (size_t k = 0; k < queries.size(); ++k) {
@@ -517,6 +535,12 @@ void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
             return probeAll<3>(map, options, queries, out, residency);
         case 4:
             return probeAll<4>(map, options, queries, out, residency);
+        case 5:
+            return probeAll<5>(map, options, queries, out, residency);
+        case 6:
+            return probeAll<6>(map, options, queries, out, residency);
+        case 7:
+            return probeAll<7>(map, options, queries, out, residency);
         case 8:
             return probeAll<8>(map, options, queries, out, residency);
         default:

@@ -63,21 +63,96 @@ glm::vec3 shadeLightOne(Op op, const LightSample& light, const glm::vec3& P, con
     return Cl * scalar::safePow(std::fmax(0.0f, glm::dot(R, L)), param);
 }
 
+namespace {
+
+// max(0, x) that is 0 for NaN, as std::fmax(0, x) is, without a library call.
+inline float positive(float x) {
+    return x > 0.0f ? x : 0.0f;
+}
+
+// One light over m lanes, with the light's kind and the operation fixed, so the lane loop
+// has no branches on them (the formulas are shadeLightOne's).
+template <Op kOp, bool kPoint>
+void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
+    const float* __restrict px = args[0];
+    const float* __restrict py = args[1];
+    const float* __restrict pz = args[2];
+    const float* __restrict nx = args[3];
+    const float* __restrict ny = args[4];
+    const float* __restrict nz = args[5];
+    const float* __restrict vx0 = kOp == Op::Diffuse ? nullptr : args[6];
+    const float* __restrict vy0 = kOp == Op::Diffuse ? nullptr : args[7];
+    const float* __restrict vz0 = kOp == Op::Diffuse ? nullptr : args[8];
+    const float* __restrict pr = kOp == Op::Diffuse ? nullptr : args[9];
+    float* __restrict outR = rgb[0];
+    float* __restrict outG = rgb[1];
+    float* __restrict outB = rgb[2];
+    const float lpx = light.position.x, lpy = light.position.y, lpz = light.position.z;
+    const float tlx = light.toLight.x, tly = light.toLight.y, tlz = light.toLight.z;
+    const float ccr = light.color.x, ccg = light.color.y, ccb = light.color.z;
+    // Branch-free (selects, and divisions by safe denominators), so the loop vectorizes.
+    for (int l = 0; l < m; ++l) {
+        float Lx, Ly, Lz, cr, cg, cb;
+        if constexpr (kPoint) {
+            const float dx = lpx - px[l], dy = lpy - py[l], dz = lpz - pz[l];
+            const float d2 = dx * dx + dy * dy + dz * dz;
+            const bool ok = d2 > 0.0f;
+            const float safe = ok ? d2 : 1.0f;
+            const float root = 1.0f / std::sqrt(safe), recip = 1.0f / safe;
+            const float inv = ok ? root : 0.0f;
+            const float fall = ok ? recip : 0.0f;
+            Lx = dx * inv, Ly = dy * inv, Lz = dz * inv;
+            cr = ccr * fall, cg = ccg * fall, cb = ccb * fall;
+        } else {
+            Lx = tlx, Ly = tly, Lz = tlz;
+            cr = ccr, cg = ccg, cb = ccb;
+        }
+        const float ndl = positive(nx[l] * Lx + ny[l] * Ly + nz[l] * Lz);
+        float f;
+        if constexpr (kOp == Op::Diffuse) {
+            f = ndl;
+        } else if constexpr (kOp == Op::Specular) {
+            const float hx = Lx + vx0[l], hy = Ly + vy0[l], hz = Lz + vz0[l];
+            const float hl = std::sqrt(hx * hx + hy * hy + hz * hz);
+            const bool ok = hl > 0.0f && ndl > 0.0f;
+            const float ndh = positive((nx[l] * hx + ny[l] * hy + nz[l] * hz) / (ok ? hl : 1.0f));
+            const float param = pr[l];
+            const float r = std::min(param > 0.01f ? param : 0.01f, 1.0f);
+            const float a2 = r * r * r * r;
+            const float denom = ndh * ndh * (a2 - 1.0f) + 1.0f;
+            const float D = a2 / (kPi * denom * denom);
+            f = ok ? D * ndl * 0.25f : 0.0f;
+        } else {
+            const float vx = vx0[l], vy = vy0[l], vz = vz0[l];
+            const float nv2 = 2.0f * (nx[l] * vx + ny[l] * vy + nz[l] * vz);
+            const float rx = -vx + nv2 * nx[l], ry = -vy + nv2 * ny[l], rz = -vz + nv2 * nz[l];
+            f = scalar::safePow(positive(rx * Lx + ry * Ly + rz * Lz), pr[l]);
+        }
+        outR[l] = cr * f;
+        outG[l] = cg * f;
+        outB[l] = cb * f;
+    }
+}
+
+template <Op kOp>
+void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
+    if (light.kind == LightKind::Point)
+        shadeLanes<kOp, true>(light, args, rgb, m);
+    else
+        shadeLanes<kOp, false>(light, args, rgb, m);
+}
+
+}  // namespace
+
 void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb,
                 int m) {
-    for (int l = 0; l < m; ++l) {
-        const glm::vec3 P(args[0][l], args[1][l], args[2][l]);
-        const glm::vec3 N(args[3][l], args[4][l], args[5][l]);
-        glm::vec3 V(0.0f);
-        float param = 0.0f;
-        if (op != Op::Diffuse) {
-            V = glm::vec3(args[6][l], args[7][l], args[8][l]);
-            param = args[9][l];
-        }
-        const glm::vec3 c = shadeLightOne(op, light, P, N, V, param);
-        rgb[0][l] = c.x;
-        rgb[1][l] = c.y;
-        rgb[2][l] = c.z;
+    switch (op) {
+        case Op::Diffuse:
+            return shadeLanes<Op::Diffuse>(light, args, rgb, m);
+        case Op::Specular:
+            return shadeLanes<Op::Specular>(light, args, rgb, m);
+        default:
+            return shadeLanes<Op::Phong>(light, args, rgb, m);
     }
 }
 
