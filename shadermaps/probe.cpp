@@ -489,9 +489,11 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
                               : 0.0f;
             // Probe i, d = -half + i step texels from the centre, weighs exp(-2 (d / major)^2).
             const int n = setup.n;
+            // Several taps only along a real major axis (n > 1 means major > minor > 0).
             const float half = n > 1 ? f.major - minor : 0.0f;
             const float step = n > 1 ? 2.0f * half / static_cast<float>(n - 1) : 0.0f;
-            const float dirU = f.ax / (f.major * res0), dirV = f.ay / (f.major * res0);
+            const float dirU = n > 1 ? f.ax / (f.major * res0) : 0.0f;
+            const float dirV = n > 1 ? f.ay / (f.major * res0) : 0.0f;
             setup.offsetU = -half * dirU, setup.offsetV = -half * dirV;
             setup.du = step * dirU, setup.dv = step * dirV;
             const float gk = -2.0f / (f.major * f.major);
