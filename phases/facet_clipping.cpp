@@ -58,7 +58,7 @@ int clipFacet(const FixedPointWarp& warp, const FacetMesh& mesh, const WarpedVer
     ClipVertex* next = buffers[1];
     for (int i = 0; i < 3; ++i) {
         const HomogeneousVertex h = warp.homogeneous(mesh.qx[p[i]], mesh.qy[p[i]], mesh.qz[p[i]]);
-        poly[i] = {h.X, h.Y, h.W, warped.culled[p[i]] == 0, p[i]};
+        poly[i] = {h.X, h.Y, h.W, !warped.culled(p[i]), p[i]};
     }
     for (int k = 0; k < 5 && n > 0; ++k) {
         int m = 0;

@@ -280,7 +280,7 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
         };
         auto binFacet = [&](size_t f) {
             const uint32_t* p = &mesh.positionIndex[3 * f];
-            if (!(w.culled[p[0]] | w.culled[p[1]] | w.culled[p[2]])) {
+            if (!(w.culled(p[0]) || w.culled(p[1]) || w.culled(p[2]))) {
                 const ScreenTriangle t = screenTriangle(w, p);
                 if (measure)
                     for (int i = 0; i < 3; ++i) {

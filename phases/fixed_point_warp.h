@@ -15,18 +15,20 @@
 //     int64 (which has no vector multiply on x86) or int128.
 //   * A vertex is kept only if W >= near (in the same scale) and |X|, |Y| < 2^15 W (a
 //     guard band of 32768 pixels). Then X 256 / W is below 2^23 in magnitude; it is formed
-//     by one correctly rounded double division (X 256 is exact: a power-of-two scaling)
-//     and rounded to the nearest integer (ties to even), which is deterministic and off by
-//     at most 1/2 + 2^-30 units of 1/256 pixel -- where the 128-bit integer division it
-//     replaces truncated, off by up to one unit.
+//     as (X 256) (1 / W) -- X 256 is exact (a power-of-two scaling), the reciprocal and the
+//     product each round once, so it is within 2^-28 of the true quotient -- and rounded to
+//     the nearest integer (ties to even): deterministic, and off by at most 1/2 + 2^-28
+//     units of 1/256 pixel, where the 128-bit integer division it replaces truncated, off
+//     by up to one unit.
 // Error. Rounding each coefficient costs at most 1/2 unit of 2^-s, so |dX|, |dW| <=
 // (3 * 65535 + 1) / 2 units, and the screen error is at most
 //   (|dX| + |x| |dW|) / (W 2^s) pixels,
-// plus 1/512 + 2^-38 pixel from rounding x to 8 fractional bits. errorBound() evaluates
+// plus 1/512 + 2^-36 pixel from rounding x to 8 fractional bits. errorBound() evaluates
 // this at the object's nearest depth and the image's widest coordinate; the tests check
 // the measured error against it and against 1/16 pixel over the valid range.
 #pragma once
 
+#include <climits>
 #include <cstdint>
 #include <vector>
 
@@ -38,10 +40,13 @@
 namespace mpshade {
 
 struct WarpedVertices {
+    // x of a vertex behind the near plane or outside the guard band (never a real value:
+    // real ones are within 2^23 of zero).
+    static constexpr int32_t kCulled = INT32_MIN;
     std::vector<int32_t> x, y;    // pixels, 8 fractional bits (value / 256 = pixel coordinate)
     std::vector<float> invDepth;  // 1 / W, W the view depth in world units
-    std::vector<uint8_t> culled;  // behind the near plane or outside the guard band
     void resize(size_t n);
+    bool culled(size_t i) const { return x[i] == kCulled; }
 };
 
 // A vertex in homogeneous screen coordinates: x_px = X / W, y_px = Y / W, W the view depth

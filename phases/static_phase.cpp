@@ -201,7 +201,7 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(
         int64_t longest = 0;
         for (size_t f = 0; f < mesh.facetCount(); ++f) {
             const uint32_t* p = &mesh.positionIndex[3 * f];
-            if (warped.culled[p[0]] | warped.culled[p[1]] | warped.culled[p[2]]) continue;
+            if (warped.culled(p[0]) || warped.culled(p[1]) || warped.culled(p[2])) continue;
             for (int i = 0; i < 3; ++i) {
                 const int64_t dx = warped.x[p[(i + 1) % 3]] - warped.x[p[i]];
                 const int64_t dy = warped.y[p[(i + 1) % 3]] - warped.y[p[i]];

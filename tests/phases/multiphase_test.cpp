@@ -82,7 +82,7 @@ TEST(FixedPointWarp, WithinASixteenthOfAPixelOverTheRange) {
             for (size_t i = 0; i < x.size(); ++i) {
                 double ex, ey;
                 ASSERT_TRUE(warp.warpExact(x[i], y[i], z[i], ex, ey));
-                ASSERT_EQ(out.culled[i], 0);
+                ASSERT_FALSE(out.culled(i));
                 worstHere = std::max({worstHere, std::fabs(out.x[i] / 256.0 - ex),
                                       std::fabs(out.y[i] / 256.0 - ey)});
             }
@@ -128,7 +128,7 @@ TEST(FixedPointWarp, ExtremesNeitherOverflowNorCrash) {
             ASSERT_TRUE(std::isfinite(out.invDepth[i])) << c.what;
             double ex, ey;
             const bool front = warp.warpExact(x[i], y[i], z[i], ex, ey);
-            if (out.culled[i]) continue;
+            if (out.culled(i)) continue;
             ++kept;
             ASSERT_TRUE(front) << c.what;
             ASSERT_LE(out.invDepth[i], 1.0f / (c.zNear * 0.999f)) << c.what;
@@ -157,7 +157,6 @@ struct GridFixture {
                 warped.x.push_back(256 * (2 + 3 * i) + (inner ? jitter(rng) : 0));
                 warped.y.push_back(256 * (2 + 3 * j) + (inner ? jitter(rng) : 0));
                 warped.invDepth.push_back(0.2f + 0.001f * i);
-                warped.culled.push_back(0);
                 mesh.qx.push_back(0), mesh.qy.push_back(0), mesh.qz.push_back(0);
             }
         for (int j = 0; j + 1 < gh; ++j)
@@ -237,9 +236,9 @@ TEST(FacetRasterizer, OpaqueDepthTestCoversTheSameSamples) {
 TEST(FacetRasterizer, SkipsDegenerateAndCulledFacets) {
     FacetMesh mesh;
     WarpedVertices warped;
-    auto vertex = [&](int32_t x, int32_t y, uint8_t culled) {
-        warped.x.push_back(x), warped.y.push_back(y), warped.invDepth.push_back(0.5f),
-            warped.culled.push_back(culled);
+    auto vertex = [&](int32_t x, int32_t y, bool culled) {
+        warped.x.push_back(culled ? WarpedVertices::kCulled : x), warped.y.push_back(y),
+            warped.invDepth.push_back(0.5f);
         mesh.qx.push_back(0), mesh.qy.push_back(0), mesh.qz.push_back(0);
     };
     vertex(256, 256, 0), vertex(2560, 256, 0), vertex(256, 2560, 0);    // a real facet
