@@ -198,6 +198,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
                 entry["texels_filled"] = stats.texelsFilled;
                 entry["resident_tiles"] = stats.residentTiles;
                 entry["resident_bytes"] = stats.residentBytes;
+                entry["tiles_evicted"] = stats.tilesEvicted;
             }
             if (options.compare) {
                 FrameStats refStats;

@@ -67,6 +67,7 @@ struct DynamicPhase::Band {
         std::vector<uint32_t> pending;        // points still to shade
     };
     struct Scratch {
+        State work;  // the band being shaded, unless it has a state of its own
         std::vector<uint32_t> order, objectStart, cursor, stillPending;
         std::vector<uint32_t> batchFacet;
         std::vector<float> batchX, batchY, batchColor, batchOpacity;
@@ -215,8 +216,10 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
 }
 
 void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& lacking) {
-    Band::State& st = scratch_->states[band];
+    // A band keeps a state of its own only while it waits for tiles: shaded in one pass,
+    // it uses its thread's buffers and keeps nothing.
     Band::Scratch& s = scratch_->scratch.local();
+    Band::State& st = scratch_->states[band].built ? scratch_->states[band] : s.work;
     if (s.costs.size() != objects_.size()) s.costs.assign(objects_.size(), ObjectFrameCost{});
     const SampleLayout& layout = *layout_;
     const VisibilityBuffer& vis = visibility_;
@@ -360,7 +363,11 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
         s.counters.nonFinite += counters.nonFinite;
     }
     st.pending.swap(s.stillPending);
-    if (!st.pending.empty()) return;  // shaded again once the lacking tiles are filled
+    if (!st.pending.empty()) {
+        // Shaded again once the lacking tiles are filled: the band keeps these buffers.
+        if (&st == &s.work) std::swap(s.work, scratch_->states[band]);
+        return;
+    }
 
     // 3. Composite every sample front to back over the background; note the pixels whose
     //    samples all came out alike (the resolve reads those once).
@@ -382,6 +389,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     }
     for (uint32_t o : st.object) ++s.costs[o].shadingPoints;
     st.built = false;
+    if (&st != &s.work) std::swap(s.work, st);  // its buffers go back to the thread
     bandDone_[band] = 1;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <malloc.h>
 #include <string>
 
 #include <tbb/parallel_for.h>
@@ -41,7 +42,7 @@ bool inView(const Surface& surface, const ObjectState& state, const CameraState&
 MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptions& options)
     : scene_(scene),
       options_(options),
-      resources_(scene),
+      resources_(scene, SceneResources::RayScenes::ForOcclusion),
       static_(scene, resources_,
               [&] {
                   StaticPhaseOptions o = options.staticPhase;
@@ -242,6 +243,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         stats.tilesFromChildren += costs[k].tilesFromChildren;
         stats.texelsFilled += costs[k].texelsFilled;
     }
+    if (std::getenv("MPX_TRIM") && !stale.empty()) malloc_trim(0);
     stats.staticRuns = static_cast<int>(stale.size());
     stats.staticSeconds = secondsSince(staticStart);
     if (progress) progress(1, 4);
@@ -250,6 +252,9 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     std::vector<const ObjectRepresentation*> drawn(n, nullptr);
     for (size_t i = 0; i < n; ++i)
         if (visible[i]) drawn[i] = representations_[i].get();
+    ++useStamp_;
+    for (const auto& rep : representations_)
+        if (rep && rep->map) rep->map->setUseStamp(useStamp_);
     dynamic_.begin(frame_, drawn, layout_, dynamicOptions);
     if (progress) progress(2, 4);
     StaticCosts fills;
@@ -259,6 +264,10 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         stats.tilesRequested += lacking.size();
         if (lacking.empty() || last) break;
         const auto fillStart = Clock::now();
+        // Room for the new tiles first, so the maps' storage never outgrows the budget.
+        size_t incoming = 0;
+        for (const TileRequest& r : lacking) incoming += drawn[r.object]->map->tileBytes();
+        keepMapsInBudget(incoming, stats);
         static_.fill(lacking, drawn, fills);
         stats.fillSeconds += secondsSince(fillStart);
         for (const TileRequest& r : lacking) ++reports_[r.object].staticCosts.tilesFilled;
@@ -286,11 +295,10 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         }
         ++stats.objectsDrawn;
     }
-    for (size_t i = 0; i < n; ++i)
-        if (representations_[i] && representations_[i]->map) {
-            stats.residentTiles += representations_[i]->map->residentTiles();
-            stats.residentBytes += representations_[i]->map->bytes();
-        }
+    for (const auto& pool : static_.tilePools().all()) {
+        stats.residentTiles += pool->tilesHeld();
+        stats.residentBytes += pool->bytesHeld();
+    }
     stats.warpSeconds = d.warpSeconds;
     stats.rasterSeconds = d.rasterSeconds;
     stats.shadeSeconds = d.shadeSeconds;
@@ -309,6 +317,34 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     stats.time = frame_.time;
     stats.samples = static_cast<uint64_t>(frame_.width) * frame_.height * frame_.spp;
     stats.wallSeconds = secondsSince(start);
+}
+
+void MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
+    const std::vector<std::shared_ptr<TilePool>> pools = static_.tilePools().all();
+    size_t bytes = 0;
+    for (const auto& pool : pools) bytes += pool->bytesHeld();
+    if (bytes + incoming <= options_.mapMemoryBytes) return;
+    std::vector<TilePool::Held> candidates;
+    std::vector<size_t> tileBytes;
+    for (const auto& pool : pools) {
+        const size_t before = candidates.size();
+        pool->evictable(useStamp_, candidates);
+        tileBytes.resize(candidates.size(), pool->tileBytes());
+        (void)before;
+    }
+    std::vector<size_t> order(candidates.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(),
+              [&](size_t a, size_t b) { return candidates[a].lastUse < candidates[b].lastUse; });
+    // Down to 90% of the budget, so it is not at the edge every frame. Tiles this frame
+    // used are not candidates: they may be over the budget when the frame needs them all.
+    const size_t target = options_.mapMemoryBytes / 10 * 9;
+    for (size_t i : order) {
+        if (bytes + incoming <= target) break;
+        candidates[i].owner->evict(candidates[i].key);
+        bytes -= tileBytes[i];
+        ++stats.tilesEvicted;
+    }
 }
 
 Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,

@@ -33,6 +33,10 @@ struct MultiphaseOptions {
     DynamicOptions dynamic;  // its shadingRate is the scene's unless shadingRate is set
     std::optional<ShadingRate> shadingRate;
     RepresentationCostModel costModel;
+    // The shader maps' tiles stay under this many bytes: before tiles are filled, the tiles
+    // unused longest are dropped (never the always-resident levels, nor a tile the frame
+    // being rendered has used).
+    size_t mapMemoryBytes = size_t{96} << 20;
     // Forces every object's representation (tests, benchmarks); unset: the scene's.
     std::optional<Representation> representation;
 };
@@ -76,6 +80,9 @@ class MultiphaseRenderer {
   private:
     void render(int frame, const RenderOptions& options, FrameStats& stats,
                 const ProgressFn& progress);
+    // Drops the least recently used tiles until `incoming` more bytes of tiles fit the
+    // budget (or nothing the frame has not used is left).
+    void keepMapsInBudget(size_t incoming, FrameStats& stats);
     Representation chooseKind(size_t object, int frame, const ObjectState& state,
                               const CameraState& camera, int spp);
     int framesSeenFrom(size_t object, int frame) const;
@@ -97,6 +104,7 @@ class MultiphaseRenderer {
     int layoutWidth_ = 0, layoutHeight_ = 0;  // the planned image size
     std::vector<ObjectReport> reports_;
     FrameState frame_;
+    uint32_t useStamp_ = 0;  // frames rendered: the maps' recency stamp
 };
 
 }  // namespace mpshade

@@ -34,6 +34,13 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                       "auto: facets; a shader map's always-resident levels of %d charts would "
                       "take %.0f MB",
                       in.charts, in.pinnedBytes / 1048576.0);
+    } else if (!in.haveMap && in.charts * model.pinnedTexelsPerChart >
+                                  model.maxPinnedTexelsPerPoint * std::max(points, 1.0)) {
+        c.kind = Representation::Facets;
+        std::snprintf(text, sizeof text,
+                      "auto: facets; a shader map would keep %.3g texels always resident for "
+                      "%d charts covering about %.3g shading points",
+                      in.charts * model.pinnedTexelsPerChart, in.charts, points);
     } else if (in.combinedFacets > model.maxFacetsPerScreenPixel * in.screenPixels) {
         c.kind = Representation::ShaderMap;
         std::snprintf(text, sizeof text,

@@ -35,6 +35,9 @@ struct RepresentationCostModel {
     double pinnedTexelsPerChart = 34.0 * 34.0;  // the 32 x 32 level with its border
     double maxFacetsPerScreenPixel = 4.0;  // combined facets beyond this: always a map
     double maxPinnedBytes = 64.0 * 1024 * 1024;  // pinned levels beyond this: facets
+    // Pinned texels beyond this many per shading point the object covers: facets (a point
+    // cloud's thousand one-pixel discs would each pin a 34 x 34 level).
+    double maxPinnedTexelsPerPoint = 32.0;
 };
 
 // What the estimate needs to know of an object at a static run.

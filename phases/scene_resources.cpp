@@ -5,14 +5,18 @@
 
 namespace mpshade {
 
-SceneResources::SceneResources(const Scene& scene) : scene_(scene) {
+SceneResources::SceneResources(const Scene& scene, RayScenes rayScenes) : scene_(scene) {
     for (const SceneObject& obj : scene.objects) {
         ObjectResources r;
         r.kernel =
             forObject(scene, obj, [&] { return buildKernel(*obj.shader, bindingOf(scene, obj)); });
-        auto& rs = rayScenes_[obj.surface.get()];
-        if (!rs) rs = std::make_unique<SurfaceRayScene>(*obj.surface);
-        r.rayScene = rs.get();
+        bool casts = rayScenes == RayScenes::All;
+        for (const Inst& inst : r.kernel->program().insts) casts = casts || inst.op == Op::Occlusion;
+        if (casts) {
+            auto& rs = rayScenes_[obj.surface.get()];
+            if (!rs) rs = std::make_unique<SurfaceRayScene>(*obj.surface);
+            r.rayScene = rs.get();
+        }
         r.occlusionBias = 1e-4f * std::max(surfaceBounds(*obj.surface).diagonal(), 1e-6f);
         objects_.push_back(std::move(r));
     }

@@ -16,7 +16,7 @@ namespace mpshade {
 
 struct ObjectResources {
     std::shared_ptr<const ShaderKernel> kernel;
-    const SurfaceRayScene* rayScene = nullptr;  // owned by SceneResources
+    const SurfaceRayScene* rayScene = nullptr;  // owned by SceneResources; may be null
     float occlusionBias = 1e-4f;                // object units
 };
 
@@ -35,7 +35,10 @@ auto forObject(const Scene& scene, const SceneObject& object, F&& build) {
 
 class SceneResources {
   public:
-    explicit SceneResources(const Scene& scene);
+    // Which objects get an Embree scene of their surface: all (a ray tracer needs them
+    // for camera rays), or only those whose shader casts occlusion rays.
+    enum class RayScenes { All, ForOcclusion };
+    explicit SceneResources(const Scene& scene, RayScenes rayScenes = RayScenes::All);
     const Scene& scene() const { return scene_; }
     const ObjectResources& object(size_t i) const { return objects_[i]; }
     size_t objectCount() const { return objects_.size(); }

@@ -156,7 +156,7 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(
     const bool useMap = kind == Representation::ShaderMap;
     const DicingView view = dicingView(state, camera);
     const DicingOptions& dicing = useMap ? options_.separateDicing : options_.combinedDicing;
-    const DicedSurface diced = diceSurface(surface, view, sceneObject.range, dicing);
+    DicedSurface diced = diceSurface(surface, view, sceneObject.range, dicing);
 
     auto rep = std::make_unique<ObjectRepresentation>();
     rep->kind = useMap ? Representation::ShaderMap : Representation::Facets;
@@ -179,15 +179,16 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(
 
     FacetMesh& mesh = rep->mesh;
     mesh.format = diced.format;
-    mesh.qx = diced.qx;
-    mesh.qy = diced.qy;
-    mesh.qz = diced.qz;
-    mesh.attributeIndex = diced.triangles;
+    mesh.qx = std::move(diced.qx);
+    mesh.qy = std::move(diced.qy);
+    mesh.qz = std::move(diced.qz);
     mesh.positionIndex.resize(diced.triangles.size());
     for (size_t k = 0; k < diced.triangles.size(); ++k)
         mesh.positionIndex[k] = diced.positionOf[diced.triangles[k]];
-    mesh.attributeChartPoint = diced.attributePoints;
-    mesh.clusters = diced.clusters;
+    mesh.attributeIndex = std::move(diced.triangles);
+    std::vector<uint32_t>().swap(diced.positionOf);
+    mesh.attributeChartPoint = std::move(diced.attributePoints);
+    mesh.clusters = std::move(diced.clusters);
     const size_t channels = obj.factored.staticPart.channelOutputs.size();
     mesh.channels = useMap ? 0 : static_cast<int>(channels);
     if (!useMap) {
@@ -213,7 +214,7 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(
     }
 
     // Geometry the dynamic part reads, and (combined) the n-tuple from the static part.
-    const size_t n = diced.attributePoints.size();
+    const size_t n = mesh.attributeChartPoint.size();
     VertexAttributes& attr = mesh.attributes;
     attr.count = n;
     attr.rows.assign(VertexAttributes::kGeometryRows + static_cast<size_t>(mesh.channels), {});
@@ -229,7 +230,7 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(
         b.batch.resize(m, useMap ? 0 : channels);
         for (size_t i = 0; i < m; ++i) {
             const SurfaceSample& g = diced.attributeGeometry[begin + i];
-            const ChartPoint& at = diced.attributePoints[begin + i];
+            const ChartPoint& at = mesh.attributeChartPoint[begin + i];
             const glm::vec3 I = glm::normalize(g.P - state.eye);
             b.batch.setPoint(i, g, at, I);
             for (int row : obj.geometryRows) {
@@ -260,7 +261,9 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(
         while (resolution < cap && resolution < (1 << 20)) resolution *= 2;
         mapOptions.resolution = resolution;
         mapOptions.tileSize = std::min(mapOptions.tileSize, resolution);
-        rep->map = std::make_shared<ShaderMap>(surface, *obj.staticKernel, uniforms, mapOptions);
+        rep->map = std::make_shared<ShaderMap>(
+            surface, *obj.staticKernel, uniforms, mapOptions,
+            pools_.forTileBytes(ShaderMap::tileBytesFor(mapOptions, static_cast<int>(channels))));
         const FillStats& f = rep->map->fillStats();
         costs.tilesFilled += f.tiles;
         costs.tilesFromChildren += f.tilesFromChildren;

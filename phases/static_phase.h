@@ -56,6 +56,8 @@ class StaticPhase {
     ~StaticPhase();
 
     const ObjectShading& shading(size_t object) const { return *objects_[object]; }
+    // Where every map this static phase makes keeps its tiles.
+    TilePools& tilePools() const { return pools_; }
     const StaticPhaseOptions& options() const { return options_; }
 
     // Object `object`'s representation for the view of `camera` (its representative view).
@@ -86,6 +88,7 @@ class StaticPhase {
     const SceneResources& resources_;
     StaticPhaseOptions options_;
     std::vector<std::unique_ptr<ObjectShading>> objects_;
+    mutable TilePools pools_;
 };
 
 }  // namespace mpshade

@@ -111,6 +111,7 @@ struct Prober {
             cachedSlot[parity] =
                 map.slotOf({static_cast<uint32_t>(chart), static_cast<uint16_t>(level),
                             static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)});
+            if (cachedSlot[parity] >= 0) map.markUsed(cachedSlot[parity]);
         }
         return cachedSlot[parity] >= 0 ? map.tileFloats(cachedSlot[parity]) : nullptr;
     }
@@ -159,6 +160,7 @@ struct Prober {
         if (packed != lastKey) {
             lastKey = packed;
             lastSlot = map.slotOf(key);
+            if (lastSlot >= 0) map.markUsed(lastSlot);
         }
         return lastSlot;
     }
@@ -318,7 +320,10 @@ struct Prober {
         j = std::clamp(j, 0, res - 1);
         const TileKey key = map.tileOf(static_cast<uint32_t>(chart), level, i, j);
         const int slot = map.slotOf(key);
-        if (slot >= 0) return map.texel(key, slot, i, j, out);
+        if (slot >= 0) {
+            map.markUsed(slot);
+            return map.texel(key, slot, i, j, out);
+        }
         bilinear(chart, level, (i + 0.5f) / res, (j + 0.5f) / res, out);
     }
 

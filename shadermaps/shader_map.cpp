@@ -25,8 +25,15 @@ struct FillScratch {
 
 }  // namespace
 
+size_t ShaderMap::tileBytesFor(const ShaderMapOptions& options, int channels) {
+    const size_t stride = static_cast<size_t>(options.tileSize + 2 * options.border);
+    return stride * stride * static_cast<size_t>(channels) *
+           (options.halfPrecision ? sizeof(uint16_t) : sizeof(float));
+}
+
 ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
-                     const ShadingUniforms& uniforms, const ShaderMapOptions& options)
+                     const ShadingUniforms& uniforms, const ShaderMapOptions& options,
+                     std::shared_ptr<TilePool> pool)
     : surface_(surface),
       kernel_(staticPart),
       params_(uniforms.params.begin(), uniforms.params.end()),
@@ -52,8 +59,14 @@ ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
     tileValues_ = static_cast<size_t>(stride_) * stride_ * static_cast<size_t>(channels_);
     for (int level = 0; level < levels_; ++level)
         tilesPerSide_.push_back((resolution(level) + options.tileSize - 1) / options.tileSize);
+    pool_ = pool ? std::move(pool) : std::make_shared<TilePool>(tileBytesFor(options, channels_));
+    MPSHADE_CHECK(pool_->tileBytes() == tileBytesFor(options, channels_));
     if (options.alwaysResidentLevels > 0)
         fillLevels(std::max(0, levels_ - options.alwaysResidentLevels), levels_ - 1);
+}
+
+ShaderMap::~ShaderMap() {
+    table_.forEach([&](uint64_t, int32_t slot) { pool_->free(slot); });
 }
 
 size_t ShaderMap::tileBytes() const {
@@ -61,28 +74,27 @@ size_t ShaderMap::tileBytes() const {
 }
 
 size_t ShaderMap::bytes() const {
-    return data_.size() * sizeof(float) + halfData_.size() * sizeof(uint16_t) + table_.bytes();
+    return residentTiles_ * tileBytes() + table_.bytes();
 }
 
 void ShaderMap::texel(const TileKey& key, int slot, int i, int j, float* out) const {
     const int li = i - (key.tx << tileShift_) + options_.border;
     const int lj = j - (key.ty << tileShift_) + options_.border;
-    const size_t at = ((static_cast<size_t>(slot) * stride_ + static_cast<size_t>(lj)) * stride_ +
-                       static_cast<size_t>(li)) *
+    const size_t at = (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) *
                       static_cast<size_t>(channels_);
-    if (options_.halfPrecision) {
-        for (int c = 0; c < channels_; ++c)
-            out[c] = halfToFloat(halfData_[at + static_cast<size_t>(c)]);
+    if (const uint16_t* h = tileHalves(slot)) {
+        for (int c = 0; c < channels_; ++c) out[c] = halfToFloat(h[at + static_cast<size_t>(c)]);
     } else {
-        for (int c = 0; c < channels_; ++c) out[c] = data_[at + static_cast<size_t>(c)];
+        const float* f = tileFloats(slot);
+        for (int c = 0; c < channels_; ++c) out[c] = f[at + static_cast<size_t>(c)];
     }
 }
 
-void ShaderMap::store(size_t at, float value) {
+void ShaderMap::store(int slot, size_t at, float value) {
     if (options_.halfPrecision)
-        halfData_[at] = floatToHalf(value);
+        reinterpret_cast<uint16_t*>(tileData(slot))[at] = floatToHalf(value);
     else
-        data_[at] = value;
+        reinterpret_cast<float*>(tileData(slot))[at] = value;
 }
 
 void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, ShadingBatch& scratch,
@@ -98,9 +110,8 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
     const int validW = std::min(stride_, res - key.tx * T + 2 * border);
     const int validH = std::min(stride_, res - key.ty * T + 2 * border);
     const size_t channels = static_cast<size_t>(channels_);
-    const size_t base = static_cast<size_t>(slot) * tileValues_;
     auto texelAt = [&](int li, int lj) {
-        return base + (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) * channels;
+        return (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) * channels;
     };
     // Interior texels from the four children where they are resident: the mean of the
     // 2 x 2 texels of the level below each covers.
@@ -129,7 +140,7 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
                 }
                 const size_t at = texelAt(li, lj);
                 for (size_t c = 0; c < channels; ++c)
-                    store(at + c, 0.25f * ((c4[0][c] + c4[1][c]) + (c4[2][c] + c4[3][c])));
+                    store(slot, at + c, 0.25f * ((c4[0][c] + c4[1][c]) + (c4[2][c] + c4[3][c])));
             }
         ++stats.tilesFromChildren;
     }
@@ -176,7 +187,7 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
                 for (size_t c = 0; c < channels; ++c) {
                     float sum = 0.0f;
                     for (int s = 0; s < k * k; ++s) sum += channelOut[c][first + static_cast<size_t>(s)];
-                    store(at + c, sum * inv);
+                    store(slot, at + c, sum * inv);
                 }
                 first += static_cast<size_t>(k * k);
             }
@@ -215,12 +226,11 @@ void ShaderMap::fill(std::span<const TileKey> keys) {
                 children = slotOf({key.chart, static_cast<uint16_t>(key.level - 1),
                                    static_cast<uint16_t>(ctx), static_cast<uint16_t>(cty)}) >= 0;
             }
-            plan[w - begin] = {static_cast<int>(residentTiles_++), children};
+            const bool pinned = key.level >= levels_ - options_.alwaysResidentLevels;
+            const int slot = pool_->allocate(this, key.packed(), pinned, useStamp_);
+            ++residentTiles_;
+            plan[w - begin] = {slot, children};
         }
-        if (options_.halfPrecision)
-            halfData_.resize(residentTiles_ * tileValues_);
-        else
-            data_.resize(residentTiles_ * tileValues_);
         for (size_t w = begin; w < end; ++w) table_.insert(work[w].packed(), plan[w - begin].first);
         tbb::parallel_for(begin, end, [&](size_t w) {
             enableFlushToZero();
@@ -236,6 +246,14 @@ void ShaderMap::fill(std::span<const TileKey> keys) {
         fillStats_.texels += s.stats.texels;
         fillStats_.programRuns += s.stats.programRuns;
     }
+}
+
+void ShaderMap::evict(uint64_t key) {
+    const int slot = table_.find(key);
+    MPSHADE_CHECK(slot >= 0);
+    table_.erase(key);
+    pool_->free(slot);
+    --residentTiles_;
 }
 
 void ShaderMap::fillLevels(int first, int last) {

@@ -43,6 +43,7 @@
 #include "geometry/surface.h"
 #include "shading/interpreter.h"
 #include "shading/shading_batch.h"
+#include "shadermaps/tile_pool.h"
 #include "shadermaps/tile_table.h"
 
 namespace mpshade {
@@ -86,8 +87,17 @@ class ShaderMap {
   public:
     // `staticPart` computes the channels (its channelOutputs); `uniforms` are the static
     // phase's (representative) values, copied. The surface and kernel must outlive the map.
+    // `pool` holds the tiles (shared with other maps of the same tile size); null: a pool of
+    // its own. Its tileBytes() must be this map's: see tileBytesFor().
     ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
-              const ShadingUniforms& uniforms, const ShaderMapOptions& options = {});
+              const ShadingUniforms& uniforms, const ShaderMapOptions& options = {},
+              std::shared_ptr<TilePool> pool = nullptr);
+    ~ShaderMap();
+    ShaderMap(const ShaderMap&) = delete;
+    ShaderMap& operator=(const ShaderMap&) = delete;
+
+    // The storage of one tile of a map with these options and channels.
+    static size_t tileBytesFor(const ShaderMapOptions& options, int channels);
 
     int channels() const { return channels_; }
     int charts() const { return charts_; }
@@ -104,8 +114,16 @@ class ShaderMap {
     void fillLevels(int first, int last);
     const FillStats& fillStats() const { return fillStats_; }
     size_t residentTiles() const { return residentTiles_; }
-    size_t bytes() const;
+    size_t bytes() const;      // its tiles' storage and its table
     size_t tileBytes() const;  // storage of one tile
+    const std::shared_ptr<TilePool>& pool() const { return pool_; }
+
+    // Recency, for a cache that keeps the maps under a memory budget (tile_pool.h): probes
+    // mark the tiles they read with the current use stamp; evict() drops a tile (the pool
+    // says which are unused longest). Neither evict() nor fill() may run during probes.
+    void setUseStamp(uint32_t stamp) { useStamp_ = stamp; }
+    void markUsed(int slot) const { pool_->markUsed(slot, useStamp_); }
+    void evict(uint64_t key);
 
     // The tile holding texel (i, j) of a level (clamped to the level).
     TileKey tileOf(uint32_t chart, int level, int i, int j) const {
@@ -124,11 +142,10 @@ class ShaderMap {
     // Direct access for probes: a tile's texels, row-major with borders, channels
     // interleaved; stride() texels per row. Exactly one of the two is non-null.
     const float* tileFloats(int slot) const {
-        return options_.halfPrecision ? nullptr
-                                      : data_.data() + static_cast<size_t>(slot) * tileValues_;
+        return options_.halfPrecision ? nullptr : reinterpret_cast<const float*>(tileData(slot));
     }
     const uint16_t* tileHalves(int slot) const {
-        return options_.halfPrecision ? halfData_.data() + static_cast<size_t>(slot) * tileValues_
+        return options_.halfPrecision ? reinterpret_cast<const uint16_t*>(tileData(slot))
                                       : nullptr;
     }
     int stride() const { return stride_; }
@@ -142,10 +159,12 @@ class ShaderMap {
     }
 
   private:
+    const unsigned char* tileData(int slot) const { return pool_->data(slot); }
+    unsigned char* tileData(int slot) { return pool_->data(slot); }
     void fillTile(const TileKey& key, int slot, bool fromChildren, ShadingBatch& scratch,
                   std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
                   std::vector<float>& workspace, FillStats& stats);
-    void store(size_t at, float value);
+    void store(int slot, size_t at, float value);
 
     const Surface& surface_;
     std::unique_ptr<ChartAdjacency> adjacency_;
@@ -160,9 +179,9 @@ class ShaderMap {
     size_t tileValues_ = 0;  // floats (or halves) per tile
     std::vector<int> tilesPerSide_;
     TileTable table_;
-    std::vector<float> data_;         // float storage
-    std::vector<uint16_t> halfData_;  // half storage
+    std::shared_ptr<TilePool> pool_;  // tile storage
     size_t residentTiles_ = 0;
+    uint32_t useStamp_ = 0;
     FillStats fillStats_;
     std::mutex fillMutex_;
 };

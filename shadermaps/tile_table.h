@@ -30,6 +30,11 @@ class TileTable {
     // Removes a key if present (for a cache that evicts tiles).
     void erase(uint64_t key);
     size_t size() const { return size_; }
+    template <typename F>
+    void forEach(F&& f) const {
+        for (size_t i = 0; i < keys_.size(); ++i)
+            if (keys_[i] != kEmpty) f(keys_[i], slots_[i]);
+    }
     size_t bytes() const { return keys_.size() * (sizeof(uint64_t) + sizeof(int32_t)); }
 
   private:

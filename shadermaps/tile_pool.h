@@ -1,0 +1,92 @@
+// tile_pool.h -- storage for shader-map tiles shared by every map whose tiles have one size:
+// slots in blocks of 64, allocated as needed (the storage never moves, nor reserves twice
+// what it holds), reused once freed. Per slot it records which map holds it, under which key,
+// whether it is one of that map's always-resident levels, and when probes last used it, so a
+// cache can keep all the maps under one memory budget by dropping the tiles unused longest
+// (patent col. 10: "the tiles can be stored in and/or removed from a memory using a least
+// recently used (LRU) algorithm").
+//
+// Threads: allocate() and free() may run on several threads at once (maps filled in
+// parallel share a pool); data() of a slot may run alongside them (blocks never move);
+// markUsed() may run on many threads at once (it writes atomically) but not alongside
+// allocate(); evictable() runs alone.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+namespace mpshade {
+
+class ShaderMap;
+
+class TilePool {
+  public:
+    explicit TilePool(size_t tileBytes);
+    TilePool(const TilePool&) = delete;
+    TilePool& operator=(const TilePool&) = delete;
+
+    size_t tileBytes() const { return tileBytes_; }
+    size_t tilesHeld() const { return held_; }
+    size_t bytesHeld() const { return held_ * tileBytes_; }
+    size_t bytesAllocated() const { return blockCount_ * kTilesPerBlock * tileBytes_; }
+
+    int allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t stamp);
+    void free(int slot);
+
+    unsigned char* data(int slot) {
+        return blocks_[static_cast<size_t>(slot) >> kBlockShift].get() +
+               static_cast<size_t>(slot & (kTilesPerBlock - 1)) * tileBytes_;
+    }
+    const unsigned char* data(int slot) const {
+        return blocks_[static_cast<size_t>(slot) >> kBlockShift].get() +
+               static_cast<size_t>(slot & (kTilesPerBlock - 1)) * tileBytes_;
+    }
+    static constexpr size_t kMaxTiles = size_t{1} << 22;  // per pool
+    void markUsed(int slot, uint32_t stamp) const {
+        __atomic_store_n(&lastUse_[static_cast<size_t>(slot)], stamp, __ATOMIC_RELAXED);
+    }
+
+    struct Held {
+        uint32_t lastUse;
+        int slot;
+        ShaderMap* owner;
+        uint64_t key;
+    };
+    // Appends the tiles held that may be dropped: not always-resident, last used before
+    // `before`.
+    void evictable(uint32_t before, std::vector<Held>& out) const;
+
+  private:
+    static constexpr int kBlockShift = 6;
+    static constexpr int kTilesPerBlock = 1 << kBlockShift;
+
+    size_t tileBytes_;
+    size_t held_ = 0;
+    std::mutex mutex_;
+    // Block pointers in an array that never grows: data() reads it while other threads
+    // allocate.
+    std::unique_ptr<std::unique_ptr<unsigned char[]>[]> blocks_;
+    size_t blockCount_ = 0;
+    std::vector<int> free_;
+    std::vector<ShaderMap*> owner_;  // per slot; null: free
+    std::vector<uint64_t> key_;
+    std::vector<uint8_t> pinned_;
+    mutable std::vector<uint32_t> lastUse_;
+};
+
+// The pools of a renderer, one per tile size, created on first use. Thread safe.
+class TilePools {
+  public:
+    std::shared_ptr<TilePool> forTileBytes(size_t tileBytes);
+    std::vector<std::shared_ptr<TilePool>> all() const;
+    size_t bytesHeld() const;
+
+  private:
+    mutable std::mutex mutex_;
+    std::vector<std::shared_ptr<TilePool>> pools_;
+};
+
+}  // namespace mpshade
