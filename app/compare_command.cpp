@@ -15,11 +15,11 @@ int runCompareCommand(const CompareCommandOptions& options) {
         const Image test = readImage(options.test);
         const Image reference = readImage(options.reference);
         if (test.width != reference.width || test.height != reference.height)
-            throw InputError({options.test, 0, 0, {}},
-                             "is " + std::to_string(test.width) + "x" +
-                                 std::to_string(test.height) + " but the reference is " +
-                                 std::to_string(reference.width) + "x" +
-                                 std::to_string(reference.height));
+            throw InputError({options.test, 0, 0, {}}, "is " + std::to_string(test.width) + "x" +
+                                                           std::to_string(test.height) +
+                                                           " but the reference is " +
+                                                           std::to_string(reference.width) + "x" +
+                                                           std::to_string(reference.height));
         const ImageError e = compareImages(test, reference);
         if (options.json) {
             const nlohmann::json doc = {{"psnr_db", e.psnr},

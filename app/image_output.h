@@ -1,5 +1,6 @@
-// image_output.h -- reads images and writes frames with OpenImageIO: linear half-float RGBA OpenEXR, and an
-// sRGB-encoded 8-bit PNG for viewing. Kept apart so only this file pays for OIIO's headers.
+// image_output.h -- reads images and writes frames with OpenImageIO: linear half-float RGBA
+// OpenEXR, and an sRGB-encoded 8-bit PNG for viewing. Kept apart so only this file pays for OIIO's
+// headers.
 #pragma once
 
 #include <string>

@@ -137,9 +137,9 @@ int runRenderCommand(const RenderCommandOptions& options) {
                 else if (options.shadingRate == "pixel")
                     mo.shadingRate = ShadingRate::Pixel;
                 else
-                    throw InputError({"--shading-rate", 0, 0, {}},
-                                     "expected sample or pixel, found '" + options.shadingRate +
-                                         "'");
+                    throw InputError(
+                        {"--shading-rate", 0, 0, {}},
+                        "expected sample or pixel, found '" + options.shadingRate + "'");
             }
             multi = std::make_unique<MultiphaseRenderer>(scene, mo);
             multi->plan(first, last, render);

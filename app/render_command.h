@@ -14,8 +14,8 @@ struct RenderCommandOptions {
     std::string size;    // "WxH"; empty = the scene's
     int spp = -1;        // -1 = the scene's; else 1..1024
     uint32_t seed = 0;
-    bool quiet = false;  // no progress bar
-    bool compare = false;  // multiphase: also render the reference, report error and speed
+    bool quiet = false;       // no progress bar
+    bool compare = false;     // multiphase: also render the reference, report error and speed
     std::string shadingRate;  // "sample" or "pixel"; empty = the scene's
     int truthSpp = -1;        // with compare: also measure both against this many spp
 };

@@ -25,8 +25,8 @@ namespace {
 // counts that see all the work (callgrind's --toggle-collect follows one thread).
 const std::unique_ptr<tbb::global_control> threadLimit = [] {
     const char* n = std::getenv("MPSHADE_BENCH_THREADS");
-    return n ? std::make_unique<tbb::global_control>(
-                   tbb::global_control::max_allowed_parallelism, std::stoul(n))
+    return n ? std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                     std::stoul(n))
              : nullptr;
 }();
 
@@ -119,15 +119,14 @@ __attribute__((noinline)) Image steadyFrame(MultiphaseRenderer& multi, const Ren
 void frameMultiphase(benchmark::State& state, const char* path, int representation, int rate) {
     FrameFixture f(path);
     MultiphaseOptions options;
-    if (const char* a = std::getenv("MPSHADE_BENCH_ANISO")) options.dynamic.probe.maxAnisotropy = std::stof(a);
-    if (const char* a = std::getenv("MPSHADE_BENCH_FILTER")) options.dynamic.probe.filter = static_cast<ProbeFilter>(std::stoi(a));
     if (representation >= 0) options.representation = static_cast<Representation>(representation);
     if (rate >= 0) options.shadingRate = static_cast<ShadingRate>(rate);
     f.multi = std::make_unique<MultiphaseRenderer>(f.scene, options);
     FrameStats stats;
     f.multi->renderFrame(0, f.options, stats);  // the static phase
     f.multi->renderFrame(1, f.options, stats);  // frame 1's tiles
-    for (auto _ : state) benchmark::DoNotOptimize(steadyFrame(*f.multi, f.options, stats).rgba.data());
+    for (auto _ : state)
+        benchmark::DoNotOptimize(steadyFrame(*f.multi, f.options, stats).rgba.data());
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * stats.samples));
     state.counters["facets"] = static_cast<double>(stats.facets);
     state.counters["static_runs_in_loop"] = stats.staticRuns;
@@ -167,30 +166,30 @@ constexpr int kAuto = -1, kFacets = static_cast<int>(Representation::Facets),
               kMap = static_cast<int>(Representation::ShaderMap);
 constexpr int kSceneRate = -1, kPerSample = static_cast<int>(ShadingRate::Sample);
 
-#define MPSHADE_FRAME_BENCH(name, path)                                                  \
-    BENCHMARK_CAPTURE(frameReference, name, path)                                        \
-        ->Name("Frame/" #name "/reference")                                              \
-        ->Unit(benchmark::kMillisecond)                                                  \
-        ->UseRealTime();                                                                 \
-    BENCHMARK_CAPTURE(frameMultiphase, name, path, kAuto, kSceneRate)                    \
-        ->Name("Frame/" #name "/multiphase")                                             \
-        ->Unit(benchmark::kMillisecond)                                                  \
-        ->UseRealTime();                                                                 \
-    BENCHMARK_CAPTURE(frameMultiphase, name##_sample, path, kAuto, kPerSample)           \
-        ->Name("Frame/" #name "/multiphase_per_sample")                                  \
-        ->Unit(benchmark::kMillisecond)                                                  \
-        ->UseRealTime();                                                                 \
-    BENCHMARK_CAPTURE(frameMultiphase, name##_facets, path, kFacets, kSceneRate)         \
-        ->Name("Frame/" #name "/multiphase_facets")                                      \
-        ->Unit(benchmark::kMillisecond)                                                  \
-        ->UseRealTime();                                                                 \
-    BENCHMARK_CAPTURE(facetsPerPixel, name##_map, path, kMap)                            \
-        ->Name("FacetsPerPixel/" #name "/shadermap")                                     \
-        ->Iterations(1)                                                                  \
-        ->Unit(benchmark::kMillisecond);                                                 \
-    BENCHMARK_CAPTURE(facetsPerPixel, name##_facets, path, kFacets)                      \
-        ->Name("FacetsPerPixel/" #name "/facets")                                        \
-        ->Iterations(1)                                                                  \
+#define MPSHADE_FRAME_BENCH(name, path)                                          \
+    BENCHMARK_CAPTURE(frameReference, name, path)                                \
+        ->Name("Frame/" #name "/reference")                                      \
+        ->Unit(benchmark::kMillisecond)                                          \
+        ->UseRealTime();                                                         \
+    BENCHMARK_CAPTURE(frameMultiphase, name, path, kAuto, kSceneRate)            \
+        ->Name("Frame/" #name "/multiphase")                                     \
+        ->Unit(benchmark::kMillisecond)                                          \
+        ->UseRealTime();                                                         \
+    BENCHMARK_CAPTURE(frameMultiphase, name##_sample, path, kAuto, kPerSample)   \
+        ->Name("Frame/" #name "/multiphase_per_sample")                          \
+        ->Unit(benchmark::kMillisecond)                                          \
+        ->UseRealTime();                                                         \
+    BENCHMARK_CAPTURE(frameMultiphase, name##_facets, path, kFacets, kSceneRate) \
+        ->Name("Frame/" #name "/multiphase_facets")                              \
+        ->Unit(benchmark::kMillisecond)                                          \
+        ->UseRealTime();                                                         \
+    BENCHMARK_CAPTURE(facetsPerPixel, name##_map, path, kMap)                    \
+        ->Name("FacetsPerPixel/" #name "/shadermap")                             \
+        ->Iterations(1)                                                          \
+        ->Unit(benchmark::kMillisecond);                                         \
+    BENCHMARK_CAPTURE(facetsPerPixel, name##_facets, path, kFacets)              \
+        ->Name("FacetsPerPixel/" #name "/facets")                                \
+        ->Iterations(1)                                                          \
         ->Unit(benchmark::kMillisecond)
 
 MPSHADE_FRAME_BENCH(vase, "examples/vase/scene.json");

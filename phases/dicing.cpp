@@ -115,6 +115,27 @@ EdgeKey edgeKey(uint32_t a, uint32_t b) {
     return {std::min(a, b), std::max(a, b)};
 }
 
+// A point where the chart collapses (a sphere's pole, where dP/du vanishes).
+bool collapsed(const SurfaceSample& p) {
+    const float du = glm::length(p.dPdu), dv = glm::length(p.dPdv);
+    return du < 1e-4f * dv || dv < 1e-4f * du;
+}
+
+// How far chord a-b strays from the surface, judged at the surface point m at the chord's
+// mid chart coordinates: the distance from m to the chord's midpoint, which also counts how
+// far interpolated chart coordinates stray. A diagonal chord from a collapsed point has its
+// mid chart coordinates off the surface's own path between a and b (at a pole, the mid u is
+// another meridian), so it is not judged: the chords along the chart's lines through the
+// same points are. Below float noise (the coordinates' rounding) it is zero, so a flat
+// chart stays two triangles.
+float deviation(const SurfaceSample& a, const SurfaceSample& m, const SurfaceSample& b,
+                bool diagonal) {
+    if (diagonal && (collapsed(a) || collapsed(b))) return 0.0f;
+    const float scale = glm::length(a.P) + glm::length(b.P) + glm::length(m.P);
+    const float d = glm::length(m.P - 0.5f * (a.P + b.P));
+    return d > 1e-6f * scale ? d : 0.0f;
+}
+
 // Bfr's quad corners: (0,0), (1,0), (1,1), (0,1); edge i runs from corner i to i + 1.
 const float kCorner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
 
@@ -229,7 +250,8 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
                                               std::hypot(bx - mx, by - my));
                 const float length = glm::length(m.P - a.P) + glm::length(b.P - m.P);
                 const float scale = pixelsPerUnitAt(m.P, 0.5f * length);
-                return flatness ? glm::length(m.P - 0.5f * (a.P + b.P)) * scale : length * scale;
+                if (!flatness) return length * scale;
+                return deviation(a, m, b, di != 0 && dj != 0) * scale;
             };
             // The rate a line of kGrid chords needs. Its facets split every chord alike (the
             // tessellation is uniform in the chart), so the longest chord -- or the one
@@ -282,9 +304,9 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
             out.patches = static_cast<int>(patches.size());
             for (const ChartSurvey& sv : survey)
                 if (!sv.culled)
-                    out.estimatedFacets +=
-                        2.0 * std::max({sv.innerU, sv.desired[0], sv.desired[2]}) *
-                        std::max({sv.innerV, sv.desired[1], sv.desired[3]});
+                    out.estimatedFacets += 2.0 *
+                                           std::max({sv.innerU, sv.desired[0], sv.desired[2]}) *
+                                           std::max({sv.innerV, sv.desired[1], sv.desired[3]});
             return out;
         }
         if (worst <= options.maxEdgeRate || depth >= options.maxSplitDepth ||
@@ -436,6 +458,18 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
         }
         out.clusters.push_back(cluster);
     }
+    // Drop the positions no facet uses (survey corners and edge midpoints, welded only to
+    // match shared edges), so the warp transforms only what is drawn.
+    std::vector<uint32_t> remap(out.qx.size(), UINT32_MAX);
+    std::vector<uint16_t> qx, qy, qz;
+    for (uint32_t& p : out.positionOf) {
+        if (remap[p] == UINT32_MAX) {
+            remap[p] = static_cast<uint32_t>(qx.size());
+            qx.push_back(out.qx[p]), qy.push_back(out.qy[p]), qz.push_back(out.qz[p]);
+        }
+        p = remap[p];
+    }
+    out.qx = std::move(qx), out.qy = std::move(qy), out.qz = std::move(qz);
     return out;
 }
 

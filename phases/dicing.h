@@ -51,14 +51,14 @@ enum class DicingTarget {
 
 struct DicingOptions {
     DicingTarget target = DicingTarget::EdgeLength;
-    float maxEdgePixels = 0.5f;   // P/2: the bound on every facet edge (EdgeLength)
+    float maxEdgePixels = 0.5f;    // P/2: the bound on every facet edge (EdgeLength)
     float flatnessPixels = 0.25f;  // the bound on every facet's deviation (Flatness)
     // Measure at the closest any eye of the range comes (true), or at the representative
     // eye only (false).
     bool overRange = true;
-    int maxEdgeRate = 256;       // per patch edge; charts split into patches to stay under it
-    int maxSplitDepth = 6;       // charts split into at most 2^6 x 2^6 patches
-    int maxPatches = 1 << 14;    // per object
+    int maxEdgeRate = 256;     // per patch edge; charts split into patches to stay under it
+    int maxSplitDepth = 6;     // charts split into at most 2^6 x 2^6 patches
+    int maxPatches = 1 << 14;  // per object
     size_t maxFacets =
         4'000'000;  // per object; beyond it every rate scales down alike (counted as capped)
     bool frustumCull = true;  // drop patches no view of the range can see
@@ -95,9 +95,9 @@ struct DicedSurface {
     std::vector<uint32_t> triangles;     // attribute vertex indices, 3 per facet
     std::vector<FacetCluster> clusters;  // one per tessellated patch
     int charts = 0, patches = 0, culledCharts = 0,
-        cappedCharts = 0;    // culled and capped count patches
-    int frustumCulled = 0;   // patches outside every view of the range
-    float rateScale = 1.0f;  // < 1 when the facet budget cut every rate
+        cappedCharts = 0;          // culled and capped count patches
+    int frustumCulled = 0;         // patches outside every view of the range
+    float rateScale = 1.0f;        // < 1 when the facet budget cut every rate
     double estimatedFacets = 0.0;  // from the surveyed rates, before the budget
 };
 

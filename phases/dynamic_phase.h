@@ -47,7 +47,7 @@ struct DynamicOptions {
 // What one object cost this frame.
 struct ObjectFrameCost {
     bool drawn = false;
-    uint64_t facets = 0;         // in its representation
+    uint64_t facets = 0;  // in its representation
     uint64_t verticesWarped = 0;
     uint64_t shadingPoints = 0;  // runs of the dynamic shader
     uint64_t probes = 0, probeFallbacks = 0;

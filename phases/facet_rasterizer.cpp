@@ -270,7 +270,8 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
             const int32_t minY = std::min({t.y[0], t.y[1], t.y[2]}),
                           maxY = std::max({t.y[0], t.y[1], t.y[2]});
             const int x0 = std::max(0, minX >> kSub), y0 = std::max(0, minY >> kSub);
-            const int x1 = std::min(width - 1, maxX >> kSub), y1 = std::min(height - 1, maxY >> kSub);
+            const int x1 = std::min(width - 1, maxX >> kSub),
+                      y1 = std::min(height - 1, maxY >> kSub);
             if (x0 > x1 || y0 > y1) return;
             for (int ty = y0 / tile; ty <= y1 / tile; ++ty)
                 for (int tx = x0 / tile; tx <= x1 / tile; ++tx) {
@@ -284,7 +285,8 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
                 const ScreenTriangle t = screenTriangle(w, p);
                 if (measure)
                     for (int i = 0; i < 3; ++i) {
-                        const int64_t dx = t.x[(i + 1) % 3] - t.x[i], dy = t.y[(i + 1) % 3] - t.y[i];
+                        const int64_t dx = t.x[(i + 1) % 3] - t.x[i],
+                                      dy = t.y[(i + 1) % 3] - t.y[i];
                         c.longestEdge2 = std::max(c.longestEdge2, dx * dx + dy * dy);
                     }
                 binTriangle(t, static_cast<uint32_t>(f), -1);
@@ -431,9 +433,10 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
         if (obj.longestEdgePixels) *obj.longestEdgePixels = 0.0f;
     for (size_t ci = 0; ci < chunkCount; ++ci) {
         if (float* longest = objects[st.chunks[ci].object].longestEdgePixels)
-            *longest = std::max(*longest, static_cast<float>(std::sqrt(static_cast<double>(
-                                              st.chunks[ci].longestEdge2))) /
-                                              256.0f);
+            *longest = std::max(
+                *longest,
+                static_cast<float>(std::sqrt(static_cast<double>(st.chunks[ci].longestEdge2))) /
+                    256.0f);
         const RasterStats& s = st.chunks[ci].stats;
         stats.facets += s.facets;
         stats.facetsCulled += s.facetsCulled;

@@ -57,11 +57,11 @@ struct VisibilityBuffer {
 };
 
 struct RasterStats {
-    uint64_t facets = 0;            // offered
-    uint64_t facetsCulled = 0;      // wholly behind the near plane or outside the guard band
-    uint64_t facetsClipped = 0;     // crossing the near plane or the guard band: clipped
-    uint64_t facetsDegenerate = 0;  // zero area on the sub-pixel grid
-    uint64_t facetsBackFacing = 0;  // culled as back faces of closed opaque surfaces
+    uint64_t facets = 0;                  // offered
+    uint64_t facetsCulled = 0;            // wholly behind the near plane or outside the guard band
+    uint64_t facetsClipped = 0;           // crossing the near plane or the guard band: clipped
+    uint64_t facetsDegenerate = 0;        // zero area on the sub-pixel grid
+    uint64_t facetsBackFacing = 0;        // culled as back faces of closed opaque surfaces
     uint64_t facetsInCulledClusters = 0;  // skipped with their whole cluster
     uint64_t facetsBinned = 0;            // facet-tile pairs rasterized
     uint64_t tilesCoveredWhole = 0;       // facet-tile pairs that skipped the edge tests

@@ -93,7 +93,8 @@ FixedPointWarp::FixedPointWarp(const glm::mat4& objectToWorld, const CameraState
     minW = std::max(minW, static_cast<double>(camera.zNear));
     const double roundingUnits = 0.5 * (3.0 * 65535.0 + 1.0);
     const double widest = std::max(camera.width, camera.height);
-    errorBound_ = roundingUnits * (1.0 + widest) / (minW * scale) + 1.0 / 512.0 + std::ldexp(1.0, -36);
+    errorBound_ =
+        roundingUnits * (1.0 + widest) / (minW * scale) + 1.0 / 512.0 + std::ldexp(1.0, -36);
 }
 
 namespace {
@@ -157,8 +158,8 @@ __attribute__((target_clones("avx2", "default"))) void warpLanes(
         const double band = guard * W;
         const bool keep = W >= nearW && X < band && X > -band && Y < band && Y > -band;
         const double r = 1.0 / (keep ? W : 1.0);
-        ox[i] = keep ? static_cast<int32_t>(roundToInteger(X * 256.0 * r))
-                     : WarpedVertices::kCulled;
+        ox[i] =
+            keep ? static_cast<int32_t>(roundToInteger(X * 256.0 * r)) : WarpedVertices::kCulled;
         oy[i] = keep ? static_cast<int32_t>(roundToInteger(Y * 256.0 * r)) : 0;
         oinv[i] = keep ? static_cast<float>(scale * r) : 0.0f;
     }
@@ -192,14 +193,19 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void warpAvx512(
             _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(qy + i))));
         const __m512d c = _mm512_cvtepi32_pd(
             _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(qz + i))));
-        const __m512d X = _mm512_fmadd_pd(l02, c, _mm512_fmadd_pd(l01, b, _mm512_fmadd_pd(l00, a, t0)));
-        const __m512d Y = _mm512_fmadd_pd(l12, c, _mm512_fmadd_pd(l11, b, _mm512_fmadd_pd(l10, a, t1)));
-        const __m512d W = _mm512_fmadd_pd(l22, c, _mm512_fmadd_pd(l21, b, _mm512_fmadd_pd(l20, a, t2)));
+        const __m512d X =
+            _mm512_fmadd_pd(l02, c, _mm512_fmadd_pd(l01, b, _mm512_fmadd_pd(l00, a, t0)));
+        const __m512d Y =
+            _mm512_fmadd_pd(l12, c, _mm512_fmadd_pd(l11, b, _mm512_fmadd_pd(l10, a, t1)));
+        const __m512d W =
+            _mm512_fmadd_pd(l22, c, _mm512_fmadd_pd(l21, b, _mm512_fmadd_pd(l20, a, t2)));
         const __m512d band = _mm512_mul_pd(guard, W);
         const __m512d negBand = _mm512_sub_pd(_mm512_setzero_pd(), band);
         __mmask8 keep = _mm512_cmp_pd_mask(W, nearW, _CMP_GE_OQ);
-        keep &= _mm512_cmp_pd_mask(X, band, _CMP_LT_OQ) & _mm512_cmp_pd_mask(X, negBand, _CMP_GT_OQ);
-        keep &= _mm512_cmp_pd_mask(Y, band, _CMP_LT_OQ) & _mm512_cmp_pd_mask(Y, negBand, _CMP_GT_OQ);
+        keep &=
+            _mm512_cmp_pd_mask(X, band, _CMP_LT_OQ) & _mm512_cmp_pd_mask(X, negBand, _CMP_GT_OQ);
+        keep &=
+            _mm512_cmp_pd_mask(Y, band, _CMP_LT_OQ) & _mm512_cmp_pd_mask(Y, negBand, _CMP_GT_OQ);
         const __m512d r = _mm512_maskz_div_pd(keep, one, W);
         const __m512d sx = _mm512_roundscale_pd(_mm512_mul_pd(_mm512_mul_pd(X, sub), r),
                                                 _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);

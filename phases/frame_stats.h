@@ -29,8 +29,8 @@ struct FrameStats {
     uint64_t facetsRasterized = 0;    // facet-tile pairs rasterized
     uint64_t fragments = 0;           // facet-sample hits tested against the depth buffer
     uint64_t verticesWarped = 0;
-    uint64_t facetBytes = 0;          // memory of the drawn objects' facets and attributes
-    uint64_t objectsDrawn = 0;        // objects in view this frame
+    uint64_t facetBytes = 0;    // memory of the drawn objects' facets and attributes
+    uint64_t objectsDrawn = 0;  // objects in view this frame
     // Shader maps: distinct tiles this frame's probes asked for that were not resident,
     // tiles filled (of them, built from their children), texels filled, and what stays
     // resident after the frame (tiles and bytes, all maps).
@@ -40,7 +40,7 @@ struct FrameStats {
     uint64_t texelsFilled = 0;
     uint64_t residentTiles = 0;
     uint64_t residentBytes = 0;
-    uint64_t tilesEvicted = 0;  // dropped to keep the maps under their memory budget
+    uint64_t tilesEvicted = 0;    // dropped to keep the maps under their memory budget
     uint64_t probes = 0;          // bilinear probes
     uint64_t probeFallbacks = 0;  // answered from a coarser level (zero when render fills first)
     int shadePasses = 0;          // shading passes: 1, plus one per round of fills

@@ -4,8 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <malloc.h>
 #include <string>
 
 #include <tbb/parallel_for.h>
@@ -43,16 +41,7 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
     : scene_(scene),
       options_(options),
       resources_(scene, SceneResources::RayScenes::ForOcclusion),
-      static_(scene, resources_,
-              [&] {
-                  StaticPhaseOptions o = options.staticPhase;
-                  if (const char* e = std::getenv("MPX_SS")) o.shaderMap.supersampleLimit = std::stoi(e);
-                  if (const char* e = std::getenv("MPX_TILE")) o.shaderMap.tileSize = std::stoi(e);
-                  if (std::getenv("MPX_HALF")) o.shaderMap.halfPrecision = true;
-                  if (const char* e = std::getenv("MPX_FLAT")) o.separateDicing.flatnessPixels = std::stof(e);
-                  if (const char* e = std::getenv("MPX_EDGE")) o.combinedDicing.maxEdgePixels = std::stof(e);
-                  return o;
-              }()),
+      static_(scene, resources_, options.staticPhase),
       dynamic_(scene) {
     const size_t n = scene.objects.size();
     representations_.resize(n);
@@ -77,7 +66,8 @@ void MultiphaseRenderer::plan(int first, int last, const RenderOptions& options)
     planFirst_ = first;
     layoutWidth_ = options.width > 0 ? options.width : scene_.settings.width;
     layoutHeight_ = options.height > 0 ? options.height : scene_.settings.height;
-    for (std::vector<int>& seen : framesSeen_) seen.assign(static_cast<size_t>(std::max(0, last - first)), 0);
+    for (std::vector<int>& seen : framesSeen_)
+        seen.assign(static_cast<size_t>(std::max(0, last - first)), 0);
     const int w = options.width > 0 ? options.width : scene_.settings.width;
     const int h = options.height > 0 ? options.height : scene_.settings.height;
     for (int f = first; f < last; ++f) {
@@ -87,7 +77,8 @@ void MultiphaseRenderer::plan(int first, int last, const RenderOptions& options)
             const bool seen =
                 inView(*scene_.objects[i].surface, objectAt(scene_.objects[i], t, camera), camera);
             framesSeen_[i][static_cast<size_t>(f - first)] =
-                (f > first ? framesSeen_[i][static_cast<size_t>(f - first - 1)] : 0) + (seen ? 1 : 0);
+                (f > first ? framesSeen_[i][static_cast<size_t>(f - first - 1)] : 0) +
+                (seen ? 1 : 0);
         }
     }
 }
@@ -96,10 +87,9 @@ Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectS
                                               const CameraState& camera, int spp) {
     const SceneObject& obj = scene_.objects[i];
     Representation asked = options_.representation.value_or(obj.representation);
-    if (const char* e = std::getenv("MPX_REP")) asked = static_cast<Representation>(std::stoi(e));
     if (asked != Representation::Auto) {
-        reports_[i].reason = options_.representation ? "forced by the renderer's options"
-                                                     : "the scene asks for it";
+        reports_[i].reason =
+            options_.representation ? "forced by the renderer's options" : "the scene asks for it";
         return asked;
     }
     const ObjectShading& shading = static_.shading(i);
@@ -121,8 +111,8 @@ Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectS
     in.staticCostUnits = shading.factored.staticCost;
     in.samplesPerPixel = spp;
     in.shadingRate = options_.dynamic.shadingRate;
-    const int tile = options_.staticPhase.shaderMap.tileSize +
-                     2 * options_.staticPhase.shaderMap.border;
+    const int tile =
+        options_.staticPhase.shaderMap.tileSize + 2 * options_.staticPhase.shaderMap.border;
     in.pinnedBytes = static_cast<double>(in.charts) * 9.0 * tile * tile *
                      shading.factored.staticPart.channelOutputs.size() * sizeof(float);
     in.haveMap = previous && previous->map;
@@ -178,19 +168,14 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
                                 const ProgressFn& progress) {
     const auto start = Clock::now();
     stats = FrameStats{};
-    frame_ = frameStateAt(resources_, frame, options.width, options.height,
-                          options.samplesPerPixel);
+    frame_ =
+        frameStateAt(resources_, frame, options.width, options.height, options.samplesPerPixel);
     const CameraState& camera = frame_.camera;
-    if (!layout_ || !layout_->matches(frame_.width, frame_.height, frame_.spp, options.seed,
-                                      options.filter))
+    if (!layout_ ||
+        !layout_->matches(frame_.width, frame_.height, frame_.spp, options.seed, options.filter))
         layout_ = std::make_shared<const SampleLayout>(frame_.width, frame_.height, frame_.spp,
                                                        options.seed, options.filter);
     DynamicOptions dynamicOptions = options_.dynamic;
-    if (const char* e = std::getenv("MPX_FOOT")) dynamicOptions.footprintScale = std::stof(e);
-    if (const char* e = std::getenv("MPX_ANISO")) dynamicOptions.probe.maxAnisotropy = std::stof(e);
-    if (const char* e = std::getenv("MPX_TPR")) dynamicOptions.probe.tapsPerRatio = std::stof(e);
-    if (const char* e = std::getenv("MPX_BLEND")) dynamicOptions.probe.levelBlend = std::stof(e);
-    if (const char* e = std::getenv("MPX_FILTER")) dynamicOptions.probe.filter = static_cast<ProbeFilter>(std::stoi(e));
     if (options_.shadingRate)
         dynamicOptions.shadingRate = *options_.shadingRate;
     else
@@ -208,8 +193,8 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         const ObjectRepresentation* rep = representations_[i].get();
         const glm::vec3 forward =
             glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
-        const bool tooCoarse = rep && rep->kind == Representation::Facets &&
-                               longestEdge_[i] > rep->maxEdgePixels;
+        const bool tooCoarse =
+            rep && rep->kind == Representation::Facets && longestEdge_[i] > rep->maxEdgePixels;
         if (!rep || !rep->inRange(state.eye, forward) || rep->imageHeight != camera.height ||
             tooCoarse)
             stale.push_back(i);
@@ -224,11 +209,6 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
                           representations_[i].get(), costs[k]);
         longestEdge_[i] = 0.0f;
     });
-    if (std::getenv("MPX_LOG"))
-        for (size_t k = 0; k < stale.size(); ++k)
-            std::fprintf(stderr, "frame %d static %s kind %d %.3f s facets %zu\n", frame,
-                         scene_.objects[stale[k]].name.c_str(), static_cast<int>(kinds_[stale[k]]),
-                         costs[k].seconds, representations_[stale[k]]->mesh.facetCount());
     for (size_t k = 0; k < stale.size(); ++k) {
         ObjectReport& r = reports_[stale[k]];
         r.kind = kinds_[stale[k]];
@@ -243,7 +223,6 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         stats.tilesFromChildren += costs[k].tilesFromChildren;
         stats.texelsFilled += costs[k].texelsFilled;
     }
-    if (std::getenv("MPX_TRIM") && !stale.empty()) malloc_trim(0);
     stats.staticRuns = static_cast<int>(stale.size());
     stats.staticSeconds = secondsSince(staticStart);
     if (progress) progress(1, 4);

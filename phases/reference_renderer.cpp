@@ -31,7 +31,7 @@ struct Hit {
 
 // Per-thread scratch, reused across tiles so the hot loops never allocate once warm.
 struct Scratch {
-    std::vector<glm::vec3> dir;               // per tile sample, world space
+    std::vector<glm::vec3> dir;              // per tile sample, world space
     std::vector<SampleComposite> composite;  // per tile sample
     std::vector<PendingRay> active, next;
     std::vector<Hit> hits;
@@ -48,12 +48,12 @@ struct Scratch {
 
 ReferenceRenderer::ReferenceRenderer(const Scene& scene) : scene_(scene), resources_(scene) {}
 
-std::shared_ptr<const SampleLayout> ReferenceRenderer::layoutFor(int width, int height, int spp,
-                                                                 const RenderOptions& options) const {
+std::shared_ptr<const SampleLayout> ReferenceRenderer::layoutFor(
+    int width, int height, int spp, const RenderOptions& options) const {
     std::lock_guard<std::mutex> lock(layoutMutex_);
     if (!layout_ || !layout_->matches(width, height, spp, options.seed, options.filter))
-        layout_ = std::make_shared<const SampleLayout>(width, height, spp, options.seed,
-                                                       options.filter);
+        layout_ =
+            std::make_shared<const SampleLayout>(width, height, spp, options.seed, options.filter);
     return layout_;
 }
 

@@ -9,18 +9,17 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                                           const RepresentationCostModel& model) {
     const double frames = std::max(1, in.frames);
     const double staticPointNs = in.staticCostUnits * model.nsPerCostUnit;
-    const double points = in.coveredPixels * (in.shadingRate == ShadingRate::Pixel
-                                                  ? 1.0
-                                                  : static_cast<double>(in.samplesPerPixel));
+    const double points =
+        in.coveredPixels *
+        (in.shadingRate == ShadingRate::Pixel ? 1.0 : static_cast<double>(in.samplesPerPixel));
     // Combined: a vertex per two facets, shaded again at every run.
     const double facetsStatic =
         0.5 * in.combinedFacets * staticPointNs * std::max(1, in.combinedRuns);
     const double facetsFrame = in.combinedFacets * model.facetNs + points * model.vertexPointNs;
     // Separate: the texels frames ask for and the always-resident levels, unless built.
-    const double runs =
-        in.haveMap ? 0.0
-                   : in.coveredPixels * model.texelsPerCoveredPixel +
-                         in.charts * model.pinnedTexelsPerChart;
+    const double runs = in.haveMap ? 0.0
+                                   : in.coveredPixels * model.texelsPerCoveredPixel +
+                                         in.charts * model.pinnedTexelsPerChart;
     const double mapStatic = runs * staticPointNs;
     const double mapFrame = points * model.mapPointNs;
 
@@ -47,8 +46,8 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                       "auto: shadermap; facets would number %.3g, over %.0f per screen pixel",
                       in.combinedFacets, model.maxFacetsPerScreenPixel);
     } else {
-        c.kind = c.mapSeconds <= c.facetsSeconds ? Representation::ShaderMap
-                                                 : Representation::Facets;
+        c.kind =
+            c.mapSeconds <= c.facetsSeconds ? Representation::ShaderMap : Representation::Facets;
         std::snprintf(text, sizeof text,
                       "auto: %s; estimated over %d frames: shader map %.3f s (%.3f static + "
                       "%.2f ms a frame), facets %.3f s (%.3f static in %d runs + %.2f ms a "

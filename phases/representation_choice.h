@@ -27,13 +27,13 @@
 namespace mpshade {
 
 struct RepresentationCostModel {
-    double facetNs = 25.0;        // warp, bin and rasterize one facet of the combined, per frame
+    double facetNs = 25.0;         // warp, bin and rasterize one facet of the combined, per frame
     double vertexPointNs = 170.0;  // interpolate and shade one point of a facets object
     double mapPointNs = 290.0;     // interpolate, probe and shade one point of a map object
     double nsPerCostUnit = 1.4;    // the static shader, per point and opCost unit
-    double texelsPerCoveredPixel = 12.0;  // separate: texels filled per covered pixel
-    double pinnedTexelsPerChart = 34.0 * 34.0;  // the 32 x 32 level with its border
-    double maxFacetsPerScreenPixel = 4.0;  // combined facets beyond this: always a map
+    double texelsPerCoveredPixel = 12.0;         // separate: texels filled per covered pixel
+    double pinnedTexelsPerChart = 34.0 * 34.0;   // the 32 x 32 level with its border
+    double maxFacetsPerScreenPixel = 4.0;        // combined facets beyond this: always a map
     double maxPinnedBytes = 64.0 * 1024 * 1024;  // pinned levels beyond this: facets
     // Pinned texels beyond this many per shading point the object covers: facets (a point
     // cloud's thousand one-pixel discs would each pin a 34 x 34 level).
@@ -42,11 +42,11 @@ struct RepresentationCostModel {
 
 // What the estimate needs to know of an object at a static run.
 struct ObjectCostInputs {
-    double combinedFacets = 0.0;   // from the dicing survey at this view
-    double coveredPixels = 0.0;    // the screen area it covers, estimated
+    double combinedFacets = 0.0;  // from the dicing survey at this view
+    double coveredPixels = 0.0;   // the screen area it covers, estimated
     int charts = 1;
-    int frames = 1;                // frames it is seen in, from now on
-    int combinedRuns = 1;          // static runs the combined would need over those frames
+    int frames = 1;        // frames it is seen in, from now on
+    int combinedRuns = 1;  // static runs the combined would need over those frames
     double screenPixels = 1.0;
     double staticCostUnits = 0.0;  // the static part's opCost per point
     int samplesPerPixel = 4;

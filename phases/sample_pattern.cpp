@@ -35,8 +35,7 @@ void samplePosition(uint32_t seed, int px, int py, int k, int spp, float& x, flo
     y = static_cast<float>(py) + (static_cast<float>(k / nx) + jy) / static_cast<float>(ny);
 }
 
-SampleLayout::SampleLayout(int width, int height, int spp, uint32_t seed,
-                           const PixelFilter& filter)
+SampleLayout::SampleLayout(int width, int height, int spp, uint32_t seed, const PixelFilter& filter)
     : width_(width), height_(height), spp_(spp), seed_(seed), stratified_(true), filter_(filter) {
     MPSHADE_CHECK(width > 0 && height > 0 && spp > 0);
     xy_.resize(static_cast<size_t>(width) * height * spp * 2);
@@ -67,8 +66,8 @@ SampleLayout::SampleLayout(int width, int height, int spp, std::vector<float> xy
 
 bool SampleLayout::matches(int width, int height, int spp, uint32_t seed,
                            const PixelFilter& filter) const {
-    return stratified_ && width == width_ && height == height_ && spp == spp_ &&
-           seed == seed_ && filter == filter_;
+    return stratified_ && width == width_ && height == height_ && spp == spp_ && seed == seed_ &&
+           filter == filter_;
 }
 
 void SampleLayout::prepareFilter() {
@@ -195,8 +194,8 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
                     continue;
                 }
                 for (size_t s = first; s < last; ++s) {
-                    const float* w = same ? pixelWeights + pixel * taps * taps
-                                          : weights + s * 2 * taps;
+                    const float* w =
+                        same ? pixelWeights + pixel * taps * taps : weights + s * 2 * taps;
                     const Float4 c = load4(rgba + 4 * s);
                     for (int py = py0; py <= py1; ++py) {
                         const size_t oy = static_cast<size_t>(py - qy + reach);

@@ -74,7 +74,7 @@ class SampleLayout {
     int reach_ = 1, taps_ = 3;
     std::vector<float> weights_;
     std::vector<float> pixelWeights_;  // per pixel: taps x taps, its samples' weights summed
-    std::vector<float> inverseSum_;  // per pixel: 1 / the sum of the weights reaching it
+    std::vector<float> inverseSum_;    // per pixel: 1 / the sum of the weights reaching it
 };
 
 // Per-sample results of one frame, in its layout's order.

@@ -11,7 +11,8 @@ SceneResources::SceneResources(const Scene& scene, RayScenes rayScenes) : scene_
         r.kernel =
             forObject(scene, obj, [&] { return buildKernel(*obj.shader, bindingOf(scene, obj)); });
         bool casts = rayScenes == RayScenes::All;
-        for (const Inst& inst : r.kernel->program().insts) casts = casts || inst.op == Op::Occlusion;
+        for (const Inst& inst : r.kernel->program().insts)
+            casts = casts || inst.op == Op::Occlusion;
         if (casts) {
             auto& rs = rayScenes_[obj.surface.get()];
             if (!rs) rs = std::make_unique<SurfaceRayScene>(*obj.surface);

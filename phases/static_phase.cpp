@@ -145,10 +145,12 @@ double StaticPhase::combinedFacets(size_t object, const ObjectState& state,
         .estimatedFacets;
 }
 
-std::unique_ptr<ObjectRepresentation> StaticPhase::build(
-    size_t index, Representation kind, const ObjectState& state, const CameraState& camera,
-    const ShadingUniforms& uniforms, const ObjectRepresentation* previous,
-    StaticCosts& costs) const {
+std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Representation kind,
+                                                         const ObjectState& state,
+                                                         const CameraState& camera,
+                                                         const ShadingUniforms& uniforms,
+                                                         const ObjectRepresentation* previous,
+                                                         StaticCosts& costs) const {
     const auto start = Clock::now();
     const ObjectShading& obj = *objects_[index];
     const SceneObject& sceneObject = scene_.objects[index];
@@ -292,14 +294,16 @@ void StaticPhase::fill(std::span<const TileRequest> requests,
     for (auto& [object, keys] : perObject) {
         const ObjectRepresentation* rep = representations[object];
         if (rep && rep->map)
-            work.push_back({rep->map.get(), &keys, objects_[object]->staticKernel->instructionCount()});
+            work.push_back(
+                {rep->map.get(), &keys, objects_[object]->staticKernel->instructionCount()});
     }
     std::vector<FillStats> before(work.size());
     for (size_t w = 0; w < work.size(); ++w) before[w] = work[w].map->fillStats();
     tbb::parallel_for(size_t{0}, work.size(), [&](size_t w) { work[w].map->fill(*work[w].keys); });
     for (size_t w = 0; w < work.size(); ++w) {
         const FillStats& after = work[w].map->fillStats();
-        costs.instructions += (after.programRuns - before[w].programRuns) * work[w].instructionsPerRun;
+        costs.instructions +=
+            (after.programRuns - before[w].programRuns) * work[w].instructionsPerRun;
         costs.tilesFilled += after.tiles - before[w].tiles;
         costs.tilesFromChildren += after.tilesFromChildren - before[w].tilesFromChildren;
         costs.texelsFilled += after.texels - before[w].texels;

@@ -34,7 +34,7 @@ struct ObjectShading {
     std::shared_ptr<const ShaderKernel> dynamicKernel;
     // VertexAttributes rows the dynamic part reads (P and I come from the facet itself).
     std::vector<int> geometryRows;
-    bool opaque = true;  // the dynamic part's Oi is the constant 1
+    bool opaque = true;   // the dynamic part's Oi is the constant 1
     bool closed = false;  // the surface bounds a solid
     // The static part reads the view, the time or an animated input (through bake()): its
     // values hold for the representative view only, so a new static run needs new ones.
@@ -64,16 +64,14 @@ class StaticPhase {
     // `previous` (may be null) lends its shader map when the static part does not read the
     // frame. Safe to call for different objects in parallel.
     std::unique_ptr<ObjectRepresentation> build(size_t object, Representation kind,
-                                                const ObjectState& state,
-                                                const CameraState& camera,
+                                                const ObjectState& state, const CameraState& camera,
                                                 const ShadingUniforms& uniforms,
                                                 const ObjectRepresentation* previous,
                                                 StaticCosts& costs) const;
 
     // The facets the combined representation of object `object` would have at this view
     // (the dicing survey's estimate, before any budget): for choosing a representation.
-    double combinedFacets(size_t object, const ObjectState& state,
-                          const CameraState& camera) const;
+    double combinedFacets(size_t object, const ObjectState& state, const CameraState& camera) const;
 
     // Fills the requested tiles lacking from the representations' maps: each map's tiles
     // in one batch (finest level first), maps in parallel.

@@ -18,8 +18,8 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
     const VertexAttributes& attr = mesh.attributes;
     const bool useMap = rep.map != nullptr;
     const size_t n = points.n;
-    const size_t channels = useMap ? static_cast<size_t>(rep.map->channels())
-                                   : static_cast<size_t>(mesh.channels);
+    const size_t channels =
+        useMap ? static_cast<size_t>(rep.map->channels()) : static_cast<size_t>(mesh.channels);
     ShadingBatch& batch = scratch.batch;
     batch.resize(n, channels);
     if (useMap) scratch.queries.resize(n);
@@ -90,8 +90,7 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
             const ChartPoint& c0 = mesh.attributeChartPoint[a[0]];
             const ChartPoint& c1 = mesh.attributeChartPoint[a[1]];
             const ChartPoint& c2 = mesh.attributeChartPoint[a[2]];
-            const float du1 = c1.u - c0.u, du2 = c2.u - c0.u, dv1 = c1.v - c0.v,
-                        dv2 = c2.v - c0.v;
+            const float du1 = c1.u - c0.u, du2 = c2.u - c0.u, dv1 = c1.v - c0.v, dv2 = c2.v - c0.v;
             ProbeQuery& q = scratch.queries[i];
             q.chart = c0.chart;
             q.u = c0.u + b1 * du1 + b2 * du2;

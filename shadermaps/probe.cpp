@@ -35,8 +35,8 @@ inline float fastExp(float x) {
     const float fi = floorOf(t);
     const float f = t - fi;
     const float p =
-        1.0f +
-        f * (0.6931527f + f * (0.2401532f + f * (0.05582816f + f * (0.008988991f + f * 0.001876627f))));
+        1.0f + f * (0.6931527f +
+                    f * (0.2401532f + f * (0.05582816f + f * (0.008988991f + f * 0.001876627f))));
     int32_t bits;
     std::memcpy(&bits, &p, sizeof bits);
     bits += static_cast<int32_t>(fi) << 23;
@@ -56,8 +56,8 @@ inline float fastLog2(float x) {
     float m;
     std::memcpy(&m, &bits, sizeof m);
     const float t = m - 1.0f;
-    return e + t * (1.441826f + t * (-0.7086829f + t * (0.4154247f + t * (-0.1944264f +
-                                                                          t * 0.04588722f))));
+    return e + t * (1.441826f +
+                    t * (-0.7086829f + t * (0.4154247f + t * (-0.1944264f + t * 0.04588722f))));
 }
 
 // kChannels > 0: the channel count is a compile-time constant, so the per-channel loops
@@ -175,8 +175,8 @@ struct Prober {
             const float fx0 = floorOf(x), fy0 = floorOf(y);
             const int i0 = static_cast<int>(fx0), j0 = static_cast<int>(fy0);
             int li, lj;
-            const int slot = find(static_cast<uint32_t>(chart), level, std::max(i0, 0),
-                                  std::max(j0, 0), li, lj);
+            const int slot =
+                find(static_cast<uint32_t>(chart), level, std::max(i0, 0), std::max(j0, 0), li, lj);
             li += i0 - std::max(i0, 0);
             lj += j0 - std::max(j0, 0);
             if (residency) ++residency->bilinearProbes;
@@ -253,7 +253,8 @@ struct Prober {
         if (fast) {
             // Every tap's texels in one tile (the common case: taps span a few texels):
             // one lookup for the line.
-            const float xe = x0 + static_cast<float>(n - 1) * dx, ye = y0 + static_cast<float>(n - 1) * dy;
+            const float xe = x0 + static_cast<float>(n - 1) * dx,
+                        ye = y0 + static_cast<float>(n - 1) * dy;
             const float lo = -0.5f, hi = fres - 0.5f;
             const int ix0 = static_cast<int>(floorOf(std::clamp(std::min(x0, xe), lo, hi)));
             const int ix1 = static_cast<int>(floorOf(std::clamp(std::max(x0, xe), lo, hi)));
@@ -442,13 +443,16 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
         const float tolerance =
             (1.0f / 64.0f) * std::max({std::fabs(setup.dudx), std::fabs(setup.dvdx),
                                        std::fabs(setup.dudy), std::fabs(setup.dvdy)});
-        const bool sameFeline =
-            options.filter == ProbeFilter::Feline && q.chart == setup.chart &&
-            std::fabs(q.dudx - setup.dudx) <= tolerance &&
-            std::fabs(q.dvdx - setup.dvdx) <= tolerance &&
-            std::fabs(q.dudy - setup.dudy) <= tolerance && std::fabs(q.dvdy - setup.dvdy) <= tolerance;
-        const Footprint f = sameFeline ? Footprint{} : footprintOf(
-            q, res0, options.filter == ProbeFilter::Trilinear ? 1e30f : options.maxAnisotropy);
+        const bool sameFeline = options.filter == ProbeFilter::Feline && q.chart == setup.chart &&
+                                std::fabs(q.dudx - setup.dudx) <= tolerance &&
+                                std::fabs(q.dvdx - setup.dvdx) <= tolerance &&
+                                std::fabs(q.dudy - setup.dudy) <= tolerance &&
+                                std::fabs(q.dvdy - setup.dvdy) <= tolerance;
+        const Footprint f = sameFeline ? Footprint{}
+                                       : footprintOf(q, res0,
+                                                     options.filter == ProbeFilter::Trilinear
+                                                         ? 1e30f
+                                                         : options.maxAnisotropy);
         if (options.filter == ProbeFilter::Trilinear) {
             p.trilinear(q.chart, std::log2(std::max(f.major, 1e-30f)), q.u, q.v, o);
             return;
@@ -513,11 +517,11 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
         float sum[Prober<C>::kArr] = {};
         const float u0 = q.u + setup.offsetU, v0 = q.v + setup.offsetV;
         if (setup.blend < 1.0f)
-            p.lineAccumulate(q.chart, setup.l0, u0, v0, setup.du, setup.dv, setup.n,
-                             setup.weights, 1.0f - setup.blend, sum);
+            p.lineAccumulate(q.chart, setup.l0, u0, v0, setup.du, setup.dv, setup.n, setup.weights,
+                             1.0f - setup.blend, sum);
         if (setup.blend > 0.0f)
-            p.lineAccumulate(q.chart, setup.l1, u0, v0, setup.du, setup.dv, setup.n,
-                             setup.weights, setup.blend, sum);
+            p.lineAccumulate(q.chart, setup.l1, u0, v0, setup.du, setup.dv, setup.n, setup.weights,
+                             setup.blend, sum);
         for (int c = 0; c < channels; ++c) o[c] = sum[c];
     };
     uint8_t* queryMissed = residency ? residency->queryMissed : nullptr;

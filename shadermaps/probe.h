@@ -63,7 +63,7 @@ struct ProbeResidency {
     size_t touchedCapacity = 0;
     size_t touchedCount = 0;  // written to touched; a tile read twice in a row is written once
     bool stopAtMissing = false;
-    uint64_t missingProbes = 0;     // bilinear probes that found their tile lacking
+    uint64_t missingProbes = 0;      // bilinear probes that found their tile lacking
     uint8_t* queryMissed = nullptr;  // caller's buffer, one per query: 1 where it lacked a tile
 };
 

@@ -156,11 +156,11 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
                         (static_cast<float>(i) + (static_cast<float>(si) + 0.5f) / k) / res;
                     const float v =
                         (static_cast<float>(j) + (static_cast<float>(sj) + 0.5f) / k) / res;
-                    points.push_back(adjacency_ ? adjacency_->resolve(static_cast<int>(key.chart),
-                                                                      u, v)
-                                                : ChartPoint{static_cast<int>(key.chart),
-                                                             std::clamp(u, 0.0f, 1.0f),
-                                                             std::clamp(v, 0.0f, 1.0f)});
+                    points.push_back(adjacency_
+                                         ? adjacency_->resolve(static_cast<int>(key.chart), u, v)
+                                         : ChartPoint{static_cast<int>(key.chart),
+                                                      std::clamp(u, 0.0f, 1.0f),
+                                                      std::clamp(v, 0.0f, 1.0f)});
                 }
         }
     const size_t n = points.size();
@@ -186,7 +186,8 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
                 const size_t at = texelAt(li, lj);
                 for (size_t c = 0; c < channels; ++c) {
                     float sum = 0.0f;
-                    for (int s = 0; s < k * k; ++s) sum += channelOut[c][first + static_cast<size_t>(s)];
+                    for (int s = 0; s < k * k; ++s)
+                        sum += channelOut[c][first + static_cast<size_t>(s)];
                     store(slot, at + c, sum * inv);
                 }
                 first += static_cast<size_t>(k * k);
@@ -219,7 +220,11 @@ void ShaderMap::fill(std::span<const TileKey> keys) {
         std::vector<std::pair<int, bool>> plan(end - begin);
         for (size_t w = begin; w < end; ++w) {
             const TileKey& key = work[w];
-            bool children = key.level > 0;
+            // From the children only where that is exactly what evaluating it would give
+            // (their texel centres are its k x k samples), so what a tile holds does not
+            // depend on which tiles happened to be resident.
+            bool children = key.level > 0 && options_.prefilter == Prefilter::Box &&
+                            (1 << std::min<int>(key.level, 20)) <= options_.supersampleLimit;
             for (int q = 0; q < 4 && children; ++q) {
                 const int ctx = std::min(2 * key.tx + (q & 1), tilesPerSide(key.level - 1) - 1);
                 const int cty = std::min(2 * key.ty + (q >> 1), tilesPerSide(key.level - 1) - 1);

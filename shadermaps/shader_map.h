@@ -22,14 +22,15 @@
 //
 // Prefiltering: point-sampled coarse levels alias high-frequency patterns; with
 // `Prefilter::Box` a texel of level L > 0 is the mean of the static program over a k x k
-// grid inside it (k = min(2^L, supersampleLimit)). A tile whose four children (the level
-// below) are resident is instead the mean of their texels -- the same k x k means where
-// 2^L <= supersampleLimit (up to float rounding), and a wider box above -- at a fraction
-// of the cost: only its border is evaluated.
+// grid inside it (k = min(2^L, supersampleLimit)). Where 2^L <= supersampleLimit those
+// samples are the texel centres of the level below, so a tile whose four children are
+// resident is built as their mean at a fraction of the cost (only its border evaluated),
+// with the same values up to float rounding: a tile does not depend on what else was
+// resident when it was filled.
 //
 // Residency: the coarsest `alwaysResidentLevels` levels of every chart are filled at
-// construction (the finest of them evaluated, the rest built from it), so a probe always
-// finds data: it falls back to the finest resident coarser level (patent col. 10).
+// construction, so a probe always finds data: it falls back to the finest resident coarser
+// level (patent col. 10).
 #pragma once
 
 #include <algorithm>
@@ -41,19 +42,19 @@
 
 #include "geometry/chart_adjacency.h"
 #include "geometry/surface.h"
-#include "shading/interpreter.h"
-#include "shading/shading_batch.h"
 #include "shadermaps/tile_pool.h"
 #include "shadermaps/tile_table.h"
+#include "shading/interpreter.h"
+#include "shading/shading_batch.h"
 
 namespace mpshade {
 
 enum class Prefilter { Point, Box };
 
 struct ShaderMapOptions {
-    int resolution = 1 << 20;    // level-0 texels per chart side; a power of two, <= 2^20
-    int tileSize = 16;           // texels per tile side; a power of two, resolution / tileSize <= 2^16
-    int border = 1;              // texels around each tile, >= 1
+    int resolution = 1 << 20;  // level-0 texels per chart side; a power of two, <= 2^20
+    int tileSize = 16;  // texels per tile side; a power of two, resolution / tileSize <= 2^16
+    int border = 1;     // texels around each tile, >= 1
     bool halfPrecision = false;  // store channels as binary16 (see half_float.h for the error)
     Prefilter prefilter = Prefilter::Box;
     // At most k x k program samples per evaluated texel. 1 (point samples; coarser levels
@@ -145,8 +146,7 @@ class ShaderMap {
         return options_.halfPrecision ? nullptr : reinterpret_cast<const float*>(tileData(slot));
     }
     const uint16_t* tileHalves(int slot) const {
-        return options_.halfPrecision ? reinterpret_cast<const uint16_t*>(tileData(slot))
-                                      : nullptr;
+        return options_.halfPrecision ? reinterpret_cast<const uint16_t*>(tileData(slot)) : nullptr;
     }
     int stride() const { return stride_; }
     // The slot holding texel (i, j) of a level (clamped to the level), or -1 if that tile is

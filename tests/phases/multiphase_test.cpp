@@ -172,7 +172,8 @@ struct GridFixture {
         std::vector<float> xy;
         for (int py = 0; py < H; ++py)
             for (int px = 0; px < W; ++px)
-                for (int k = 0; k < spp; ++k) xy.push_back(px + 0.25f * (k % 4)), xy.push_back(py + 0.25f * (k / 4));
+                for (int k = 0; k < spp; ++k)
+                    xy.push_back(px + 0.25f * (k % 4)), xy.push_back(py + 0.25f * (k / 4));
         layout = std::make_shared<SampleLayout>(W, H, spp, xy);
     }
     // Inside the grid: the convex hull of the border (an axis-aligned rectangle).
@@ -200,7 +201,8 @@ TEST(FacetRasterizer, SharedEdgesAreWatertight) {
         const int in = g.inside(s);
         if (in == 1) {
             ++interior;
-            ASSERT_EQ(vis.count[s], 1) << "sample at (" << g.layout->x(s) << ", " << g.layout->y(s) << ")";
+            ASSERT_EQ(vis.count[s], 1)
+                << "sample at (" << g.layout->x(s) << ", " << g.layout->y(s) << ")";
         } else if (in == 0) {
             ASSERT_EQ(vis.count[s], 0);
         }

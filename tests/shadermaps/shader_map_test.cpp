@@ -1,12 +1,15 @@
 // Shader maps and probes: exact at texel centres, trilinear exact on linear functions,
 // Feline close to EWA, residency fallback, half precision, degenerate footprints.
 #include <cmath>
+#include <map>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "shadermaps/half_float.h"
 #include "shadermaps/probe.h"
+#include "shadermaps/tile_pool.h"
+#include "shadermaps/tile_table.h"
 #include "shading/factoring.h"
 #include "shading/noise.h"
 #include "shading/shader_compiler.h"
@@ -289,6 +292,114 @@ TEST(Probe, DegenerateFootprintsGiveFiniteResults) {
             for (float x : out) ASSERT_TRUE(std::isfinite(x)) << static_cast<int>(filter);
         }
     }
+}
+
+TEST(TileTable, FindsWhatWasInsertedAndForgetsWhatWasErased) {
+    // Random keys in and out, checked against std::map; erasing from the middle of a
+    // probe run must keep the keys after it findable (backward-shift deletion).
+    TileTable table;
+    std::map<uint64_t, int32_t> truth;
+    std::mt19937_64 rng(7);
+    for (int step = 0; step < 20000; ++step) {
+        const uint64_t key = rng() % 3000;  // collisions and re-insertions
+        if (truth.count(key) && rng() % 2) {
+            table.erase(key);
+            truth.erase(key);
+        } else if (!truth.count(key)) {
+            const int32_t slot = static_cast<int32_t>(step);
+            table.insert(key, slot);
+            truth[key] = slot;
+        }
+        if (step % 997 == 0)
+            for (uint64_t k = 0; k < 3000; ++k) {
+                const auto it = truth.find(k);
+                ASSERT_EQ(table.find(k), it == truth.end() ? -1 : it->second) << k;
+            }
+    }
+    EXPECT_EQ(table.size(), truth.size());
+}
+
+TEST(ShaderMap, VirtualResolutionFillsOnlyWhatIsAsked) {
+    // Level 0 of 2^20 texels a side: 2^32 tiles, of which one is asked for. The table holds
+    // it and the always-resident levels; the texel centres hold the program's exact values.
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;  // resolution 2^20 by default
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    ASSERT_EQ(map.resolution(0), 1 << 20);
+    const size_t pinned = map.residentTiles();
+    const TileKey key = map.tileOf(0, 0, 700000, 123456);
+    map.fill({&key, 1});
+    EXPECT_EQ(map.residentTiles(), pinned + 1);
+    EXPECT_TRUE(map.resident(key));
+    EXPECT_FALSE(map.resident(map.tileOf(0, 0, 700000 + 16, 123456)));
+    const int i = 700000 + 3, j = 123456 + 5;
+    float texel[3];
+    map.texel(key, map.slotOf(key), i, j, texel);
+    const std::vector<float> want = f.direct((i + 0.5f) / (1 << 20), (j + 0.5f) / (1 << 20));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(texel[c], want[static_cast<size_t>(c)], 1e-6f);
+}
+
+TEST(ShaderMap, TilesBuiltFromTheirChildrenAreTheirBoxMean) {
+    // A level-1 tile filled after its four children is their 2 x 2 mean, which is what
+    // evaluating it with 2 x 2 supersamples gives (the same points): up to float rounding.
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;
+    options.resolution = 64;
+    options.alwaysResidentLevels = 0;
+    options.supersampleLimit = 2;
+    ShaderMap built(f.surface, *f.kernel, f.uniforms, options);
+    built.fillLevels(0, 0);
+    built.fillLevels(1, 1);
+    ShaderMap direct(f.surface, *f.kernel, f.uniforms, options);
+    direct.fillLevels(1, 1);
+    EXPECT_EQ(built.fillStats().tilesFromChildren, 4u);  // level 1: 32 x 32, four tiles
+    EXPECT_EQ(direct.fillStats().tilesFromChildren, 0u);
+    // Level 2 wants 4 x 4 samples, more than the limit allows: evaluated, never built from
+    // level 1 (whose mean would be a wider box than a map without level 1 holds).
+    built.fillLevels(2, 2);
+    EXPECT_EQ(built.fillStats().tilesFromChildren, 4u);
+    for (int j = 0; j < 32; ++j)
+        for (int i = 0; i < 32; ++i) {
+            const TileKey key = built.tileOf(0, 1, i, j);
+            float a[3], b[3];
+            built.texel(key, built.slotOf(key), i, j, a);
+            direct.texel(key, direct.slotOf(key), i, j, b);
+            for (int c = 0; c < 3; ++c) ASSERT_NEAR(a[c], b[c], 1e-5f) << i << "," << j;
+        }
+}
+
+TEST(TilePool, MapsShareItAndEvictedSlotsAreReused) {
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;
+    options.resolution = 256;
+    options.alwaysResidentLevels = 1;
+    auto pool = std::make_shared<TilePool>(ShaderMap::tileBytesFor(options, 3));
+    {
+        ShaderMap a(f.surface, *f.kernel, f.uniforms, options, pool);
+        ShaderMap b(f.surface, *f.kernel, f.uniforms, options, pool);
+        EXPECT_EQ(pool->tilesHeld(), 2u);  // each map's 1 x 1 level
+        std::vector<TileKey> keys;
+        for (uint16_t t = 0; t < 8; ++t) keys.push_back({0, 0, t, 0});
+        a.setUseStamp(5);
+        a.fill(keys);
+        b.fill({keys.data(), 2});
+        EXPECT_EQ(pool->tilesHeld(), 12u);
+        const size_t allocated = pool->bytesAllocated();
+        // a's tiles were filled at stamp 5, b's at 0: before 3, only b's (not the pinned).
+        std::vector<TilePool::Held> old;
+        pool->evictable(3, old);
+        ASSERT_EQ(old.size(), 2u);
+        for (const TilePool::Held& h : old) {
+            EXPECT_EQ(h.owner, &b);
+            b.evict(h.key);
+        }
+        EXPECT_FALSE(b.resident(keys[0]));
+        EXPECT_EQ(pool->tilesHeld(), 10u);
+        b.fill({keys.data() + 2, 2});  // into the freed slots: no new storage
+        EXPECT_EQ(pool->bytesAllocated(), allocated);
+        EXPECT_EQ(pool->tilesHeld(), 12u);
+    }
+    EXPECT_EQ(pool->tilesHeld(), 0u);  // destroyed maps give their tiles back
 }
 
 }  // namespace
