@@ -21,6 +21,16 @@ int runCompareCommand(const CompareCommandOptions& options) {
                                                            std::to_string(reference.width) + "x" +
                                                            std::to_string(reference.height));
         const ImageError e = compareImages(test, reference);
+        if (!options.difference.empty()) {
+            const Image d = differenceImage(test, reference, options.gain);
+            const std::string& path = options.difference;
+            const bool exr = path.size() >= 4 && path.compare(path.size() - 4, 4, ".exr") == 0;
+            try {
+                exr ? writeExr(d, path) : writePng(d, path);
+            } catch (const std::runtime_error& err) {
+                throw InputError({path, 0, 0, {}}, std::string("cannot be written: ") + err.what());
+            }
+        }
         if (options.json) {
             const nlohmann::json doc = {{"psnr_db", e.psnr},
                                         {"rmse", e.rmse},

@@ -9,10 +9,13 @@ struct CompareCommandOptions {
     std::string test;       // the image measured
     std::string reference;  // the image it is measured against
     bool json = false;
+    std::string difference;  // if set: write the difference image here (.exr or .png)
+    float gain = 4.0f;       // the difference image's scale
 };
 
-// Prints PSNR, RMSE, largest error and coverage difference. Returns the exit code: 0, or
-// 2 for images that cannot be read or differ in size (message on stderr).
+// Prints PSNR, RMSE, largest error and coverage difference, and writes the difference
+// image if asked. Returns the exit code: 0, or 2 for images that cannot be read or differ in
+// size, or a difference image that cannot be written (message on stderr).
 int runCompareCommand(const CompareCommandOptions& options);
 
 }  // namespace mpshade

@@ -55,6 +55,12 @@ int main(int argc, char** argv) {
     compareCmd->add_option("reference", compare.reference, "Image it is measured against")
         ->required();
     compareCmd->add_flag("--json", compare.json, "Machine-readable output");
+    compareCmd->add_option(
+        "--diff", compare.difference,
+        "Also write |image - reference| per channel, times --gain (.exr or .png)");
+    compareCmd->add_option("--gain", compare.gain, "Scale of the --diff image")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
 
     try {
         app.parse(argc, argv);

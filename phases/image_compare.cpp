@@ -28,4 +28,18 @@ ImageError compareImages(const Image& test, const Image& reference) {
     return e;
 }
 
+Image differenceImage(const Image& test, const Image& reference, float gain) {
+    MPSHADE_CHECK(test.width == reference.width && test.height == reference.height);
+    Image out(test.width, test.height);
+    const size_t pixels = static_cast<size_t>(test.width) * test.height;
+    for (size_t i = 0; i < pixels; ++i) {
+        for (int c = 0; c < 3; ++c)
+            out.rgba[4 * i + c] =
+                gain * std::fabs(std::clamp(test.rgba[4 * i + c], 0.0f, 1.0f) -
+                                 std::clamp(reference.rgba[4 * i + c], 0.0f, 1.0f));
+        out.rgba[4 * i + 3] = 1.0f;
+    }
+    return out;
+}
+
 }  // namespace mpshade

@@ -15,4 +15,8 @@ struct ImageError {
 // Both images must have the same size.
 ImageError compareImages(const Image& test, const Image& reference);
 
+// Where they differ: per pixel the absolute difference of each channel of RGB (each clamped
+// to [0, 1] first, as compareImages does) times `gain`, alpha 1. Both the same size.
+Image differenceImage(const Image& test, const Image& reference, float gain);
+
 }  // namespace mpshade

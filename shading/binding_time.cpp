@@ -2,6 +2,38 @@
 
 namespace mpshade {
 
+bool isDiscontinuous(Op op) {
+    switch (op) {
+        case Op::Floor:
+        case Op::Ceil:
+        case Op::Fract:
+        case Op::Sign:
+        case Op::Trunc:
+        case Op::Not:
+        case Op::IDiv:
+        case Op::Mod:
+        case Op::Step:
+        case Op::Lt:
+        case Op::Le:
+        case Op::Gt:
+        case Op::Ge:
+        case Op::Eq:
+        case Op::Ne:
+        case Op::And:
+        case Op::Or:
+        case Op::Select:
+        case Op::Cellnoise:
+            return true;
+        default:
+            return false;
+    }
+}
+
+bool mayRecompute(Op op, int imm, const FactorOptions& options) {
+    return opCost(op, imm) <= options.recomputeCostLimit &&
+           !(options.storeDiscontinuities && isDiscontinuous(op));
+}
+
 int opCost(Op op, int imm) {
     switch (op) {
         case Op::Const:
@@ -141,8 +173,7 @@ BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& 
                 }
                 default:
                     // Free values feed cheap arithmetic for free; expensive work on them is static.
-                    if (stage == Stage::Free &&
-                        opCost(inst.op, inst.imm) > options.recomputeCostLimit)
+                    if (stage == Stage::Free && !mayRecompute(inst.op, inst.imm, options))
                         stage = Stage::Static;
                     break;
             }

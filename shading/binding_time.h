@@ -26,6 +26,11 @@ struct FactorOptions {
     // only operations whose cost (opCost) is at most this: arithmetic, not noise, lighting
     // or occlusion.
     int recomputeCostLimit = 2;
+    // Nor discontinuous operations (step, floor, fract, comparisons, select...): stored,
+    // their edges are prefiltered with the rest of the n-tuple (a shader map's levels and
+    // probe footprint, or interpolation between facet vertices); repeated per shading point
+    // they would be point-sampled, and alias (a brick's mortar lines computed from s and t).
+    bool storeDiscontinuities = true;
     // Regroup sums and products so their static terms form one stored value (the patent's
     // C = A1 + A2 + A3 Kspec stores A1 + A2 and A3).
     bool reassociate = true;
@@ -33,6 +38,13 @@ struct FactorOptions {
 
 // A rough per-lane cost of an operation, in units of one float add.
 int opCost(Op op, int imm = 0);
+
+// Whether an operation's result can jump where its arguments change smoothly.
+bool isDiscontinuous(Op op);
+
+// Whether the dynamic part may repeat an operation whose arguments it has, rather than
+// read its result from the n-tuple.
+bool mayRecompute(Op op, int imm, const FactorOptions& options);
 
 struct BindingTimes {
     std::vector<Stage> stage;  // per value

