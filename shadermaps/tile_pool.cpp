@@ -18,7 +18,8 @@ int TilePool::allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t sta
         slot = static_cast<int>(owner_.size());
         MPSHADE_CHECK(owner_.size() < kMaxTiles);
         if (owner_.size() == blockCount_ * kTilesPerBlock)
-            blocks_[blockCount_++] = std::make_unique<unsigned char[]>(kTilesPerBlock * tileBytes_);
+            blocks_[blockCount_++] =
+                std::make_unique<unsigned char[]>(kTilesPerBlock * tileBytes_ + kSlackBytes);
         owner_.push_back(nullptr);
         key_.push_back(0);
         pinned_.push_back(0);

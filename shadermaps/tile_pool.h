@@ -6,6 +6,9 @@
 // (patent col. 10: "the tiles can be stored in and/or removed from a memory using a least
 // recently used (LRU) algorithm").
 //
+// Each block ends in kSlackBytes of zeros, so probes may load a texel's channels in whole
+// vectors (8 floats for 5 channels) even at a block's last texel.
+//
 // Threads: allocate() and free() may run on several threads at once (maps filled in
 // parallel share a pool); data() of a slot may run alongside them (blocks never move);
 // markUsed() may run on many threads at once (it writes atomically) but not alongside
@@ -24,6 +27,8 @@ class ShaderMap;
 
 class TilePool {
   public:
+    static constexpr size_t kSlackBytes = 64;
+
     explicit TilePool(size_t tileBytes);
     TilePool(const TilePool&) = delete;
     TilePool& operator=(const TilePool&) = delete;
