@@ -19,7 +19,9 @@ int main(int argc, char** argv) {
     renderCmd->add_option("scene", render.scene, "Scene file (.json)")->required();
     renderCmd->add_option("--out", render.outDir, "Output folder (created if missing)")->required();
     renderCmd
-        ->add_option("--mode", render.mode, "Renderer: reference (single-phase, exact geometry)")
+        ->add_option("--mode", render.mode,
+                     "Renderer: multiphase (static phase per object, dynamic phase per frame) or "
+                     "reference (single-phase: exact geometry, whole shaders)")
         ->capture_default_str();
     renderCmd->add_option("--frames", render.frames,
                           "Frames A:B (half-open; 0:2 is frames 0 and 1) or N");
@@ -33,7 +35,7 @@ int main(int argc, char** argv) {
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
     renderCmd->add_flag(
         "--compare", render.compare,
-        "With --mode multiphase: also render the reference; report PSNR and speed in stats.json");
+        "Multiphase: also render the reference; report PSNR and speed in stats.json");
 
     renderCmd->add_option("--truth-spp", render.truthSpp,
                           "With --compare: also measure both renderers against the reference "

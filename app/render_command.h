@@ -9,7 +9,7 @@ namespace mpshade {
 struct RenderCommandOptions {
     std::string scene;   // scene file
     std::string outDir;  // created if missing
-    std::string mode = "reference";
+    std::string mode = "multiphase";  // or "reference" (the judge)
     std::string frames;  // "A:B" half-open, or "N"; empty = every frame
     std::string size;    // "WxH"; empty = the scene's
     int spp = -1;        // -1 = the scene's; else 1..1024

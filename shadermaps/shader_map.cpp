@@ -119,6 +119,8 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
         return fromChildren && i >= key.tx * T && i < (key.tx + 1) * T && i < res &&
                j >= key.ty * T && j < (key.ty + 1) * T && j < res;
     };
+    // Border texels a resident neighbour holds are copied after the batch (copyBorders).
+    auto skipped = [&](int i, int j) { return interior(i, j) || borderFromNeighbour(key, i, j); };
     if (fromChildren) {
         float child[4][64];
         std::vector<float> wide;
@@ -149,7 +151,7 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
     for (int lj = 0; lj < validH; ++lj)
         for (int li = 0; li < validW; ++li) {
             const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
-            if (interior(i, j)) continue;
+            if (skipped(i, j)) continue;
             for (int sj = 0; sj < k; ++sj)
                 for (int si = 0; si < k; ++si) {
                     const float u =
@@ -182,7 +184,7 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
         for (int lj = 0; lj < validH; ++lj)
             for (int li = 0; li < validW; ++li) {
                 const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
-                if (interior(i, j)) continue;
+                if (skipped(i, j)) continue;
                 const size_t at = texelAt(li, lj);
                 for (size_t c = 0; c < channels; ++c) {
                     float sum = 0.0f;
@@ -196,6 +198,40 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
     ++stats.tiles;
     stats.texels += static_cast<uint64_t>(validW) * static_cast<uint64_t>(validH);
     stats.programRuns += n;
+}
+
+bool ShaderMap::borderFromNeighbour(const TileKey& key, int i, int j) const {
+    const int res = resolution(key.level);
+    if (i < 0 || j < 0 || i >= res || j >= res) return false;  // beyond the chart: evaluated
+    const int tx = i >> tileShift_, ty = j >> tileShift_;
+    if (tx == key.tx && ty == key.ty) return false;
+    return table_.find(
+               TileKey{key.chart, key.level, static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)}
+                   .packed()) >= 0;
+}
+
+void ShaderMap::copyBorders(const TileKey& key, int slot, FillStats& stats) {
+    const int T = options_.tileSize, border = options_.border;
+    const int res = resolution(key.level);
+    float value[kMaxCopyChannels];
+    std::vector<float> wide(channels_ > kMaxCopyChannels ? static_cast<size_t>(channels_) : 0);
+    float* out = wide.empty() ? value : wide.data();
+    const int validW = std::min(stride_, res - key.tx * T + 2 * border);
+    const int validH = std::min(stride_, res - key.ty * T + 2 * border);
+    for (int lj = 0; lj < validH; ++lj)
+        for (int li = 0; li < validW; ++li) {
+            // Only the frame of the tile can lie in a neighbour.
+            if (lj >= border && lj < border + T && li == border) li = border + T;
+            if (li >= validW) break;
+            const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
+            if (!borderFromNeighbour(key, i, j)) continue;
+            const TileKey from = tileOf(key.chart, key.level, i, j);
+            texel(from, slotOf(from), i, j, out);
+            const size_t at = (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) *
+                              static_cast<size_t>(channels_);
+            for (int c = 0; c < channels_; ++c) store(slot, at + static_cast<size_t>(c), out[c]);
+            ++stats.texelsCopied;
+        }
 }
 
 void ShaderMap::fill(std::span<const TileKey> keys) {
@@ -243,6 +279,12 @@ void ShaderMap::fill(std::span<const TileKey> keys) {
             fillTile(work[w], plan[w - begin].first, plan[w - begin].second, s.batch, s.points,
                      s.geometry, s.workspace, s.stats);
         });
+        // A texel is the same wherever it is evaluated (the program sees only its chart
+        // point), so borders inside the chart come from the neighbouring tile when that is
+        // resident: a 16 x 16 tile with a 1-texel border evaluates 256 texels, not 324.
+        tbb::parallel_for(begin, end, [&](size_t w) {
+            copyBorders(work[w], plan[w - begin].first, scratch.local().stats);
+        });
         begin = end;
     }
     for (const FillScratch& s : scratch) {
@@ -250,6 +292,7 @@ void ShaderMap::fill(std::span<const TileKey> keys) {
         fillStats_.tilesFromChildren += s.stats.tilesFromChildren;
         fillStats_.texels += s.stats.texels;
         fillStats_.programRuns += s.stats.programRuns;
+        fillStats_.texelsCopied += s.stats.texelsCopied;
     }
 }
 

@@ -151,6 +151,7 @@ TEST(Cli, SppAndSeedOverrideTheScene) {
     const nlohmann::json stats = nlohmann::json::parse(statsFile);
     EXPECT_EQ(stats["frames"][0]["samples"], 40 * 30 * 2);
     EXPECT_EQ(stats["seed"], 3);
+    EXPECT_EQ(stats["mode"], "multiphase") << "multi-phase is the default mode";
 }
 
 struct BadRun {
