@@ -195,6 +195,8 @@ constexpr int kSceneRate = -1, kPerSample = static_cast<int>(ShadingRate::Sample
 MPSHADE_FRAME_BENCH(vase, "examples/vase/scene.json");
 MPSHADE_FRAME_BENCH(teapot, "examples/teapot/scene.json");
 MPSHADE_FRAME_BENCH(courtyard, "examples/courtyard/scene.json");
+// The hard case of a 400 x 400 floor seen from 0.25 units above it, dollying along it.
+MPSHADE_FRAME_BENCH(grazing_floor, "tests/data/scenes/grazing_floor.json");
 
 }  // namespace
 }  // namespace mpshade
