@@ -162,6 +162,31 @@ InputLocation locationOfByte(const std::string& path, const std::string& text, s
     return {path, line, col, {}};
 }
 
+// A scene nests five levels deep; anything near kMaxJsonNesting is a generated or hostile
+// file, stopped before the parser builds it (and before anything walks it recursively).
+void checkNesting(const std::string& path, const std::string& text) {
+    int depth = 0;
+    bool inString = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonNesting)
+                throw InputError(locationOfByte(path, text, i),
+                                 "invalid JSON: nested more than " +
+                                     std::to_string(kMaxJsonNesting) + " levels deep");
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+}
+
 }  // namespace
 
 nlohmann::json parseJsonFile(const std::string& path) {
@@ -170,6 +195,7 @@ nlohmann::json parseJsonFile(const std::string& path) {
     std::ostringstream buffer;
     buffer << in.rdbuf();
     const std::string text = buffer.str();
+    checkNesting(path, text);
     try {
         return nlohmann::json::parse(text);
     } catch (const nlohmann::json::parse_error& e) {

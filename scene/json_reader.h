@@ -57,6 +57,10 @@ class JsonNode {
 // A number as a person writes it: 0.5, 1e-06, 12.
 std::string shortNumber(double value);
 
+// Arrays and objects nested deeper than this are an error (file:line:col of the first
+// bracket too deep).
+inline constexpr int kMaxJsonNesting = 64;
+
 // Parses a JSON file; syntax errors name file:line:col.
 nlohmann::json parseJsonFile(const std::string& path);
 

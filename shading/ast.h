@@ -21,6 +21,7 @@ struct Expr {
     TokenKind op = TokenKind::End;            // Unary, Binary
     std::vector<std::unique_ptr<Expr>> args;  // operands; Index: [base, index]
     ValueType type = ValueType::Void;         // filled in by the type checker
+    int height = 1;                           // levels of the tree below and including it
 };
 
 struct Stmt {

@@ -1,5 +1,7 @@
 #include "shading/parser.h"
 
+#include <algorithm>
+
 #include "geometry/error.h"
 
 namespace mpshade {
@@ -68,6 +70,32 @@ class Parser {
     }
     [[noreturn]] void fail(const Token& at, const std::string& message) const {
         throw InputError({file_, at.line, at.column, {}}, message);
+    }
+    // One level of nesting for as long as it lives.
+    class Nest {
+      public:
+        Nest(Parser& parser, const Token& at) : parser_(parser) {
+            if (++parser_.nesting_ > kMaxShaderNesting) parser_.tooDeep(at);
+        }
+        ~Nest() { --parser_.nesting_; }
+        Nest(const Nest&) = delete;
+        Nest& operator=(const Nest&) = delete;
+
+      private:
+        Parser& parser_;
+    };
+    [[noreturn]] void tooDeep(const Token& at) const {
+        fail(at, "the shader nests more than " + std::to_string(kMaxShaderNesting) +
+                     " levels deep here (blocks, parentheses and operators each count one; "
+                     "a chain like a + b + c one per operator): split it with variables");
+    }
+    // Sets e's height from its operands and checks the depth it reaches.
+    std::unique_ptr<Expr> measured(std::unique_ptr<Expr> e, const Token& at) const {
+        int below = 0;
+        for (const auto& a : e->args) below = std::max(below, a->height);
+        e->height = below + 1;
+        if (nesting_ + e->height - 1 > kMaxShaderNesting) tooDeep(at);
+        return e;
     }
     const Token& expect(TokenKind kind, const std::string& what) {
         if (peek().kind != kind) fail(peek(), "expected " + what + ", found " + spell(peek()));
@@ -150,6 +178,7 @@ class Parser {
 
     std::unique_ptr<Stmt> statement() {
         const Token& first = peek();
+        const Nest nest(*this, first);
         if (first.kind == TokenKind::LBrace) return block();
         if (first.kind == TokenKind::Identifier && first.text == "if") {
             next();
@@ -234,13 +263,14 @@ class Parser {
             e->op = opTok.kind;
             e->args.push_back(std::move(lhs));
             e->args.push_back(binary(prec + 1));
-            lhs = std::move(e);
+            lhs = measured(std::move(e), opTok);
         }
         return lhs;
     }
 
     std::unique_ptr<Expr> unary() {
         const Token& t = peek();
+        const Nest nest(*this, t);
         if (t.kind == TokenKind::Minus || t.kind == TokenKind::Bang || t.kind == TokenKind::Plus) {
             next();
             auto operand = unary();
@@ -248,7 +278,7 @@ class Parser {
             auto e = makeExpr(Expr::Kind::Unary, t);
             e->op = t.kind;
             e->args.push_back(std::move(operand));
-            return e;
+            return measured(std::move(e), t);
         }
         return postfix();
     }
@@ -261,7 +291,7 @@ class Parser {
             idx->args.push_back(std::move(e));
             idx->args.push_back(expression());
             expect(TokenKind::RBracket, "']' after the component index");
-            e = std::move(idx);
+            e = measured(std::move(idx), open);
         }
         return e;
     }
@@ -297,7 +327,7 @@ class Parser {
                         }
                     }
                     expect(TokenKind::RParen, "')' or ',' in the call to '" + t.text + "'");
-                    return call;
+                    return measured(std::move(call), t);
                 }
                 auto e = makeExpr(Expr::Kind::Name, t);
                 e->name = t.text;
@@ -311,6 +341,7 @@ class Parser {
     std::string file_;
     std::vector<Token> tokens_;
     size_t pos_ = 0;
+    int nesting_ = 0;  // statements and operands being parsed, innermost included
 };
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "geometry/error.h"
+#include "scene/json_reader.h"
 #include "scene/scene.h"
 #include "scene/scene_state.h"
 #include "scene/variability.h"
@@ -79,6 +80,11 @@ const BadScene kBadScenes[] = {
      "invalid JSON: syntax error while parsing value - unexpected end of input; expected '[', '{', "
      "or a literal"},
     {"not_an_object", "", "(top level)", 0, 0, "a scene must be a JSON object"},
+    {"deep_nesting", "", "", 1, 77, "invalid JSON: nested more than 64 levels deep"},
+    {"deep_shader", "tests/data/bad_shaders/deep_parens.sl", "", 3, 526,
+     "the shader nests more than 512 levels deep here (blocks, parentheses and operators each "
+     "count one; a chain like a + b + c one per operator): split it with variables (loading "
+     "shaders.deep of "},
     {"animated_count", "tests/data/shaders/counted.sl", "", 3, 32,
      "the occlusion ray count must be a constant (binding objects[0] 'ball' of "},
 };
@@ -109,6 +115,31 @@ TEST(BadScenes, GoldenErrors) {
          std::filesystem::directory_iterator(sourcePath("tests/data/bad_scenes")))
         files += entry.path().extension() == ".json";
     EXPECT_EQ(files, checked);
+}
+
+TEST(BadScenes, JsonNestingStopsJustPastItsLimit) {
+    // 64 levels (the object and 63 arrays, brackets inside a string not counted) are read
+    // and judged as a scene; one more is the nesting error at that bracket.
+    const std::string dir = testing::TempDir();
+    const auto write = [&](int arrays) {
+        const std::string path = dir + "/nest" + std::to_string(arrays) + ".json";
+        std::ofstream(path) << "{\"settings\": " << std::string(static_cast<size_t>(arrays), '[')
+                            << "\"[[[[\"" << std::string(static_cast<size_t>(arrays), ']') << "}";
+        return path;
+    };
+    try {
+        loadScene(write(kMaxJsonNesting - 1));
+        ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.where().jsonPath, "settings") << e.what();
+    }
+    try {
+        loadScene(write(kMaxJsonNesting));
+        ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.message(), "invalid JSON: nested more than 64 levels deep");
+        EXPECT_EQ(e.where().column, 13 + kMaxJsonNesting);
+    }
 }
 
 TEST(Keyframes, InterpolateLinearlyAndHoldOutside) {

@@ -6,7 +6,9 @@
 
 #include "geometry/error.h"
 #include "scene/variability.h"
+#include "shading/factoring.h"
 #include "shading/lower.h"
+#include "shading/parser.h"
 #include "shading/shader_compiler.h"
 #include "test_support.h"
 
@@ -96,6 +98,67 @@ TEST(LanguageErrors, GoldenMessages) {
                 << e.what();
         }
     }
+}
+
+// The column of the first error of `source`, or 0 if it compiles and factors.
+int errorColumn(const std::string& source, std::string* message = nullptr) {
+    try {
+        auto ast = compileShaderText("deep.sl", source);
+        lowerShader(*ast, {});
+        factorShader(*ast, {});
+        return 0;
+    } catch (const InputError& e) {
+        if (message) *message = e.message();
+        return e.where().column;
+    }
+}
+
+std::string repeat(const std::string& s, int n) {
+    std::string out;
+    for (int i = 0; i < n; ++i) out += s;
+    return out;
+}
+
+TEST(LanguageErrors, NestingIsBoundedOnTheBoundary) {
+    // `float x = (...(1)...)` with k parentheses: the statement is one level, each operand
+    // one more, so k = kMaxShaderNesting - 2 is the deepest accepted; it must also get
+    // through type checking, lowering and factoring (recursive) without overflowing the
+    // stack, which the sanitizer build checks with its larger frames.
+    const auto parens = [](int k) {
+        return "surface s() { float x = " + repeat("(", k) + "u" + repeat(")", k) +
+               "; Ci = color(x); }";
+    };
+    EXPECT_EQ(errorColumn(parens(kMaxShaderNesting - 2)), 0);
+    std::string message;
+    const int prefix = static_cast<int>(std::string("surface s() { float x = ").size());
+    EXPECT_EQ(errorColumn(parens(kMaxShaderNesting - 1), &message),
+              prefix + kMaxShaderNesting - 1 + 1)
+        << "points at the operand one level too deep";
+    EXPECT_NE(message.find("nests more than 512 levels"), std::string::npos) << message;
+    // A chain of n terms is n - 1 levels deep under its statement.
+    const auto chain = [](int n) {
+        return "surface s() { float x = u" + repeat(" + u", n - 1) + "; Ci = color(x); }";
+    };
+    EXPECT_EQ(errorColumn(chain(kMaxShaderNesting)), 0);
+    EXPECT_GT(errorColumn(chain(kMaxShaderNesting + 1)), 0);
+    // Nested blocks: the body's block is not a statement; each inner one is, then the
+    // assignment, its call and the call's argument.
+    const auto blocks = [](int k) {
+        return "surface s() { " + repeat("{", k) + "Ci = color(u);" + repeat("}", k) + " }";
+    };
+    EXPECT_EQ(errorColumn(blocks(kMaxShaderNesting - 3)), 0);
+    EXPECT_GT(errorColumn(blocks(kMaxShaderNesting - 2)), 0);
+}
+
+TEST(LanguageErrors, HostileNestingIsAnErrorNotACrash) {
+    // Found crashing (stack overflow) before the parser bounded nesting.
+    EXPECT_GT(errorColumn("surface s() { Ci = color(" + repeat("(", 100000) + "1" +
+                          repeat(")", 100000) + "); }"),
+              0);
+    EXPECT_GT(errorColumn("surface s() { Ci = color(1" + repeat(" + 1", 199999) + "); }"), 0);
+    EXPECT_GT(errorColumn("surface s() { Ci = color(" + repeat("-", 100000) + "1); }"), 0);
+    EXPECT_GT(errorColumn("surface s() { Ci = color(u" + repeat("[0]", 100000) + "); }"), 0);
+    EXPECT_GT(errorColumn("surface s() { " + repeat("if (u > 0) ", 100000) + "Ci = 1; }"), 0);
 }
 
 TEST(LanguageErrors, MissingFile) {
