@@ -10,21 +10,26 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "app/output_files.h"
 #include "geometry/error.h"
 
 namespace mpshade {
 namespace {
 
-void write(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc format,
-           const void* data) {
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) throw std::runtime_error("cannot write " + path + ": " + OIIO::geterror());
-    if (!out->open(path, spec) || !out->write_image(format, data) || !out->close())
-        throw std::runtime_error("cannot write " + path + ": " + out->geterror());
+// Writes `data` as a `formatName` file ("openexr", "png") under a temporary name, renamed
+// to `path` once complete (output_files.h).
+void write(const std::string& path, const char* formatName, const OIIO::ImageSpec& spec,
+           OIIO::TypeDesc format, const void* data) {
+    writeAtomically(path, [&](const std::string& temporary) {
+        auto out = OIIO::ImageOutput::create(formatName);
+        if (!out) throw std::runtime_error(OIIO::geterror());
+        if (!out->open(temporary, spec) || !out->write_image(format, data) || !out->close())
+            throw std::runtime_error(out->geterror());
+    });
 }
 
 float linearToSrgb(float c) {
-    c = std::clamp(c, 0.0f, 1.0f);
+    c = c > 0.0f ? std::min(c, 1.0f) : 0.0f;  // NaN to 0
     return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
 }
 
@@ -55,7 +60,14 @@ Image readImage(const std::string& path) {
 void writeExr(const Image& image, const std::string& path) {
     OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::HALF);
     spec.attribute("compression", "zip");
-    write(path, spec, OIIO::TypeDesc::FLOAT, image.rgba.data());
+    // Half floats end at 65504: larger values (a light of absurd intensity) are written as
+    // that, not as infinity, and a NaN (which the renderers never produce) as 0.
+    std::vector<float> clamped(image.rgba.size());
+    for (size_t i = 0; i < clamped.size(); ++i) {
+        const float v = image.rgba[i];
+        clamped[i] = v == v ? std::clamp(v, -65504.0f, 65504.0f) : 0.0f;
+    }
+    write(path, "openexr", spec, OIIO::TypeDesc::FLOAT, clamped.data());
 }
 
 void writePng(const Image& image, const std::string& path) {
@@ -65,7 +77,7 @@ void writePng(const Image& image, const std::string& path) {
             rgb[3 * i + c] = static_cast<unsigned char>(
                 std::lround(255.0f * linearToSrgb(image.rgba[4 * i + c])));
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-    write(path, spec, OIIO::TypeDesc::UINT8, rgb.data());
+    write(path, "png", spec, OIIO::TypeDesc::UINT8, rgb.data());
 }
 
 }  // namespace mpshade

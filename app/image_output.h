@@ -9,7 +9,8 @@
 
 namespace mpshade {
 
-// Throws std::runtime_error with OpenImageIO's message on failure.
+// Written atomically (output_files.h); throws OutputError naming the file on failure.
+// EXR values beyond the half-float range are clamped to +-65504.
 void writeExr(const Image& image, const std::string& path);
 void writePng(const Image& image, const std::string& path);
 // Reads any image OpenImageIO reads as linear RGBA floats (alpha 1 if it has none; the

@@ -6,6 +6,7 @@
 
 #include "app/compare_command.h"
 #include "app/factor_command.h"
+#include "app/output_files.h"
 #include "app/render_command.h"
 
 int main(int argc, char** argv) {
@@ -80,6 +81,9 @@ int main(int argc, char** argv) {
         if (renderCmd->parsed()) return mpshade::runRenderCommand(render);
         if (factorCmd->parsed()) return mpshade::runFactorCommand(factor);
         if (compareCmd->parsed()) return mpshade::runCompareCommand(compare);
+    } catch (const mpshade::OutputError& e) {
+        std::fprintf(stderr, "mpshade: error: %s\n", e.what());
+        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "mpshade: internal error: %s\n", e.what());
         return 1;

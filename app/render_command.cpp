@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/image_output.h"
+#include "app/interrupt_watch.h"
+#include "app/output_files.h"
 #include "geometry/error.h"
 #include "phases/image_compare.h"
 #include "phases/multiphase_renderer.h"
@@ -119,11 +121,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         int first, last;
         parseFrames(options.frames, scene.frameCount(), first, last);
 
-        std::error_code ec;
-        std::filesystem::create_directories(options.outDir, ec);
-        if (ec)
-            throw InputError({options.outDir, 0, 0, {}},
-                             "cannot create the output folder: " + ec.message());
+        prepareOutputFolder(options.outDir);
 
         const bool multiphase = options.mode == "multiphase";
         std::unique_ptr<ReferenceRenderer> reference;
@@ -148,6 +146,49 @@ int runRenderCommand(const RenderCommandOptions& options) {
         bar.setFirst(first);
         nlohmann::json frames = nlohmann::json::array();
         const auto start = std::chrono::steady_clock::now();
+        // stats.json, rewritten (atomically) after every frame: what a stopped render
+        // finished is always described.
+        const auto writeStats = [&] {
+            const int width = render.width > 0 ? render.width : scene.settings.width;
+            const int height = render.height > 0 ? render.height : scene.settings.height;
+            nlohmann::json doc = {
+                {"scene", options.scene},
+                {"mode", options.mode},
+                {"width", width},
+                {"height", height},
+                {"samples_per_pixel", render.samplesPerPixel > 0 ? render.samplesPerPixel
+                                                                 : scene.settings.samplesPerPixel},
+                {"seed", options.seed},
+                {"frames_requested", last - first},
+                {"total_wall_seconds",
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
+                {"frames", frames}};
+            if (multi) {
+                doc["shading_rate"] =
+                    scene.settings.shadingRate == ShadingRate::Pixel ? "pixel" : "sample";
+                nlohmann::json objects = nlohmann::json::array();
+                for (size_t i = 0; i < multi->objectCount(); ++i) {
+                    const ObjectReport& r = multi->report(i);
+                    const char* kind = r.kind == Representation::Facets      ? "facets"
+                                       : r.kind == Representation::ShaderMap ? "shadermap"
+                                                                             : "none (never seen)";
+                    objects.push_back({{"name", r.name},
+                                       {"representation", kind},
+                                       {"reason", r.reason},
+                                       {"static_runs", r.staticRuns},
+                                       {"static_seconds", r.staticCosts.seconds},
+                                       {"frames_drawn", r.framesDrawn},
+                                       {"facets", r.facets},
+                                       {"longest_edge_pixels", r.longestEdgePixels},
+                                       {"facet_bytes", r.facetBytes},
+                                       {"resident_tiles", r.residentTiles},
+                                       {"map_bytes", r.mapBytes}});
+                }
+                doc["objects"] = objects;
+            }
+            writeTextFile(std::filesystem::path(options.outDir) / "stats.json", doc.dump(2) + "\n");
+        };
+        const InterruptWatch watch;
         for (int frame = first; frame < last; ++frame) {
             FrameStats stats;
             const ProgressFn progress = [&](int done, int total) {
@@ -243,51 +284,24 @@ int runRenderCommand(const RenderCommandOptions& options) {
                         stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0);
             }
             frames.push_back(entry);
+            writeStats();
+            if (interrupted()) break;
         }
         bar.finish();
-        const int width = render.width > 0 ? render.width : scene.settings.width;
-        const int height = render.height > 0 ? render.height : scene.settings.height;
-        nlohmann::json doc = {
-            {"scene", options.scene},
-            {"mode", options.mode},
-            {"width", width},
-            {"height", height},
-            {"samples_per_pixel",
-             render.samplesPerPixel > 0 ? render.samplesPerPixel : scene.settings.samplesPerPixel},
-            {"seed", options.seed},
-            {"total_wall_seconds",
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
-            {"frames", frames}};
-        if (multi) {
-            doc["shading_rate"] =
-                scene.settings.shadingRate == ShadingRate::Pixel ? "pixel" : "sample";
-            nlohmann::json objects = nlohmann::json::array();
-            for (size_t i = 0; i < multi->objectCount(); ++i) {
-                const ObjectReport& r = multi->report(i);
-                const char* kind = r.kind == Representation::Facets      ? "facets"
-                                   : r.kind == Representation::ShaderMap ? "shadermap"
-                                                                         : "none (never seen)";
-                objects.push_back({{"name", r.name},
-                                   {"representation", kind},
-                                   {"reason", r.reason},
-                                   {"static_runs", r.staticRuns},
-                                   {"static_seconds", r.staticCosts.seconds},
-                                   {"frames_drawn", r.framesDrawn},
-                                   {"facets", r.facets},
-                                   {"longest_edge_pixels", r.longestEdgePixels},
-                                   {"facet_bytes", r.facetBytes},
-                                   {"resident_tiles", r.residentTiles},
-                                   {"map_bytes", r.mapBytes}});
-            }
-            doc["objects"] = objects;
+        if (interrupted()) {
+            std::fprintf(stderr,
+                         "mpshade: stopped by the user after %zu frame(s); stats.json "
+                         "describes them\n",
+                         frames.size());
+            return 130;
         }
-        std::ofstream out(std::filesystem::path(options.outDir) / "stats.json");
-        out << doc.dump(2) << "\n";
-        if (!out) throw std::runtime_error("cannot write stats.json in " + options.outDir);
         return 0;
     } catch (const InputError& e) {
         std::fprintf(stderr, "mpshade: %s\n", e.what());
         return 2;
+    } catch (const OutputError& e) {
+        std::fprintf(stderr, "mpshade: error: %s\n", e.what());
+        return 1;
     }
 }
 

@@ -7,12 +7,12 @@
 namespace mpshade {
 
 struct RenderCommandOptions {
-    std::string scene;   // scene file
-    std::string outDir;  // created if missing
+    std::string scene;                // scene file
+    std::string outDir;               // created if missing
     std::string mode = "multiphase";  // or "reference" (the judge)
-    std::string frames;  // "A:B" half-open, or "N"; empty = every frame
-    std::string size;    // "WxH"; empty = the scene's
-    int spp = -1;        // -1 = the scene's; else 1..1024
+    std::string frames;               // "A:B" half-open, or "N"; empty = every frame
+    std::string size;                 // "WxH"; empty = the scene's
+    int spp = -1;                     // -1 = the scene's; else 1..1024
     uint32_t seed = 0;
     bool quiet = false;       // no progress bar
     bool compare = false;     // multiphase: also render the reference, report error and speed

@@ -1,5 +1,8 @@
 // scene_loader.cpp -- the scene file reader (docs/scene-format.md is the contract).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 
@@ -46,8 +49,37 @@ void addKey(Keyframes<T>& frames, const JsonNode& key, const char* field, float 
     }
 }
 
-glm::vec3 vec3Of(const JsonNode& n) {
-    return n.vec3();
+// Positions and lengths mpshade renders correctly: everything is float, and ray queries
+// need every object-space coordinate (the eye seen from an object included) well inside
+// the ray tracer's valid range (about 1.8e18): positions within 1e8 of the origin, scales
+// and sizes in [1e-8, 1e8] keep the eye within 2e16 in any object's coordinates.
+constexpr double kMaxCoordinate = 1e8;
+constexpr double kMinLength = 1e-8, kMaxLength = 1e8;
+
+std::string limitText(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    std::string text = buf;  // 1e+08 -> 1e8, 1e-08 -> 1e-8
+    for (const char* from : {"e+0", "e+", "e-0"})
+        if (auto at = text.find(from); at != std::string::npos)
+            text.replace(at, std::strlen(from), from[1] == '-' ? "e-" : "e");
+    return text;
+}
+
+glm::vec3 positionOf(const JsonNode& n) {
+    const glm::vec3 v = n.vec3();
+    for (int c = 0; c < 3; ++c)
+        if (!(std::fabs(v[c]) <= kMaxCoordinate))
+            n.fail("coordinates must be within " + limitText(kMaxCoordinate) +
+                   " of the origin (found " + limitText(v[c]) + ")");
+    return v;
+}
+double lengthOf(const JsonNode& n) {
+    const double v = n.positive();
+    if (!(v >= kMinLength && v <= kMaxLength))
+        n.fail("expected a length in [" + limitText(kMinLength) + ", " + limitText(kMaxLength) +
+               "], found " + limitText(v));
+    return v;
 }
 glm::vec3 colorOf(const JsonNode& n) {
     glm::vec3 c = n.vec3();
@@ -69,7 +101,7 @@ glm::vec4 rotationOf(const JsonNode& n) {
 float scaleOf(const JsonNode& n) {
     if (n.isArray())
         n.fail("scale must be one positive number (mpshade supports uniform scale only)");
-    return static_cast<float>(n.positive());
+    return static_cast<float>(lengthOf(n));
 }
 
 template <typename T>
@@ -171,17 +203,17 @@ class SceneLoader {
                    shortNumber(cam.zNear) + ")");
         if (auto k = c.optional("keys")) {
             readKeys(*k, {"eye", "target", "up"}, [&](const JsonNode& key, float t) {
-                addKey(cam.eye, key, "eye", t, vec3Of);
-                addKey(cam.target, key, "target", t, vec3Of);
+                addKey(cam.eye, key, "eye", t, positionOf);
+                addKey(cam.target, key, "target", t, positionOf);
                 addKey(cam.up, key, "up", t, directionOf);
             });
         }
         if (auto n = c.optional("eye")) {
-            const glm::vec3 value = n->vec3();
+            const glm::vec3 value = positionOf(*n);
             if (cam.eye.empty()) cam.eye = constant(value);  // keys override
         }
         if (auto n = c.optional("target")) {
-            const glm::vec3 value = n->vec3();
+            const glm::vec3 value = positionOf(*n);
             if (cam.target.empty()) cam.target = constant(value);  // keys override
         }
         if (auto n = c.optional("up")) {
@@ -230,7 +262,7 @@ class SceneLoader {
                      [&](const JsonNode& key, float t) {
                          addKey(light.color, key, "color", t, colorOf);
                          addKey(light.intensity, key, "intensity", t, intensityOf);
-                         if (hasPos) addKey(light.position, key, "position", t, vec3Of);
+                         if (hasPos) addKey(light.position, key, "position", t, positionOf);
                          if (hasDir) addKey(light.direction, key, "direction", t, directionOf);
                      });
         }
@@ -243,7 +275,7 @@ class SceneLoader {
         };
         direct("color", light.color, colorOf);
         direct("intensity", light.intensity, intensityOf);
-        if (light.kind == LightKind::Point) direct("position", light.position, vec3Of);
+        if (light.kind == LightKind::Point) direct("position", light.position, positionOf);
         if (light.kind == LightKind::Distant) direct("direction", light.direction, directionOf);
         if (light.color.empty()) light.color = constant(glm::vec3(1.0f));
         if (light.intensity.empty()) light.intensity = constant(1.0f);
@@ -277,12 +309,12 @@ class SceneLoader {
         if (type == "sphere") {
             g.allowKeys({"type", "radius"});
             return std::make_shared<const Surface>(
-                Sphere{static_cast<float>(g["radius"].positive())});
+                Sphere{static_cast<float>(lengthOf(g["radius"]))});
         }
         if (type == "torus") {
             g.allowKeys({"type", "major", "minor"});
-            const float major = static_cast<float>(g["major"].positive());
-            const float minor = static_cast<float>(g["minor"].positive());
+            const float major = static_cast<float>(lengthOf(g["major"]));
+            const float minor = static_cast<float>(lengthOf(g["minor"]));
             if (!(minor < major))
                 g["minor"].fail("minor must be smaller than major (a self-intersecting torus)");
             return std::make_shared<const Surface>(Torus{major, minor});
@@ -291,9 +323,8 @@ class SceneLoader {
             g.allowKeys({"type", "size"});
             JsonNode size = g["size"];
             if (!size.isArray() || size.size() != 2) size.fail("expected [width, depth]");
-            return std::make_shared<const Surface>(
-                Plane{static_cast<float>(size.at(0).positive()),
-                      static_cast<float>(size.at(1).positive())});
+            return std::make_shared<const Surface>(Plane{static_cast<float>(lengthOf(size.at(0))),
+                                                         static_cast<float>(lengthOf(size.at(1)))});
         }
         if (type == "bezier") {
             g.allowKeys({"type", "file"});
@@ -366,6 +397,15 @@ class SceneLoader {
                 o["name"].fail("another object is already named '" + obj.name + "'");
         obj.surface =
             withContext(o["geometry"], [&] { return geometry(o["geometry"], obj.geometryType); });
+        {
+            const Bounds3 b = surfaceBounds(*obj.surface);
+            for (int c = 0; c < 3; ++c)
+                if (!(std::fabs(b.lo[c]) <= kMaxCoordinate && std::fabs(b.hi[c]) <= kMaxCoordinate))
+                    o["geometry"].fail("the geometry reaches " +
+                                       limitText(std::max(std::fabs(b.lo[c]), std::fabs(b.hi[c]))) +
+                                       " from its origin; coordinates must be within " +
+                                       limitText(kMaxCoordinate));
+        }
         obj.shaderName = o["shader"].string();
         auto sh = scene_.shaders.find(obj.shaderName);
         if (sh == scene_.shaders.end())
@@ -392,7 +432,7 @@ class SceneLoader {
         ObjectTransform& tr = obj.transform;
         if (auto t = o.optional("keys")) {
             readKeys(*t, {"translate", "rotate", "scale"}, [&](const JsonNode& key, float time) {
-                addKey(tr.translate, key, "translate", time, vec3Of);
+                addKey(tr.translate, key, "translate", time, positionOf);
                 addKey(tr.rotate, key, "rotate", time, rotationOf);
                 addKey(tr.scale, key, "scale", time, scaleOf);
             });
@@ -401,7 +441,7 @@ class SceneLoader {
             t->allowKeys({"translate", "rotate", "scale"});
             // Keyed fields override the static transform.
             if (auto n = t->optional("translate"); n && tr.translate.empty())
-                tr.translate = constant(n->vec3());
+                tr.translate = constant(positionOf(*n));
             if (auto n = t->optional("rotate"); n && tr.rotate.empty())
                 tr.rotate = constant(rotationOf(*n));
             if (auto n = t->optional("scale"); n && tr.scale.empty())

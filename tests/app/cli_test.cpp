@@ -263,6 +263,57 @@ TEST(Cli, FactorBadInput) {
     }
 }
 
+TEST(Cli, CtrlCKeepsEveryFinishedFrameAndValidStats) {
+    // Ctrl-C once the first frame is out: the render stops after the frame under way with
+    // status 130, stats.json lists exactly the frames on disk, and no partial file is left.
+    const std::string out = tempDir("interrupt");
+    const std::string script = ::testing::TempDir() + "mpshade_interrupt.sh";
+    std::ofstream(script) << "set -m\n"  // job control: the background job keeps SIGINT
+                          << "cd '" MPSHADE_SOURCE_DIR "'\n'" MPSHADE_BINARY
+                          << "' render examples/courtyard/scene.json --size 160x90 --quiet --out "
+                          << out << " &\npid=$!\n"
+                          << "for i in $(seq 1000); do [ -f " << out
+                          << "/stats.json ] && break; sleep 0.02; done\n"
+                          << "kill -INT $pid\nwait $pid\necho \"rc=$?\"\n";
+    FILE* pipe = popen(("bash " + script + " 2>&1").c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string output;
+    std::array<char, 4096> buffer;
+    while (fgets(buffer.data(), buffer.size(), pipe)) output += buffer.data();
+    pclose(pipe);
+    EXPECT_NE(output.find("rc=130"), std::string::npos) << output;
+    EXPECT_NE(output.find("stopping after this frame"), std::string::npos) << output;
+    std::ifstream statsFile(out + "/stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(statsFile);
+    const size_t written = stats["frames"].size();
+    EXPECT_GE(written, 1u);
+    EXPECT_LT(written, static_cast<size_t>(stats["frames_requested"]));
+    size_t exrs = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(out)) {
+        const std::string name = entry.path().filename().string();
+        EXPECT_EQ(name.find("partial"), std::string::npos) << name;
+        if (entry.path().extension() == ".exr") ++exrs;
+    }
+    EXPECT_EQ(exrs, written);
+    for (const auto& f : stats["frames"]) {
+        char name[32];
+        std::snprintf(name, sizeof name, "/frame_%04d.png", f["index"].get<int>());
+        EXPECT_TRUE(std::filesystem::exists(out + name)) << name;
+    }
+}
+
+TEST(Cli, AnOutputPathThatIsAFileIsABadPath) {
+    const std::string dir = tempDir("notafolder");
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "/file") << "x";
+    const CliRun run = mpshade("render examples/vase/scene.json --frames 0 --out " + dir + "/file");
+    EXPECT_EQ(run.exitCode, 2) << run.output;
+    EXPECT_EQ(
+        run.output.rfind("mpshade: " + dir + "/file: error: cannot create the output folder", 0),
+        0u)
+        << run.output;
+}
+
 TEST(Cli, HelpAndVersion) {
     EXPECT_EQ(mpshade("--version").exitCode, 0);
     const CliRun help = mpshade("render --help");

@@ -81,6 +81,12 @@ const BadScene kBadScenes[] = {
      "or a literal"},
     {"not_an_object", "", "(top level)", 0, 0, "a scene must be a JSON object"},
     {"deep_nesting", "", "", 1, 77, "invalid JSON: nested more than 64 levels deep"},
+    {"camera_at_1e38", "", "camera.eye", 0, 0,
+     "coordinates must be within 1e8 of the origin (found 1e38)"},
+    {"scale_1e-30", "", "objects[0].transform.scale", 0, 0,
+     "expected a length in [1e-8, 1e8], found 1e-30"},
+    {"plane_1e30", "", "objects[0].geometry.size[0]", 0, 0,
+     "expected a length in [1e-8, 1e8], found 1e30"},
     {"deep_shader", "tests/data/bad_shaders/deep_parens.sl", "", 3, 526,
      "the shader nests more than 512 levels deep here (blocks, parentheses and operators each "
      "count one; a chain like a + b + c one per operator): split it with variables (loading "
@@ -140,6 +146,27 @@ TEST(BadScenes, JsonNestingStopsJustPastItsLimit) {
         EXPECT_EQ(e.message(), "invalid JSON: nested more than 64 levels deep");
         EXPECT_EQ(e.where().column, 13 + kMaxJsonNesting);
     }
+}
+
+TEST(BadScenes, CoordinateAndLengthLimitsHoldOnTheBoundary) {
+    // The limits themselves load; just past them is the error.
+    const std::string dir = testing::TempDir();
+    const auto scene = [&](const std::string& eye, const std::string& scale,
+                           const std::string& radius) {
+        const std::string path = dir + "/limits.json";
+        std::ofstream(path) << R"({"camera": {"eye": )" << eye
+                            << R"(, "target": [0, 0, 0]}, "shaders": {"p": ")"
+                            << sourcePath("examples/shaders/plastic.sl")
+                            << R"("}, "objects": [{"name": "b", "shader": "p", "geometry": )"
+                            << R"({"type": "sphere", "radius": )" << radius
+                            << R"(}, "transform": {"scale": )" << scale << "}}]}";
+        return path;
+    };
+    EXPECT_NO_THROW(loadScene(scene("[1e8, -1e8, 0]", "1e-8", "1e8")));
+    EXPECT_NO_THROW(loadScene(scene("[0, 0, 5]", "1e8", "1e-8")));
+    EXPECT_THROW(loadScene(scene("[1.0001e8, 0, 0]", "1", "1")), InputError);
+    EXPECT_THROW(loadScene(scene("[0, 0, 5]", "0.9999e-8", "1")), InputError);
+    EXPECT_THROW(loadScene(scene("[0, 0, 5]", "1", "1.0001e8")), InputError);
 }
 
 TEST(Keyframes, InterpolateLinearlyAndHoldOutside) {
