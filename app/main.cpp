@@ -34,6 +34,9 @@ int main(int argc, char** argv) {
                           "Multiphase: run the dynamic shader per 'sample' or per 'pixel' "
                           "(overrides the scene)");
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
+    renderCmd->add_option("--memory-mb", render.memoryMb,
+                          "Refuse a render estimated to need more memory than this (MB; "
+                          "default: 3/4 of physical memory)");
     renderCmd->add_flag(
         "--compare", render.compare,
         "Multiphase: also render the reference; report PSNR and speed in stats.json");

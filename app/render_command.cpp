@@ -12,6 +12,7 @@
 
 #include "app/image_output.h"
 #include "app/interrupt_watch.h"
+#include "app/memory_limit.h"
 #include "app/output_files.h"
 #include "geometry/error.h"
 #include "phases/image_compare.h"
@@ -120,10 +121,26 @@ int runRenderCommand(const RenderCommandOptions& options) {
         parseSize(options.size, render.width, render.height);
         int first, last;
         parseFrames(options.frames, scene.frameCount(), first, last);
+        const bool multiphase = options.mode == "multiphase";
+        if (options.memoryMb < 0)
+            throw InputError({"--memory-mb", 0, 0, {}}, "expected a positive number of MB");
+        const uint64_t memoryLimit = options.memoryMb > 0
+                                         ? static_cast<uint64_t>(options.memoryMb) << 20
+                                         : defaultMemoryLimitBytes();
+        {
+            const int w = render.width > 0 ? render.width : scene.settings.width;
+            const int h = render.height > 0 ? render.height : scene.settings.height;
+            const int spp = render.samplesPerPixel > 0 ? render.samplesPerPixel
+                                                       : scene.settings.samplesPerPixel;
+            checkMemory(estimateFrameMemory(w, h, spp, multiphase, !multiphase || options.compare,
+                                            options.truthSpp),
+                        memoryLimit,
+                        !options.size.empty() || options.spp > 0 ? "--size/--spp"
+                                                                 : options.scene + ": settings");
+        }
 
         prepareOutputFolder(options.outDir);
 
-        const bool multiphase = options.mode == "multiphase";
         std::unique_ptr<ReferenceRenderer> reference;
         if (!multiphase || options.compare) reference = std::make_unique<ReferenceRenderer>(scene);
         std::unique_ptr<MultiphaseRenderer> multi;
@@ -160,6 +177,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
                                                                  : scene.settings.samplesPerPixel},
                 {"seed", options.seed},
                 {"frames_requested", last - first},
+                {"memory_limit_mb", memoryLimit >> 20},
+                {"peak_resident_mb", peakResidentBytes() >> 20},
                 {"total_wall_seconds",
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
                 {"frames", frames}};

@@ -18,6 +18,7 @@ struct RenderCommandOptions {
     bool compare = false;     // multiphase: also render the reference, report error and speed
     std::string shadingRate;  // "sample" or "pixel"; empty = the scene's
     int truthSpp = -1;        // with compare: also measure both against this many spp
+    int64_t memoryMb = 0;     // refuse renders estimated above this; 0: 3/4 of physical memory
 };
 
 // Returns the process exit code: 0 success, 2 bad input (message already on stderr).

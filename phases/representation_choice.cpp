@@ -33,6 +33,11 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                       "auto: facets; a shader map's always-resident levels of %d charts would "
                       "take %.0f MB",
                       in.charts, in.pinnedBytes / 1048576.0);
+    } else if (in.combinedFacets > model.maxFacetsPerScreenPixel * in.screenPixels) {
+        c.kind = Representation::ShaderMap;
+        std::snprintf(text, sizeof text,
+                      "auto: shadermap; facets would number %.3g, over %.0f per screen pixel",
+                      in.combinedFacets, model.maxFacetsPerScreenPixel);
     } else if (!in.haveMap && in.charts * model.pinnedTexelsPerChart >
                                   model.maxPinnedTexelsPerPoint * std::max(points, 1.0)) {
         c.kind = Representation::Facets;
@@ -40,11 +45,6 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                       "auto: facets; a shader map would keep %.3g texels always resident for "
                       "%d charts covering about %.3g shading points",
                       in.charts * model.pinnedTexelsPerChart, in.charts, points);
-    } else if (in.combinedFacets > model.maxFacetsPerScreenPixel * in.screenPixels) {
-        c.kind = Representation::ShaderMap;
-        std::snprintf(text, sizeof text,
-                      "auto: shadermap; facets would number %.3g, over %.0f per screen pixel",
-                      in.combinedFacets, model.maxFacetsPerScreenPixel);
     } else {
         c.kind =
             c.mapSeconds <= c.facetsSeconds ? Representation::ShaderMap : Representation::Facets;

@@ -5,6 +5,7 @@
 #   scripts/setup.sh demo       install, build, render the vase example to out/vase/
 #   scripts/setup.sh test       install, build (warnings are errors), run the whole test suite
 #   scripts/setup.sh sanitize   the same under AddressSanitizer + UndefinedBehaviorSanitizer
+#   scripts/setup.sh fuzz [S]   each libFuzzer target for S seconds (default 30), ASan + UBSan
 #   scripts/setup.sh build      install and build only
 #
 # Idempotent: a second run installs nothing and rebuilds only what changed.
@@ -16,10 +17,12 @@ PACKAGES=(
   libosd-dev libglm-dev libopenimageio-dev openimageio-tools libembree-dev libtbb-dev
   libgtest-dev googletest libbenchmark-dev libcli11-dev nlohmann-json3-dev libfmt-dev
 )
+# The fuzz targets only: Clang and its libFuzzer runtime.
+FUZZ_PACKAGES=(clang libclang-rt-14-dev)
 
 install_packages() {
   local missing=()
-  for p in "${PACKAGES[@]}"; do
+  for p in "${PACKAGES[@]}" "$@"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   if [ ${#missing[@]} -eq 0 ]; then
@@ -60,12 +63,16 @@ case "$job" in
     ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       ctest --test-dir build-sanitize --output-on-failure -j "$(nproc)"
     ;;
+  fuzz)
+    install_packages "${FUZZ_PACKAGES[@]}"
+    bash scripts/fuzz.sh "${2:-30}"
+    ;;
   build)
     install_packages
     build build
     ;;
   *)
-    echo "usage: scripts/setup.sh demo|test|sanitize|build" >&2
+    echo "usage: scripts/setup.sh demo|test|sanitize|fuzz [SECONDS]|build" >&2
     exit 2
     ;;
 esac

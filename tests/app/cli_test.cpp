@@ -152,6 +152,9 @@ TEST(Cli, SppAndSeedOverrideTheScene) {
     EXPECT_EQ(stats["frames"][0]["samples"], 40 * 30 * 2);
     EXPECT_EQ(stats["seed"], 3);
     EXPECT_EQ(stats["mode"], "multiphase") << "multi-phase is the default mode";
+    EXPECT_GT(stats["memory_limit_mb"], 0);
+    EXPECT_GT(stats["peak_resident_mb"], 0);
+    EXPECT_LE(stats["peak_resident_mb"], stats["memory_limit_mb"]);
 }
 
 struct BadRun {
@@ -186,6 +189,15 @@ TEST(Cli, BadInputExitsTwoNamingThePlace) {
         {"render nowhere.json --out /tmp/x",
          "mpshade: nowhere.json: error: cannot open scene file\n"},
         {"render examples/vase/scene.json", "mpshade: error: --out is required"},
+        // 16384^2 pixels at 1024 samples: refused by the estimate before any allocation.
+        {"render examples/vase/scene.json --size 16384x16384 --spp 1024 --out /tmp/x",
+         "mpshade: --size/--spp: error: 16384x16384 pixels at 1024 samples (multiphase) needs "
+         "about 659"},
+        {"render examples/vase/scene.json --memory-mb 100 --out /tmp/x",
+         "mpshade: examples/vase/scene.json: settings: error: 480x270 pixels at 4 samples "
+         "(multiphase) needs about 0.4 GB, over the memory limit of 0.1 GB (--memory-mb)"},
+        {"render examples/vase/scene.json --memory-mb -5 --out /tmp/x",
+         "mpshade: --memory-mb: error: expected a positive number of MB\n"},
         {"paint", "mpshade: error: "},
     };
     for (const BadRun& c : cases) {

@@ -1,0 +1,68 @@
+#include "app/memory_limit.h"
+
+#include <cstdio>
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "geometry/error.h"
+
+namespace mpshade {
+namespace {
+
+constexpr uint64_t kMultiphaseBytesPerSample = 240;
+constexpr uint64_t kReferenceBytesPerSample = 55;
+constexpr uint64_t kBaseBytes = uint64_t{300} << 20;
+
+std::string gigabytes(uint64_t bytes) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f GB", static_cast<double>(bytes) / 1e9);
+    return buf;
+}
+
+}  // namespace
+
+uint64_t physicalMemoryBytes() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && size > 0 ? static_cast<uint64_t>(pages) * static_cast<uint64_t>(size) : 0;
+}
+
+uint64_t defaultMemoryLimitBytes() {
+    const uint64_t physical = physicalMemoryBytes();
+    return physical > 0 ? physical / 4 * 3 : uint64_t{8} << 30;
+}
+
+uint64_t peakResidentBytes() {
+    struct rusage usage {};
+    ::getrusage(RUSAGE_SELF, &usage);
+    return static_cast<uint64_t>(usage.ru_maxrss) * 1024;  // Linux reports KiB
+}
+
+FrameMemoryEstimate estimateFrameMemory(int width, int height, int spp, bool multiphase,
+                                        bool reference, int truthSpp) {
+    const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
+    FrameMemoryEstimate e;
+    e.bytes = kBaseBytes + pixels * 16 * 4;  // frames of each renderer and the written copies
+    if (multiphase) e.bytes += pixels * static_cast<uint64_t>(spp) * kMultiphaseBytesPerSample;
+    if (reference) e.bytes += pixels * static_cast<uint64_t>(spp) * kReferenceBytesPerSample;
+    if (truthSpp > 0)
+        e.bytes += pixels * static_cast<uint64_t>(truthSpp) * kReferenceBytesPerSample;
+    e.what = std::to_string(width) + "x" + std::to_string(height) + " pixels at " +
+             std::to_string(spp) + " samples" +
+             (multiphase && reference ? " (multiphase and reference)"
+              : multiphase            ? " (multiphase)"
+                                      : " (reference)") +
+             (truthSpp > 0 ? ", truth at " + std::to_string(truthSpp) : "");
+    return e;
+}
+
+void checkMemory(const FrameMemoryEstimate& estimate, uint64_t limitBytes,
+                 const std::string& option) {
+    if (estimate.bytes <= limitBytes) return;
+    throw InputError({option, 0, 0, {}}, estimate.what + " needs about " +
+                                             gigabytes(estimate.bytes) +
+                                             ", over the memory limit of " + gigabytes(limitBytes) +
+                                             " (--memory-mb): lower --size or --spp");
+}
+
+}  // namespace mpshade

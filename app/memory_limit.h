@@ -1,0 +1,33 @@
+// memory_limit.h -- `--memory-mb`: a render that would need more memory than the limit is
+// refused before anything is allocated, with the settings that make it so named, instead
+// of being killed by the system halfway.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace mpshade {
+
+// Physical memory of this machine, in bytes (0 if unknown).
+uint64_t physicalMemoryBytes();
+// The default limit: three quarters of physical memory (8 GiB if unknown).
+uint64_t defaultMemoryLimitBytes();
+// Peak resident memory of this process so far, in bytes.
+uint64_t peakResidentBytes();
+
+// Memory a frame needs, estimated from measured use (teapot at 960x540: 240 bytes per
+// sample for multi-phase -- visibility, fragments, shading batches --, 55 for the reference,
+// on top of about 300 MB of scene, maps and facets). An estimate, made to refuse requests
+// that cannot fit (16384 x 16384 at 1024 spp needs 60 TB), not a promise.
+struct FrameMemoryEstimate {
+    uint64_t bytes = 0;
+    std::string what;  // "960x540 pixels at 32 samples (multiphase and reference)"
+};
+FrameMemoryEstimate estimateFrameMemory(int width, int height, int spp, bool multiphase,
+                                        bool reference, int truthSpp);
+
+// Throws InputError naming `option` (or the settings) if the estimate exceeds limitBytes.
+void checkMemory(const FrameMemoryEstimate& estimate, uint64_t limitBytes,
+                 const std::string& option);
+
+}  // namespace mpshade

@@ -1,0 +1,4 @@
+surface s() {
+    float a = 1.0
+    Ci = color(a);
+}
