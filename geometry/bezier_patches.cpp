@@ -120,11 +120,11 @@ Bounds3 BezierPatches::bounds() const {
 BezierPatches loadBezierPatches(const std::string& path) {
     PatchFileReader in(path);
     long patches = in.integer("the patch count");
-    if (patches <= 0 || patches > 10'000'000) in.fail("patch count must be positive");
+    if (patches <= 0 || patches > 10'000'000) in.fail("the patch count must be in 1..10,000,000");
     std::vector<long> indices(static_cast<size_t>(patches) * 16);
     for (long& index : indices) index = in.integer("a control point index");
     long vertices = in.integer("the vertex count");
-    if (vertices <= 0 || vertices > 100'000'000) in.fail("vertex count must be positive");
+    if (vertices <= 0 || vertices > 100'000'000) in.fail("the vertex count must be in 1..100,000,000");
     std::vector<glm::vec3> points(static_cast<size_t>(vertices));
     for (auto& p : points) {
         p.x = static_cast<float>(in.number("a coordinate"));

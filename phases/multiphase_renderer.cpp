@@ -87,14 +87,29 @@ Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectS
                                               const CameraState& camera, int spp) {
     const SceneObject& obj = scene_.objects[i];
     Representation asked = options_.representation.value_or(obj.representation);
+    const ObjectShading& shading = static_.shading(i);
+    const ObjectRepresentation* previous = representations_[i].get();
+    const int tile =
+        options_.staticPhase.shaderMap.tileSize + 2 * options_.staticPhase.shaderMap.border;
+    ObjectCostInputs in;
+    in.charts = chartCount(*obj.surface);
+    // The 32 x 32 level is four 16 x 16 tiles, the five below one each.
+    in.pinnedTiles = static_cast<double>(in.charts) * 9.0;
+    in.pinnedBytes = in.pinnedTiles * tile * tile *
+                     static_cast<double>(shading.factored.staticPart.channelOutputs.size()) *
+                     sizeof(float);
+    in.haveMap = previous && previous->map;
     if (asked != Representation::Auto) {
         reports_[i].reason =
             options_.representation ? "forced by the renderer's options" : "the scene asks for it";
+        std::string tooBig;
+        if (asked == Representation::ShaderMap && !in.haveMap &&
+            !shaderMapFits(in, tooBig, options_.costModel)) {
+            reports_[i].reason += ", but " + tooBig + ": facets instead";
+            return Representation::Facets;
+        }
         return asked;
     }
-    const ObjectShading& shading = static_.shading(i);
-    const ObjectRepresentation* previous = representations_[i].get();
-    ObjectCostInputs in;
     in.combinedFacets = static_.combinedFacets(i, state, camera);
     // The screen area: the object's bounding sphere, projected, within the screen.
     const Bounds3 b = surfaceBounds(*obj.surface);
@@ -104,18 +119,12 @@ Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectS
     const double projected =
         distance > radius ? 3.14159265 * std::pow(ppu * radius / distance, 2.0) : 1e30;
     in.coveredPixels = std::min(static_cast<double>(camera.width) * camera.height, projected);
-    in.charts = chartCount(*obj.surface);
     in.frames = std::max(1, framesSeenFrom(i, frame));
     in.combinedRuns = predictedCombinedRuns(i, frame, state);
     in.screenPixels = static_cast<double>(camera.width) * camera.height;
     in.staticCostUnits = shading.factored.staticCost;
     in.samplesPerPixel = spp;
     in.shadingRate = options_.dynamic.shadingRate;
-    const int tile =
-        options_.staticPhase.shaderMap.tileSize + 2 * options_.staticPhase.shaderMap.border;
-    in.pinnedBytes = static_cast<double>(in.charts) * 9.0 * tile * tile *
-                     shading.factored.staticPart.channelOutputs.size() * sizeof(float);
-    in.haveMap = previous && previous->map;
     const RepresentationChoice choice = chooseRepresentation(in, options_.costModel);
     reports_[i].reason = choice.reason;
     return choice.kind;

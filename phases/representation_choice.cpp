@@ -8,7 +8,7 @@ namespace mpshade {
 RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                                           const RepresentationCostModel& model) {
     const double frames = std::max(1, in.frames);
-    const double staticPointNs = in.staticCostUnits * model.nsPerCostUnit;
+    const double staticPointNs = in.staticCostUnits * model.nsPerCostUnit + model.geometryPointNs;
     const double points =
         in.coveredPixels *
         (in.shadingRate == ShadingRate::Pixel ? 1.0 : static_cast<double>(in.samplesPerPixel));
@@ -27,6 +27,12 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     c.facetsSeconds = (facetsStatic + frames * facetsFrame) * 1e-9;
     c.mapSeconds = (mapStatic + frames * mapFrame) * 1e-9;
     char text[320];
+    std::string tooBig;
+    if (!in.haveMap && !shaderMapFits(in, tooBig, model)) {
+        c.kind = Representation::Facets;
+        c.reason = "auto: facets; " + tooBig;
+        return c;
+    }
     if (in.pinnedBytes > model.maxPinnedBytes && !in.haveMap) {
         c.kind = Representation::Facets;
         std::snprintf(text, sizeof text,
@@ -59,6 +65,18 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     }
     c.reason = text;
     return c;
+}
+
+bool shaderMapFits(const ObjectCostInputs& in, std::string& reason,
+                   const RepresentationCostModel& model) {
+    if (in.pinnedTiles <= model.maxPinnedTiles) return true;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "a shader map of %d charts would keep %.3g tiles always resident (at most "
+                  "%.3g)",
+                  in.charts, in.pinnedTiles, model.maxPinnedTiles);
+    reason = text;
+    return false;
 }
 
 }  // namespace mpshade

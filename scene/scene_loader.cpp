@@ -295,6 +295,14 @@ class SceneLoader {
         }
     }
 
+    // Equal shapes share one surface, and so one ray scene and one tessellation: a scene
+    // of 20,000 equal spheres holds one.
+    static std::string exactKey(float v) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%a", static_cast<double>(v));
+        return buf;
+    }
+
     std::shared_ptr<const Surface> surfaceFor(const std::string& key, auto make) {
         auto it = surfaces_.find(key);
         if (it != surfaces_.end()) return it->second;
@@ -308,8 +316,9 @@ class SceneLoader {
         typeName = type;
         if (type == "sphere") {
             g.allowKeys({"type", "radius"});
-            return std::make_shared<const Surface>(
-                Sphere{static_cast<float>(lengthOf(g["radius"]))});
+            const float radius = static_cast<float>(lengthOf(g["radius"]));
+            return surfaceFor("sphere:" + exactKey(radius),
+                              [&] { return Surface(Sphere{radius}); });
         }
         if (type == "torus") {
             g.allowKeys({"type", "major", "minor"});
@@ -317,14 +326,19 @@ class SceneLoader {
             const float minor = static_cast<float>(lengthOf(g["minor"]));
             if (!(minor < major))
                 g["minor"].fail("minor must be smaller than major (a self-intersecting torus)");
-            return std::make_shared<const Surface>(Torus{major, minor});
+            return surfaceFor("torus:" + exactKey(major) + ":" + exactKey(minor), [&] {
+                return Surface(Torus{major, minor});
+            });
         }
         if (type == "plane") {
             g.allowKeys({"type", "size"});
             JsonNode size = g["size"];
             if (!size.isArray() || size.size() != 2) size.fail("expected [width, depth]");
-            return std::make_shared<const Surface>(Plane{static_cast<float>(lengthOf(size.at(0))),
-                                                         static_cast<float>(lengthOf(size.at(1)))});
+            const float w = static_cast<float>(lengthOf(size.at(0))),
+                        d = static_cast<float>(lengthOf(size.at(1)));
+            return surfaceFor("plane:" + exactKey(w) + ":" + exactKey(d), [&] {
+                return Surface(Plane{w, d});
+            });
         }
         if (type == "bezier") {
             g.allowKeys({"type", "file"});

@@ -326,6 +326,39 @@ TEST(Cli, AnOutputPathThatIsAFileIsABadPath) {
         << run.output;
 }
 
+TEST(Cli, AbsurdButAcceptedNumbersRenderFinite) {
+    // Finite values far outside any sensible range that the scene format accepts: an fps
+    // of 1e-30 (one frame), a light of intensity 1e30 (radiance beyond half floats: written
+    // as 65504), a near plane of 1e-30 and a far one of 1e30. Both modes, frames finite.
+    const std::string dir = tempDir("absurd");
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "/scene.json")
+        << R"({"settings": {"width": 16, "height": 12, "fps": 1e-30, "duration": 1},
+  "camera": {"eye": [0, 0, 4], "target": [0, 0, 0], "near": 1e-30, "far": 1e30},
+  "lights": [{"type": "point", "position": [1, 2, 3], "intensity": 1e30}],
+  "shaders": {"p": ")" MPSHADE_SOURCE_DIR R"(/examples/shaders/plastic.sl"},
+  "objects": [{"name": "ball", "geometry": {"type": "sphere", "radius": 1}, "shader": "p"}]})";
+    for (const char* mode : {"multiphase", "reference"}) {
+        const std::string out = dir + "/" + mode;
+        const CliRun run = mpshade("render " + dir + "/scene.json --quiet --mode " +
+                                   std::string(mode) + " --out " + out);
+        ASSERT_EQ(run.exitCode, 0) << run.output;
+        std::ifstream statsFile(out + "/stats.json");
+        const nlohmann::json stats = nlohmann::json::parse(statsFile);
+        EXPECT_EQ(stats["frames"].size(), 1u);
+        OIIO::ImageBuf image(out + "/frame_0000.exr");
+        ASSERT_TRUE(image.read(0, 0, true, OIIO::TypeDesc::FLOAT)) << image.geterror();
+        const auto pcs = OIIO::ImageBufAlgo::computePixelStats(image);
+        float brightest = 0.0f;
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(pcs.nancount[c], 0u) << mode;
+            EXPECT_EQ(pcs.infcount[c], 0u) << mode;
+            brightest = std::max(brightest, pcs.max[c]);
+        }
+        EXPECT_EQ(brightest, 65504.0f) << mode << ": the lit side saturates the half range";
+    }
+}
+
 TEST(Cli, HelpAndVersion) {
     EXPECT_EQ(mpshade("--version").exitCode, 0);
     const CliRun help = mpshade("render --help");

@@ -215,6 +215,25 @@ TEST(RepresentationChoice, RulesBeforeTheEstimate) {
         << chooseRepresentation(in).reason;
 }
 
+TEST(RepresentationChoice, MapsThatCannotFitAreNeverChosen) {
+    // A cloud of 2,000,000 discs pinned 18M tiles in a pool of 4M and stopped the process;
+    // the always-resident tiles now decide first, at their bound exactly.
+    const RepresentationCostModel model;
+    ObjectCostInputs in;
+    in.combinedFacets = 1e9;  // facets would be hopeless too
+    in.coveredPixels = 1e5;
+    in.screenPixels = 1e5;
+    in.pinnedTiles = model.maxPinnedTiles;
+    std::string why;
+    EXPECT_TRUE(shaderMapFits(in, why, model));
+    EXPECT_EQ(chooseRepresentation(in, model).kind, Representation::ShaderMap);
+    in.pinnedTiles = model.maxPinnedTiles + 1;
+    EXPECT_FALSE(shaderMapFits(in, why, model));
+    const RepresentationChoice c = chooseRepresentation(in, model);
+    EXPECT_EQ(c.kind, Representation::Facets);
+    EXPECT_NE(c.reason.find("always resident"), std::string::npos) << c.reason;
+}
+
 TEST(RepresentationChoice, SeenOftenAMapSeenOnceFacets) {
     // The same object: its map's static work pays back over many frames, not over one.
     ObjectCostInputs in;
