@@ -1,11 +1,15 @@
 #include "app/memory_limit.h"
 
 #include <cstdio>
+#include <unordered_set>
+#include <variant>
 
 #include <sys/resource.h>
 #include <unistd.h>
 
 #include "geometry/error.h"
+#include "geometry/surface.h"
+#include "scene/scene.h"
 
 namespace mpshade {
 namespace {
@@ -56,13 +60,30 @@ FrameMemoryEstimate estimateFrameMemory(int width, int height, int spp, bool mul
     return e;
 }
 
+uint64_t estimateRaySceneBytes(const Scene& scene, bool allObjects) {
+    std::unordered_set<const Surface*> seen;
+    uint64_t bytes = 0;
+    for (const SceneObject& obj : scene.objects) {
+        if (!allObjects && obj.shader->source.find("occlusion") == std::string::npos) continue;
+        if (!seen.insert(obj.surface.get()).second) continue;
+        const Surface& surface = *obj.surface;
+        const int charts = chartCount(surface);
+        for (int c = 0; c < charts; ++c) {
+            const auto rate = static_cast<uint64_t>(
+                std::visit([&](const auto& s) { return s.tessellationRate(c); }, surface));
+            bytes += rate == 0 ? 100 : 2 * rate * rate * 110;
+        }
+    }
+    return bytes;
+}
+
 void checkMemory(const FrameMemoryEstimate& estimate, uint64_t limitBytes,
                  const std::string& option) {
     if (estimate.bytes <= limitBytes) return;
     throw InputError({option, 0, 0, {}}, estimate.what + " needs about " +
                                              gigabytes(estimate.bytes) +
                                              ", over the memory limit of " + gigabytes(limitBytes) +
-                                             " (--memory-mb): lower --size or --spp");
+                                             " (--memory-mb): " + estimate.hint);
 }
 
 }  // namespace mpshade

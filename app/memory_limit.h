@@ -22,9 +22,19 @@ uint64_t peakResidentBytes();
 struct FrameMemoryEstimate {
     uint64_t bytes = 0;
     std::string what;  // "960x540 pixels at 32 samples (multiphase and reference)"
+    std::string hint = "lower --size or --spp";
 };
 FrameMemoryEstimate estimateFrameMemory(int width, int height, int spp, bool multiphase,
                                         bool reference, int truthSpp);
+
+struct Scene;
+// Memory of the scene's ray-query structures: the exact-surface tessellation and BVH of
+// each distinct surface (measured: about 110 bytes a triangle; a sphere takes 2 MB), and
+// 100 bytes a disc of a point cloud. Added to a frame's estimate: a scene of 20,000
+// different spheres needs 40 GB of them.
+// allObjects false (multi-phase alone): only surfaces whose shader may cast occlusion rays
+// (its text names occlusion: an over-estimate at worst) are traced.
+uint64_t estimateRaySceneBytes(const Scene& scene, bool allObjects);
 
 // Throws InputError naming `option` (or the settings) if the estimate exceeds limitBytes.
 void checkMemory(const FrameMemoryEstimate& estimate, uint64_t limitBytes,

@@ -132,11 +132,20 @@ int runRenderCommand(const RenderCommandOptions& options) {
             const int h = render.height > 0 ? render.height : scene.settings.height;
             const int spp = render.samplesPerPixel > 0 ? render.samplesPerPixel
                                                        : scene.settings.samplesPerPixel;
-            checkMemory(estimateFrameMemory(w, h, spp, multiphase, !multiphase || options.compare,
-                                            options.truthSpp),
-                        memoryLimit,
-                        !options.size.empty() || options.spp > 0 ? "--size/--spp"
-                                                                 : options.scene + ": settings");
+            FrameMemoryEstimate estimate = estimateFrameMemory(
+                w, h, spp, multiphase, !multiphase || options.compare, options.truthSpp);
+            const uint64_t rays = estimateRaySceneBytes(scene, !multiphase || options.compare);
+            const bool raysDominate = rays > estimate.bytes;
+            estimate.bytes += rays;
+            if (raysDominate) {
+                estimate.what +=
+                    " and the ray queries of " + std::to_string(scene.objects.size()) + " objects";
+                estimate.hint = "fewer distinct shapes (equal ones share)";
+            }
+            checkMemory(estimate, memoryLimit,
+                        raysDominate                               ? options.scene + ": objects"
+                        : !options.size.empty() || options.spp > 0 ? "--size/--spp"
+                                                                   : options.scene + ": settings");
         }
 
         prepareOutputFolder(options.outDir);

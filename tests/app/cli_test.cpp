@@ -195,7 +195,7 @@ TEST(Cli, BadInputExitsTwoNamingThePlace) {
          "about 659"},
         {"render examples/vase/scene.json --memory-mb 100 --out /tmp/x",
          "mpshade: examples/vase/scene.json: settings: error: 480x270 pixels at 4 samples "
-         "(multiphase) needs about 0.4 GB, over the memory limit of 0.1 GB (--memory-mb)"},
+         "(multiphase) needs about 0.5 GB, over the memory limit of 0.1 GB (--memory-mb)"},
         {"render examples/vase/scene.json --memory-mb -5 --out /tmp/x",
          "mpshade: --memory-mb: error: expected a positive number of MB\n"},
         {"paint", "mpshade: error: "},
@@ -357,6 +357,35 @@ TEST(Cli, AbsurdButAcceptedNumbersRenderFinite) {
         }
         EXPECT_EQ(brightest, 65504.0f) << mode << ": the lit side saturates the half range";
     }
+}
+
+TEST(Cli, ManyDistinctShapesAreRefusedBeforeTheirRayScenesAreBuilt) {
+    // 4,000 spheres of different radii: the reference would build a 2 MB ray scene for each
+    // (8 GB), refused under a 2 GB limit naming the objects; multi-phase, which traces rays
+    // only for shaders that cast occlusion, renders it within the same limit.
+    const std::string dir = tempDir("many");
+    std::filesystem::create_directories(dir);
+    std::ofstream scene(dir + "/scene.json");
+    scene << R"({"settings": {"width": 16, "height": 12, "duration": 0.1},
+      "camera": {"eye": [0, 0, 5], "target": [0, 0, 0]},
+      "shaders": {"p": ")" MPSHADE_SOURCE_DIR R"(/examples/shaders/plastic.sl"}, "objects": [)";
+    for (int i = 0; i < 4000; ++i)
+        scene << (i ? "," : "") << R"({"name": "s)" << i
+              << R"(", "shader": "p", "geometry": {"type": "sphere", "radius": )" << 0.01 + i * 1e-5
+              << R"(}, "transform": {"translate": [)" << (i % 64) / 32.0 - 1 << ", "
+              << (i / 64) / 32.0 - 1 << ", 0]}}";
+    scene << "]}";
+    scene.close();
+    const CliRun ref = mpshade(
+        "render " + dir + "/scene.json --mode reference --memory-mb 2000 --out " + dir + "/ref");
+    EXPECT_EQ(ref.exitCode, 2) << ref.output;
+    EXPECT_NE(ref.output.find("scene.json: objects: error: 16x12 pixels at 4 samples (reference) "
+                              "and the ray queries of 4000 objects needs about 8."),
+              std::string::npos)
+        << ref.output;
+    const CliRun multi =
+        mpshade("render " + dir + "/scene.json --memory-mb 2000 --quiet --out " + dir + "/mp");
+    EXPECT_EQ(multi.exitCode, 0) << multi.output;
 }
 
 TEST(Cli, HelpAndVersion) {
