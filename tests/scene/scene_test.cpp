@@ -191,6 +191,70 @@ TEST(SceneLoader, EqualShapesShareOneSurface) {
     EXPECT_NE(scene.objects[5].surface, scene.objects[6].surface);
 }
 
+TEST(BadScenes, EveryDocumentedRangeOnBothSidesOfItsBound) {
+    // Each range docs/scene-format.md documents: a value just inside loads, one just
+    // outside is an error naming that value's JSON path.
+    struct Edge {
+        const char* settings;  // JSON members of "settings"
+        const char* camera;    // extra members of "camera"
+        const char* object;    // extra members of the object
+        const char* geometry;  // the object's geometry
+        const char* badPath;   // "" if the scene must load
+    };
+    const char* sphere = R"({"type": "sphere", "radius": 1})";
+    const Edge kEdges[] = {
+        {R"("width": 16384, "height": 1)", "", "", sphere, ""},
+        {R"("width": 16385)", "", "", sphere, "settings.width"},
+        {R"("height": 0)", "", "", sphere, "settings.height"},
+        {R"("samples_per_pixel": 1024)", "", "", sphere, ""},
+        {R"("samples_per_pixel": 1025)", "", "", sphere, "settings.samples_per_pixel"},
+        {R"("samples_per_pixel": 0)", "", "", sphere, "settings.samples_per_pixel"},
+        {R"("fps": 1000, "duration": 1000)", "", "", sphere, ""},  // a million frames
+        {R"("fps": 1000.001)", "", "", sphere, "settings.fps"},
+        {R"("fps": 1000, "duration": 1000.01)", "", "", sphere, "settings.duration"},
+        {R"("fps": 0)", "", "", sphere, "settings.fps"},
+        {R"("duration": 0)", "", "", sphere, "settings.duration"},
+        {"", R"(, "fov_y": 179.9)", "", sphere, ""},
+        {"", R"(, "fov_y": 180)", "", sphere, "camera.fov_y"},
+        {"", R"(, "fov_y": 0)", "", sphere, "camera.fov_y"},
+        {"", R"(, "near": 0.5, "far": 0.50001)", "", sphere, ""},
+        {"", R"(, "near": 0.5, "far": 0.5)", "", sphere, "camera"},
+        {"", R"(, "near": 0)", "", sphere, "camera.near"},
+        {"", "", R"(, "range": {"distance_factor": 1.0001, "angle": 180})", sphere, ""},
+        {"", "", R"(, "range": {"distance_factor": 1})", sphere,
+         "objects[0].range.distance_factor"},
+        {"", "", R"(, "range": {"angle": 180.001})", sphere, "objects[0].range.angle"},
+        {"", "", R"(, "range": {"angle": 0})", sphere, "objects[0].range.angle"},
+        {"", "", R"(, "shadermap_resolution": 1048576)", sphere, ""},
+        {"", "", R"(, "shadermap_resolution": 1048577)", sphere, "objects[0].shadermap_resolution"},
+        {"", "", R"(, "shadermap_resolution": 0)", sphere, "objects[0].shadermap_resolution"},
+        {"", "", "", R"({"type": "torus", "major": 1, "minor": 0.999})", ""},
+        {"", "", "", R"({"type": "torus", "major": 1, "minor": 1})", "objects[0].geometry.minor"},
+        {"", "", "", R"({"type": "plane", "size": [1e-8, 1e8]})", ""},
+        {"", "", "", R"({"type": "plane", "size": [1, 0]})", "objects[0].geometry.size[1]"},
+    };
+    const std::string path = testing::TempDir() + "/edge.json";
+    for (const Edge& e : kEdges) {
+        std::ofstream(path) << R"({"settings": {)" << e.settings
+                            << R"(}, "camera": {"eye": [0, 0, 5], "target": [0, 0, 0])" << e.camera
+                            << R"(}, "shaders": {"p": ")"
+                            << sourcePath("examples/shaders/plastic.sl")
+                            << R"("}, "objects": [{"name": "o", "shader": "p", "geometry": )"
+                            << e.geometry << e.object << "}]}";
+        const std::string what = std::string(e.settings) + e.camera + e.object + e.geometry;
+        if (!*e.badPath) {
+            EXPECT_NO_THROW(loadScene(path)) << what;
+            continue;
+        }
+        try {
+            loadScene(path);
+            ADD_FAILURE() << "accepted: " << what;
+        } catch (const InputError& err) {
+            EXPECT_EQ(err.where().jsonPath, e.badPath) << what << ": " << err.what();
+        }
+    }
+}
+
 TEST(Keyframes, InterpolateLinearlyAndHoldOutside) {
     Keyframes<float> k;
     k.times = {1.0f, 3.0f};
