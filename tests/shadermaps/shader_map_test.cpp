@@ -3,6 +3,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -186,6 +187,46 @@ TEST(ShaderMap, MissingTilesFallBackToCoarserLevels) {
     EXPECT_EQ(again.fallbacks, 0u);
     ASSERT_EQ(again.touchedCount, 1u);
     EXPECT_EQ(touched[0].level, 0);
+}
+
+// The levels a probe of footprint k level-0 texels (an isotropic query) reads, observed
+// through the tiles it reports lacking from a map holding only its 1 x 1 level.
+std::set<int> levelsRead(const MapFixture& f, ProbeFilter filter, float k) {
+    ShaderMapOptions options;
+    options.resolution = 1024;
+    options.alwaysResidentLevels = 1;
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    ProbeOptions probe;
+    probe.filter = filter;
+    probe.levelBlend = 1.0f;
+    const ProbeQuery q = query(0.4f, 0.6f, k / 1024.0f, k / 1024.0f);
+    TileKey missing[64];
+    ProbeResidency residency{missing, 64};
+    residency.stopAtMissing = true;  // each tap reports its own level, not the fallbacks
+    float out[3];
+    probeShaderMap(map, probe, {&q, 1}, out, &residency);
+    std::set<int> levels;
+    for (size_t i = 0; i < residency.count; ++i) levels.insert(missing[i].level);
+    return levels;
+}
+
+TEST(ShaderMap, TheLevelAFootprintPicksIsPinned) {
+    // log2 of the footprint picks the level: at exactly 2^L texels level L (trilinear also
+    // reads L + 1, at weight 0; Feline does not), a hair below it levels L - 1 and L.
+    MapFixture f(kNoiseShader);
+    for (ProbeFilter filter : {ProbeFilter::Trilinear, ProbeFilter::Feline}) {
+        EXPECT_EQ(levelsRead(f, filter, 1.0f), std::set<int>({0})) << int(filter);
+        EXPECT_EQ(levelsRead(f, filter, 1.01f), std::set<int>({0, 1})) << int(filter);
+        for (int level = 1; level <= 4; ++level) {
+            const float k = std::ldexp(1.0f, level);
+            const std::set<int> at = filter == ProbeFilter::Trilinear
+                                         ? std::set<int>({level, level + 1})
+                                         : std::set<int>({level});
+            EXPECT_EQ(levelsRead(f, filter, k), at) << int(filter) << " at " << k;
+            EXPECT_EQ(levelsRead(f, filter, k * 0.999f), std::set<int>({level - 1, level}))
+                << int(filter) << " below " << k;
+        }
+    }
 }
 
 TEST(ShaderMap, HalfPrecisionErrorIsBounded) {
