@@ -167,8 +167,10 @@ __attribute__((target_clones("avx2", "default"))) void warpLanes(
 
 // GCC 12's AVX-512 headers start conversions from _mm512_undefined_*, which
 // -Wmaybe-uninitialized reports as a false positive.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 // The same with AVX-512 intrinsics: eight double lanes, comparison masks in mask registers
 // and a masked division (no safe denominator needed), rounding by the instruction.
 __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void warpAvx512(
@@ -219,7 +221,9 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void warpAvx512(
     }
     warpLanes(k, qx + i, qy + i, qz + i, n - i, ox + i, oy + i, oinv + i);
 }
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 }  // namespace
 
