@@ -56,18 +56,19 @@ int IrBuilder::emit(Op op, const std::vector<int>& args, int nout, int imm) {
                 break;
         }
     }
-    // Identities that hold for every float, NaN and Inf included.
-    auto isConst = [&](size_t k, float value) {
+    // Identities that hold for every float, NaN, infinities and signed zeros included:
+    // x - (+0), x + (-0), x * 1 and x / 1 are x; x + (+0) is not (-0 + 0 is +0).
+    auto isConst = [&](size_t k, float value, bool negative = false) {
         float x;
-        return constantValue(args[k], x) && x == value && !std::signbit(x);
+        return constantValue(args[k], x) && x == value && std::signbit(x) == negative;
     };
     if (args.size() == 2) {
-        if ((op == Op::Add && isConst(1, 0.0f)) || (op == Op::Sub && isConst(1, 0.0f)) ||
+        if ((op == Op::Add && isConst(1, 0.0f, true)) || (op == Op::Sub && isConst(1, 0.0f)) ||
             (op == Op::Mul && isConst(1, 1.0f)) || (op == Op::Div && isConst(1, 1.0f))) {
             ++stats_.identities;
             return args[0];
         }
-        if ((op == Op::Add && isConst(0, 0.0f)) || (op == Op::Mul && isConst(0, 1.0f))) {
+        if ((op == Op::Add && isConst(0, 0.0f, true)) || (op == Op::Mul && isConst(0, 1.0f))) {
             ++stats_.identities;
             return args[1];
         }
