@@ -205,6 +205,25 @@ TEST(Builtins, FoldingEachOperandInTurnMatchesTheInterpreter) {
         int arity;  // uses u, v (and s)
     };
     const Op kOps[] = {
+        {"abs(u)", 1},
+        {"floor(u)", 1},
+        {"ceil(u)", 1},
+        {"fract(u)", 1},
+        {"sqrt(u)", 1},
+        {"exp(u)", 1},
+        {"log(u)", 1},
+        {"sin(u)", 1},
+        {"cos(u)", 1},
+        {"tan(u)", 1},
+        {"asin(u)", 1},
+        {"acos(u)", 1},
+        {"atan(u)", 1},
+        {"sign(u)", 1},
+        {"-u", 1},
+        {"float(int(u))", 1},
+        {"float(!(u > 0))", 1},
+        {"snoise(u)", 1},
+        {"cellnoise(u)", 1},
         {"u + v", 2},
         {"u - v", 2},
         {"u * v", 2},
@@ -230,11 +249,11 @@ TEST(Builtins, FoldingEachOperandInTurnMatchesTheInterpreter) {
     for (const Op& op : kOps) {
         std::vector<ShadingPoint> points;
         const size_t n = std::size(values);
-        const size_t combos = op.arity == 2 ? n * n : n * n * n;
+        const size_t combos = op.arity == 1 ? n : op.arity == 2 ? n * n : n * n * n;
         for (size_t c = 0; c < combos; ++c) {
             ShadingPoint p;
             p.u = values[c % n];
-            p.v = values[(c / n) % n];
+            p.v = op.arity >= 2 ? values[(c / n) % n] : 0.0f;
             p.s = op.arity == 3 ? values[c / (n * n)] : 0.0f;
             points.push_back(p);
         }
