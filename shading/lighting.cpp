@@ -54,7 +54,8 @@ glm::vec3 shadeLightOne(Op op, const LightSample& light, const glm::vec3& P, con
         const float ndh = std::fmax(0.0f, glm::dot(N, h / hl));
         const float r = std::fmin(std::fmax(param, 0.01f), 1.0f);
         const float a2 = r * r * r * r;
-        const float denom = ndh * ndh * (a2 - 1.0f) + 1.0f;
+        // As in shadeLanes: 1 - ndh^2 as (1 - ndh)(1 + ndh), exact near the peak.
+        const float denom = (1.0f - ndh) * (1.0f + ndh) + ndh * ndh * a2;
         const float D = a2 / (kPi * denom * denom);
         return Cl * (D * ndl * 0.25f);
     }
@@ -119,7 +120,10 @@ void shadeLanes(const LightSample& light, const float* const* args, float* const
             const float param = pr[l];
             const float r = std::min(param > 0.01f ? param : 0.01f, 1.0f);
             const float a2 = r * r * r * r;
-            const float denom = ndh * ndh * (a2 - 1.0f) + 1.0f;
+            // 1 - ndh^2 (1 - a2), with 1 - ndh^2 as (1 - ndh)(1 + ndh): exact near the
+            // peak (Sterbenz), where the plain form cancels to 0 for a2 below float epsilon
+            // and D became infinite at the roughness floor.
+            const float denom = (1.0f - ndh) * (1.0f + ndh) + ndh * ndh * a2;
             const float D = a2 / (kPi * denom * denom);
             f = ok ? D * ndl * 0.25f : 0.0f;
         } else {

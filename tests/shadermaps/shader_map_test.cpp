@@ -304,6 +304,15 @@ TEST(HalfFloat, RoundTripsAndRoundsToNearest) {
     EXPECT_TRUE(std::isnan(halfToFloat(floatToHalf(NAN))));
     EXPECT_EQ(halfToFloat(floatToHalf(std::ldexp(1.0f, -24))),
               std::ldexp(1.0f, -24));  // the smallest subnormal
+    // Ties go to the even neighbour: 1 + 2^-11 lies halfway between 1 (even) and 1 + 2^-10
+    // (odd); 1 + 3 2^-11 between 1 + 2^-10 (odd) and 1 + 2^-9 (even). Likewise in the
+    // subnormal range: 1.5 2^-24 between 2^-24 (odd) and 2^-23 (even).
+    EXPECT_EQ(halfToFloat(floatToHalf(1.0f + std::ldexp(1.0f, -11))), 1.0f);
+    EXPECT_EQ(halfToFloat(floatToHalf(1.0f + 3.0f * std::ldexp(1.0f, -11))),
+              1.0f + std::ldexp(1.0f, -9));
+    EXPECT_EQ(halfToFloat(floatToHalf(-(1.0f + std::ldexp(1.0f, -11)))), -1.0f);
+    EXPECT_EQ(halfToFloat(floatToHalf(1.5f * std::ldexp(1.0f, -24))), std::ldexp(1.0f, -23));
+    EXPECT_EQ(halfToFloat(floatToHalf(2.5f * std::ldexp(1.0f, -24))), std::ldexp(1.0f, -23));
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> uni(-100.0f, 100.0f);
     for (int k = 0; k < 100000; ++k) {

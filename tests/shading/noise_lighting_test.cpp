@@ -153,6 +153,57 @@ TEST(Occlusion, OpenOutsideClosedInside) {
     EXPECT_EQ(r.counters.occlusionRays, 128u);
 }
 
+TEST(Occlusion, StratifiedDirectionsCountExactlyUnderASphere) {
+    // Below a unit sphere at distance D along N, a cosine-weighted direction with
+    // sin^2(angle to N) = u1 hits it exactly when u1 < 1 / D^2. Ray i has
+    // u1 = (i + 1/2) / 64, so with 1 / D^2 = 0.2547 (64 x 0.2547 = 16.3) rays 0..15 hit:
+    // open 48 / 64 exactly. (Strata at i / 64 would hit 17; every ray is at least 0.3
+    // degrees from the sphere's silhouette, far beyond its tessellation's 0.015.)
+    const Surface sphere = Sphere{1.0f};
+    const SurfaceRayScene rays(sphere);
+    const float D = 1.0f / std::sqrt(0.2547f);
+    const float P[3] = {0.0f, -D, 0.0f}, N[3] = {0.0f, 1.0f, 0.0f};
+    const float* args[6] = {&P[0], &P[1], &P[2], &N[0], &N[1], &N[2]};
+    float open = -1.0f;
+    EXPECT_EQ(occlusionLanes(&rays, 0.0f, 64, args, &open, 1), 64u);
+    EXPECT_EQ(open, 48.0f / 64.0f);
+}
+
+TEST(Lighting, GgxRoughnessIsFlooredAtAHundredth) {
+    // docs/shading-language.md: roughness is clamped to [0.01, 1]. At the mirror
+    // direction (H = N) D = 1 / (pi alpha^2), alpha = r^2: a roughness of 0.001 must give
+    // the value of 0.01, and 2 that of 1.
+    LightSample distant;
+    distant.kind = LightKind::Distant;
+    distant.color = glm::vec3(1.0f);
+    distant.toLight = glm::normalize(glm::vec3(0, 1, 1));
+    const glm::vec3 N(0, 1, 0), V = glm::normalize(glm::vec3(0, 1, -1)), P(0);
+    const float ndl = glm::dot(N, distant.toLight);
+    const auto peak = [&](float r) {
+        const double alpha = double(r) * r;
+        return 1.0 / (3.14159265358979 * alpha * alpha) * ndl / 4.0;
+    };
+    EXPECT_NEAR(shadeLightOne(Op::Specular, distant, P, N, V, 0.001f).x, peak(0.01f),
+                1e-3 * peak(0.01f));
+    EXPECT_NEAR(shadeLightOne(Op::Specular, distant, P, N, V, 2.0f).x, peak(1.0f),
+                1e-3 * peak(1.0f));
+    // The batched path the renderers run, through a shader: the viewer at the mirror
+    // direction (I = -V), roughness below the floor. This was infinite (1 - ndh^2 (1 - a2)
+    // cancelled to 0 in float).
+    ShaderBinding binding;
+    binding.lights.resize(1);
+    binding.lights[0].kind = LightKind::Distant;
+    std::vector<LightSample> lights = {distant};
+    ShadingUniforms uniforms;
+    uniforms.lights = lights;
+    test::ShadingPoint p;
+    p.N = p.Ng = N;
+    p.I = -V;
+    const auto r =
+        test::runShader("surface g() { Ci = specular(N, -I, 0.001); }", {p}, binding, uniforms);
+    EXPECT_NEAR(r.Ci[0].x, peak(0.01f), 1e-3 * peak(0.01f));
+}
+
 TEST(Occlusion, HalfOpenBesideAWall) {
     // A point on a large plane, with N along the plane: the plane blocks half the
     // hemisphere, which for cosine weighting is exactly half.
