@@ -305,6 +305,13 @@ TEST(MultiphaseRenderer, PixelRateShadesOncePerPixelAndSurface) {
     EXPECT_GT(compareImages(imageA, ref).psnr, 34.0);
     EXPECT_GT(compareImages(imageB, ref).psnr, 28.5);
     EXPECT_LT(compareImages(imageB, ref).coverageDiff, 0.01);
+    // At 4 samples a pixel point's footprint (half a pixel) is a sample's (1 / sqrt(4)):
+    // the same map levels, so about as many tiles (a pixel's point at the pixel centre
+    // reaches a few fewer at the edges of what is seen).
+    RecordProperty("tiles_sample", std::to_string(sample.tilesRequested));
+    RecordProperty("tiles_pixel", std::to_string(pixel.tilesRequested));
+    EXPECT_GT(pixel.tilesRequested, sample.tilesRequested * 3 / 4);
+    EXPECT_LE(pixel.tilesRequested, sample.tilesRequested);
 }
 
 TEST(MultiphaseRenderer, MapsStayInTheirMemoryBudget) {
