@@ -17,7 +17,9 @@ inline Float4 loadFloat4(const float* p) {
     std::memcpy(&v, p, sizeof v);
     return v;
 }
-inline void storeFloat4(float* p, Float4 v) { std::memcpy(p, &v, sizeof v); }
+inline void storeFloat4(float* p, Float4 v) {
+    std::memcpy(p, &v, sizeof v);
+}
 
 constexpr int kMaxChannels = 64;
 constexpr int kMaxTaps = 63;  // Feline: 2 maxAnisotropy - 1, maxAnisotropy capped at 32
@@ -340,6 +342,8 @@ struct Prober {
         if (lod >= static_cast<float>(maxLevel)) return bilinear(chart, maxLevel, u, v, out);
         const int l0 = static_cast<int>(lod);
         const float t = lod - static_cast<float>(l0);
+        // At an exact level the other one weighs nothing: not read, and not asked for.
+        if (t == 0.0f) return bilinear(chart, l0, u, v, out);
         if (fast) {
             float sum[kArr] = {};
             if (tap(chart, l0, u * levelRes[l0] - 0.5f, v * levelRes[l0] - 0.5f, 1.0f - t, sum) &&
