@@ -1,9 +1,9 @@
 // probe.h -- filtered lookups of shader maps (patent col. 10, claims 13-14), batched: a
 // span of queries in, n-tuples out.
 //
-//   Trilinear: two bilinear probes of adjacent levels, blended (Williams 1983; one at an
-//     exact level, where the other would weigh nothing). The level
-//     is log2 of the footprint's longer axis in level-0 texels.
+//   Trilinear: two bilinear probes of adjacent levels, blended (Williams 1983); one at an
+//     exact level, where the other would weigh nothing. The level is log2 of the
+//     footprint's longer axis in level-0 texels.
 //   Feline (McCormack et al. 1999): trilinear probes along the footprint ellipse's major
 //     axis; the minor axis picks the level. n = 2 (major / minor) - 1 probes (the ratio
 //     capped by maxAnisotropy, the minor axis widened to match), spread over a line of
