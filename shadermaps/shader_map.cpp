@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <unordered_set>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -46,7 +47,8 @@ ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
                   options.resolution <= (1 << 20));
     MPSHADE_CHECK(options.tileSize > 0 && (options.tileSize & (options.tileSize - 1)) == 0);
     MPSHADE_CHECK(options.resolution / options.tileSize <= (1 << 16));
-    MPSHADE_CHECK(options.border >= 1 && options.supersampleLimit >= 1);
+    MPSHADE_CHECK(options.border >= 1 && options.border <= options.tileSize &&
+                  options.supersampleLimit >= 1);
     charts_ = chartCount(surface);
     MPSHADE_CHECK(charts_ < (1 << 26));
     if (options.seamless) adjacency_ = std::make_unique<ChartAdjacency>(surface);
@@ -120,7 +122,10 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
                j >= key.ty * T && j < (key.ty + 1) * T && j < res;
     };
     // Border texels a resident neighbour holds are copied after the batch (copyBorders).
-    auto skipped = [&](int i, int j) { return interior(i, j) || borderFromNeighbour(key, i, j); };
+    const Neighbours around = neighboursOf(key);
+    auto skipped = [&](int i, int j) {
+        return interior(i, j) || neighbourSlot(around, key, i, j) >= 0;
+    };
     if (fromChildren) {
         float child[4][64];
         std::vector<float> wide;
@@ -200,22 +205,38 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
     stats.programRuns += n;
 }
 
-bool ShaderMap::borderFromNeighbour(const TileKey& key, int i, int j) const {
+ShaderMap::Neighbours ShaderMap::neighboursOf(const TileKey& key) const {
+    Neighbours around;
+    const int n = tilesPerSide(key.level);
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+            const int tx = key.tx + dx, ty = key.ty + dy;
+            const bool other = (dx || dy) && tx >= 0 && ty >= 0 && tx < n && ty < n;
+            around.slot[dy + 1][dx + 1] =
+                other ? table_.find(TileKey{key.chart, key.level, static_cast<uint16_t>(tx),
+                                            static_cast<uint16_t>(ty)}
+                                        .packed())
+                      : -1;
+        }
+    return around;
+}
+
+int ShaderMap::neighbourSlot(const Neighbours& around, const TileKey& key, int i, int j) const {
     const int res = resolution(key.level);
-    if (i < 0 || j < 0 || i >= res || j >= res) return false;  // beyond the chart: evaluated
-    const int tx = i >> tileShift_, ty = j >> tileShift_;
-    if (tx == key.tx && ty == key.ty) return false;
-    return table_.find(
-               TileKey{key.chart, key.level, static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)}
-                   .packed()) >= 0;
+    if (i < 0 || j < 0 || i >= res || j >= res) return -1;  // beyond the chart: evaluated
+    return around.slot[(j >> tileShift_) - key.ty + 1][(i >> tileShift_) - key.tx + 1];
 }
 
 void ShaderMap::copyBorders(const TileKey& key, int slot, FillStats& stats) {
     const int T = options_.tileSize, border = options_.border;
     const int res = resolution(key.level);
-    float value[kMaxCopyChannels];
-    std::vector<float> wide(channels_ > kMaxCopyChannels ? static_cast<size_t>(channels_) : 0);
-    float* out = wide.empty() ? value : wide.data();
+    const Neighbours around = neighboursOf(key);
+    // Both tiles store the same type: the texel's channels are copied as they are.
+    const size_t texelBytes = tileBytes() / (static_cast<size_t>(stride_) * stride_);
+    auto at = [&](int s, int li, int lj) {
+        return tileData(s) +
+               (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) * texelBytes;
+    };
     const int validW = std::min(stride_, res - key.tx * T + 2 * border);
     const int validH = std::min(stride_, res - key.ty * T + 2 * border);
     for (int lj = 0; lj < validH; ++lj)
@@ -224,12 +245,10 @@ void ShaderMap::copyBorders(const TileKey& key, int slot, FillStats& stats) {
             if (lj >= border && lj < border + T && li == border) li = border + T;
             if (li >= validW) break;
             const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
-            if (!borderFromNeighbour(key, i, j)) continue;
-            const TileKey from = tileOf(key.chart, key.level, i, j);
-            texel(from, slotOf(from), i, j, out);
-            const size_t at = (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) *
-                              static_cast<size_t>(channels_);
-            for (int c = 0; c < channels_; ++c) store(slot, at + static_cast<size_t>(c), out[c]);
+            const int from = neighbourSlot(around, key, i, j);
+            if (from < 0) continue;
+            std::memcpy(at(slot, li, lj), at(from, (i & (T - 1)) + border, (j & (T - 1)) + border),
+                        texelBytes);
             ++stats.texelsCopied;
         }
 }

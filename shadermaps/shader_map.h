@@ -169,11 +169,17 @@ class ShaderMap {
                   std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
                   std::vector<float>& workspace, FillStats& stats);
     void store(int slot, size_t at, float value);
-    // Whether texel (i, j) of key's level, in key's border, lies in another resident tile
-    // of the same chart (and is then copied from it rather than evaluated).
-    bool borderFromNeighbour(const TileKey& key, int i, int j) const;
+    // The slots of the eight tiles around `key` in its chart and level (-1: not resident,
+    // or beyond the level), found once per tile; a border (at most a tile wide) lies in
+    // them.
+    struct Neighbours {
+        int slot[3][3];
+    };
+    Neighbours neighboursOf(const TileKey& key) const;
+    // The slot of the resident neighbour holding texel (i, j) of key's border, or -1 when
+    // it must be evaluated (no such tile resident, or beyond the chart's edge).
+    int neighbourSlot(const Neighbours& around, const TileKey& key, int i, int j) const;
     void copyBorders(const TileKey& key, int slot, FillStats& stats);
-    static constexpr int kMaxCopyChannels = 64;
 
     const Surface& surface_;
     std::unique_ptr<ChartAdjacency> adjacency_;

@@ -390,41 +390,52 @@ TEST(ShaderMap, VirtualResolutionFillsOnlyWhatIsAsked) {
 TEST(ShaderMap, BordersCopiedFromNeighboursEqualEvaluatedOnes) {
     // Tile (5, 5) of level 0 filled alone evaluates its whole 18 x 18 frame; filled after
     // its eight neighbours (one batch of nine), its 68 border texels come from them. The two
-    // must hold the same bits, and only the 256 interior texels may run the program.
+    // must hold the same bits, and only the 256 interior texels may run the program. In
+    // float and in half storage (the copy moves the stored bits).
     MapFixture f(kNoiseShader);
-    ShaderMapOptions options;
-    options.resolution = 256;
-    ShaderMap alone(f.surface, *f.kernel, f.uniforms, options);
-    ShaderMap among(f.surface, *f.kernel, f.uniforms, options);
-    const TileKey key{0, 0, 5, 5};
-    const FillStats pinned = alone.fillStats();  // the always-resident levels
-    alone.fill({&key, 1});
-    EXPECT_EQ(alone.fillStats().texelsCopied, pinned.texelsCopied);
-    EXPECT_EQ(alone.fillStats().programRuns - pinned.programRuns, 324u);
-    std::vector<TileKey> ring;
-    for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-            if (dx || dy)
-                ring.push_back(
-                    {0, 0, static_cast<uint16_t>(5 + dx), static_cast<uint16_t>(5 + dy)});
-    among.fill(ring);
-    const FillStats ringStats = among.fillStats();
-    among.fill({&key, 1});
-    const FillStats after = among.fillStats();
-    EXPECT_EQ(after.texelsCopied - ringStats.texelsCopied, 68u);
-    EXPECT_EQ(after.programRuns - ringStats.programRuns, 256u);
-    const float* a = alone.tileFloats(alone.slotOf(key));
-    const float* b = among.tileFloats(among.slotOf(key));
-    const size_t values = static_cast<size_t>(alone.stride() * alone.stride() * 3);
-    for (size_t x = 0; x < values; ++x) ASSERT_EQ(a[x], b[x]) << "value " << x;
-    // A corner tile: its border beyond the plane's edge (no chart across) is evaluated,
-    // the rest (right column, bottom row and the corner between) copied: 17 + 16 texels.
-    const TileKey corner{0, 0, 0, 0};
-    std::vector<TileKey> next = {{0, 0, 1, 0}, {0, 0, 0, 1}, {0, 0, 1, 1}};
-    among.fill(next);
-    const FillStats c0 = among.fillStats();
-    among.fill({&corner, 1});
-    EXPECT_EQ(among.fillStats().texelsCopied - c0.texelsCopied, 33u);
+    for (bool half : {false, true}) {
+        SCOPED_TRACE(half ? "half" : "float");
+        ShaderMapOptions options;
+        options.resolution = 256;
+        options.halfPrecision = half;
+        ShaderMap alone(f.surface, *f.kernel, f.uniforms, options);
+        ShaderMap among(f.surface, *f.kernel, f.uniforms, options);
+        const TileKey key{0, 0, 5, 5};
+        const FillStats pinned = alone.fillStats();  // the always-resident levels
+        alone.fill({&key, 1});
+        EXPECT_EQ(alone.fillStats().texelsCopied, pinned.texelsCopied);
+        EXPECT_EQ(alone.fillStats().programRuns - pinned.programRuns, 324u);
+        std::vector<TileKey> ring;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx)
+                if (dx || dy)
+                    ring.push_back(
+                        {0, 0, static_cast<uint16_t>(5 + dx), static_cast<uint16_t>(5 + dy)});
+        among.fill(ring);
+        const FillStats ringStats = among.fillStats();
+        among.fill({&key, 1});
+        const FillStats after = among.fillStats();
+        EXPECT_EQ(after.texelsCopied - ringStats.texelsCopied, 68u);
+        EXPECT_EQ(after.programRuns - ringStats.programRuns, 256u);
+        const size_t values = static_cast<size_t>(alone.stride() * alone.stride() * 3);
+        if (half) {
+            const uint16_t* a = alone.tileHalves(alone.slotOf(key));
+            const uint16_t* b = among.tileHalves(among.slotOf(key));
+            for (size_t x = 0; x < values; ++x) ASSERT_EQ(a[x], b[x]) << "value " << x;
+        } else {
+            const float* a = alone.tileFloats(alone.slotOf(key));
+            const float* b = among.tileFloats(among.slotOf(key));
+            for (size_t x = 0; x < values; ++x) ASSERT_EQ(a[x], b[x]) << "value " << x;
+        }
+        // A corner tile: its border beyond the plane's edge (no chart across) is evaluated,
+        // the rest (right column, bottom row and the corner between) copied: 17 + 16 texels.
+        const TileKey corner{0, 0, 0, 0};
+        std::vector<TileKey> next = {{0, 0, 1, 0}, {0, 0, 0, 1}, {0, 0, 1, 1}};
+        among.fill(next);
+        const FillStats c0 = among.fillStats();
+        among.fill({&corner, 1});
+        EXPECT_EQ(among.fillStats().texelsCopied - c0.texelsCopied, 33u);
+    }
 }
 
 TEST(ShaderMap, TilesBuiltFromTheirChildrenAreTheirBoxMean) {
