@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include <tbb/parallel_for.h>
 
 #include "geometry/error.h"
+#include "geometry/float4.h"
 
 namespace mpshade {
 namespace {
@@ -135,22 +135,6 @@ void SampleLayout::prepareFilter() {
     });
 }
 
-namespace {
-
-// Four channels as one SSE/AVX register.
-typedef float Float4 __attribute__((vector_size(16)));
-
-inline Float4 load4(const float* p) {
-    Float4 v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-}
-inline void store4(float* p, Float4 v) {
-    std::memcpy(p, &v, sizeof v);
-}
-
-}  // namespace
-
 void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out) const {
     if (out.width != width_ || out.height != height_) out = Image(width_, height_);
     const size_t taps = static_cast<size_t>(taps_), spp = static_cast<size_t>(spp_);
@@ -181,14 +165,14 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
                     // The common case unrolled: a 3 x 3 neighbourhood inside the image.
                     for (size_t s = first; s < last; ++s) {
                         const float* w = weights + s * 6;
-                        const Float4 c = load4(rgba + 4 * s);
+                        const Float4 c = loadFloat4(rgba + 4 * s);
                         const Float4 c0 = w[0] * c, c1 = w[1] * c, c2 = w[2] * c;
                         for (int py = py0; py <= py1; ++py) {
                             const float wy = w[3 + (py - qy + 1)];
                             float* o = pixels + (static_cast<size_t>(py) * width + qx - 1) * 4;
-                            store4(o, load4(o) + wy * c0);
-                            store4(o + 4, load4(o + 4) + wy * c1);
-                            store4(o + 8, load4(o + 8) + wy * c2);
+                            storeFloat4(o, loadFloat4(o) + wy * c0);
+                            storeFloat4(o + 4, loadFloat4(o + 4) + wy * c1);
+                            storeFloat4(o + 8, loadFloat4(o + 8) + wy * c2);
                         }
                     }
                     continue;
@@ -196,7 +180,7 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
                 for (size_t s = first; s < last; ++s) {
                     const float* w =
                         same ? pixelWeights + pixel * taps * taps : weights + s * 2 * taps;
-                    const Float4 c = load4(rgba + 4 * s);
+                    const Float4 c = loadFloat4(rgba + 4 * s);
                     for (int py = py0; py <= py1; ++py) {
                         const size_t oy = static_cast<size_t>(py - qy + reach);
                         float* row = pixels + static_cast<size_t>(py) * width * 4;
@@ -204,14 +188,14 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
                             const size_t ox = static_cast<size_t>(px - qx + reach);
                             const float f = same ? w[oy * taps + ox] : w[taps + oy] * w[ox];
                             float* o = row + 4 * static_cast<size_t>(px);
-                            store4(o, load4(o) + f * c);
+                            storeFloat4(o, loadFloat4(o) + f * c);
                         }
                     }
                 }
             }
         }
         for (size_t p = static_cast<size_t>(r0) * width; p < static_cast<size_t>(r1) * width; ++p)
-            store4(pixels + 4 * p, load4(pixels + 4 * p) * inverseSum[p]);
+            storeFloat4(pixels + 4 * p, loadFloat4(pixels + 4 * p) * inverseSum[p]);
     });
 }
 

@@ -1,5 +1,6 @@
 #include "shadermaps/probe.h"
 
+#include "geometry/float4.h"
 #include "shadermaps/half_float.h"
 
 #include <algorithm>
@@ -8,18 +9,6 @@
 
 namespace mpshade {
 namespace {
-
-// Four floats in one SSE register (GCC and Clang vector extensions: portable, and as wide
-// as the build's instruction set allows).
-using Float4 = float __attribute__((vector_size(16)));
-inline Float4 loadFloat4(const float* p) {
-    Float4 v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-}
-inline void storeFloat4(float* p, Float4 v) {
-    std::memcpy(p, &v, sizeof v);
-}
 
 constexpr int kMaxChannels = 64;
 constexpr int kMaxTaps = 63;  // Feline: 2 maxAnisotropy - 1, maxAnisotropy capped at 32
