@@ -127,13 +127,14 @@ int runRenderCommand(const RenderCommandOptions& options) {
         const uint64_t memoryLimit = options.memoryMb > 0
                                          ? static_cast<uint64_t>(options.memoryMb) << 20
                                          : defaultMemoryLimitBytes();
+        // The frame as rendered: the options over the scene's settings.
+        const int width = render.width > 0 ? render.width : scene.settings.width;
+        const int height = render.height > 0 ? render.height : scene.settings.height;
+        const int spp =
+            render.samplesPerPixel > 0 ? render.samplesPerPixel : scene.settings.samplesPerPixel;
         {
-            const int w = render.width > 0 ? render.width : scene.settings.width;
-            const int h = render.height > 0 ? render.height : scene.settings.height;
-            const int spp = render.samplesPerPixel > 0 ? render.samplesPerPixel
-                                                       : scene.settings.samplesPerPixel;
             FrameMemoryEstimate estimate = estimateFrameMemory(
-                w, h, spp, multiphase, !multiphase || options.compare, options.truthSpp);
+                width, height, spp, multiphase, !multiphase || options.compare, options.truthSpp);
             const uint64_t rays = estimateRaySceneBytes(scene, !multiphase || options.compare);
             const bool raysDominate = rays > estimate.bytes;
             estimate.bytes += rays;
@@ -175,15 +176,12 @@ int runRenderCommand(const RenderCommandOptions& options) {
         // stats.json, rewritten (atomically) after every frame: what a stopped render
         // finished is always described.
         const auto writeStats = [&] {
-            const int width = render.width > 0 ? render.width : scene.settings.width;
-            const int height = render.height > 0 ? render.height : scene.settings.height;
             nlohmann::json doc = {
                 {"scene", options.scene},
                 {"mode", options.mode},
                 {"width", width},
                 {"height", height},
-                {"samples_per_pixel", render.samplesPerPixel > 0 ? render.samplesPerPixel
-                                                                 : scene.settings.samplesPerPixel},
+                {"samples_per_pixel", spp},
                 {"seed", options.seed},
                 {"frames_requested", last - first},
                 {"memory_limit_mb", memoryLimit >> 20},
