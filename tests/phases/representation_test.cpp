@@ -1,6 +1,7 @@
 // The static phase's representations and the dynamic phase over them: dicing to its two
 // targets, facets clipped at the near plane, the representation auto picks, shading rates,
 // the maps' memory budget, and the grazing floor against a 64-sample reference.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "phases/dicing.h"
+#include "phases/facet_clipping.h"
 #include "phases/facet_rasterizer.h"
 #include "phases/fixed_point_warp.h"
 #include "phases/image_compare.h"
@@ -177,6 +179,113 @@ TEST(FacetClipping, FacetsAcrossTheNearPlaneStayWatertight) {
             << "sample " << s << " at (" << layout.x(s) << ", " << layout.y(s) << ")";
     }
     EXPECT_GT(floor, 20000);
+}
+
+// Is (x, y) inside triangle (a, b, c), and how far from its nearest edge line (pixels)?
+bool insideTriangle(const glm::dvec2 v[3], double x, double y, double& edgeDistance) {
+    int positive = 0, negative = 0;
+    edgeDistance = 1e300;
+    for (int e = 0; e < 3; ++e) {
+        const glm::dvec2 a = v[e], b = v[(e + 1) % 3];
+        const double cross = (b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x);
+        edgeDistance = std::min(edgeDistance, std::fabs(cross) / glm::length(b - a));
+        positive += cross > 0.0, negative += cross < 0.0;
+    }
+    return positive == 0 || negative == 0;
+}
+
+TEST(FacetClipping, GuardBandOnBothAxes) {
+    // A square of two facets seen so close that it spans about 160 000 pixels each way,
+    // and three more facets crossing the guard band (|x|, |y| <= 32768 pixels) on x only,
+    // on y only, and on both. Clipped, every corner lies in the band, new corners on its
+    // edges, and the clipped triangles cover exactly the points of the band the exact
+    // facet covers (points on a grid through the band and just inside its edges, away
+    // from the facet's own edges); the square's two halves share their clipped corners.
+    FacetMesh mesh;
+    Bounds3 b;
+    b.extend(glm::vec3(-1, -1, -0.001f));
+    b.extend(glm::vec3(1, 1, 0.001f));
+    mesh.format = FixedPointFormat::forBounds(b);
+    const glm::vec2 corners[] = {{-1, -1},   {1, -1},       {1, 1},          {-1, 1},  // square
+                                 {-1, 0},    {0.2f, -0.2f}, {0.25f, 0.25f},            // x only
+                                 {0, -1},    {0.2f, 0.2f},  {-0.25f, 0.25f},           // y only
+                                 {-1, 0.9f}, {0.9f, -1},    {0.1f, 0.1f}};             // both
+    for (const glm::vec2& c : corners) {
+        mesh.qx.push_back(mesh.format.quantize(c.x, 0));
+        mesh.qy.push_back(mesh.format.quantize(c.y, 1));
+        mesh.qz.push_back(mesh.format.quantize(0.0f, 2));
+    }
+    mesh.positionIndex = {0, 1, 2, 0, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+    mesh.attributeIndex = mesh.positionIndex;
+    View view(glm::vec3(0, 0, 5), glm::vec3(0.0f), 320, 240);
+    view.camera.tanHalfFovY = 3e-4f;  // 1 object unit is about 80 000 pixels
+    const FixedPointWarp warp(glm::mat4(1.0f), view.camera, mesh.format);
+    WarpedVertices warped;
+    warp.warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.qx.size(), warped);
+
+    constexpr double G = FixedPointWarp::kGuardBand;
+    std::vector<double> probes;
+    for (double p = -G + 0.25; p < G; p += 997.0) probes.push_back(p);
+    for (double p : {-G + 0.25, -G + 0.75, G - 0.75, G - 0.25}) probes.push_back(p);
+    std::vector<std::vector<ScreenTriangle>> clipped;
+    for (size_t f = 0; f < mesh.positionIndex.size(); f += 3) {
+        const uint32_t* p = &mesh.positionIndex[f];
+        glm::dvec2 exact[3];
+        bool crossesX = false, crossesY = false;
+        for (int i = 0; i < 3; ++i) {
+            ASSERT_TRUE(warp.warpExact(mesh.qx[p[i]], mesh.qy[p[i]], mesh.qz[p[i]], exact[i].x,
+                                       exact[i].y));
+            crossesX |= std::fabs(exact[i].x) > G, crossesY |= std::fabs(exact[i].y) > G;
+            ASSERT_EQ(warped.culled(p[i]), std::fabs(exact[i].x) > G || std::fabs(exact[i].y) > G);
+        }
+        if (f == 6) {
+            EXPECT_TRUE(crossesX && !crossesY);
+        } else if (f == 9) {
+            EXPECT_TRUE(!crossesX && crossesY);
+        } else if (f == 12) {
+            EXPECT_TRUE(crossesX && crossesY);
+        }
+        ScreenTriangle out[6];
+        const int n = clipFacet(warp, mesh, warped, p, out);
+        ASSERT_GT(n, 0) << "facet " << f / 3;
+        clipped.emplace_back(out, out + n);
+        constexpr int32_t kBand = int32_t(G) * 256;
+        for (const ScreenTriangle& t : clipped.back())
+            for (int i = 0; i < 3; ++i) {
+                ASSERT_LE(std::abs(t.x[i]), kBand) << "facet " << f / 3;
+                ASSERT_LE(std::abs(t.y[i]), kBand) << "facet " << f / 3;
+                ASSERT_GT(t.invDepth[i], 0.0f);
+            }
+        int inside = 0;
+        for (double x : probes)
+            for (double y : probes) {
+                double distance;
+                const bool in = insideTriangle(exact, x, y, distance);
+                if (distance < 2.0) continue;
+                bool covered = false;
+                for (const ScreenTriangle& t : clipped.back()) {
+                    glm::dvec2 v[3];
+                    for (int i = 0; i < 3; ++i) v[i] = glm::dvec2(t.x[i], t.y[i]) / 256.0;
+                    double unused;
+                    covered |= insideTriangle(v, x, y, unused);
+                }
+                ASSERT_EQ(covered, in) << "facet " << f / 3 << " at (" << x << ", " << y << ")";
+                inside += in;
+            }
+        EXPECT_GT(inside, 100) << "facet " << f / 3;
+    }
+    // The square's halves: each corner one makes on the diagonal, the other makes too.
+    auto corners0 = [&](int facet) {
+        std::vector<std::pair<int32_t, int32_t>> c;
+        for (const ScreenTriangle& t : clipped[facet])
+            for (int i = 0; i < 3; ++i) c.emplace_back(t.x[i], t.y[i]);
+        return c;
+    };
+    const auto a = corners0(0), bc = corners0(1);
+    int shared = 0;
+    for (const auto& c : a)
+        if (std::find(bc.begin(), bc.end(), c) != bc.end()) ++shared;
+    EXPECT_GE(shared, 2) << "the clipped diagonal's two ends";
 }
 
 TEST(RepresentationChoice, RulesBeforeTheEstimate) {
