@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--shading-rate", render.shadingRate,
                           "Multiphase: run the dynamic shader per 'sample' or per 'pixel' "
                           "(overrides the scene)");
+    renderCmd->add_option("--footprint-scale", render.footprintScale,
+                          "Multiphase: shader map texels per shading point spacing, inverted "
+                          "(default 0.6; larger reads coarser levels: faster, blurrier)");
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
     renderCmd->add_option("--memory-mb", render.memoryMb,
                           "Refuse a render estimated to need more memory than this (MB; "

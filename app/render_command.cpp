@@ -166,6 +166,13 @@ int runRenderCommand(const RenderCommandOptions& options) {
                         {"--shading-rate", 0, 0, {}},
                         "expected sample or pixel, found '" + options.shadingRate + "'");
             }
+            if (options.footprintScale != 0.0f) {
+                if (!(options.footprintScale >= 0.05f && options.footprintScale <= 8.0f))
+                    throw InputError(
+                        {"--footprint-scale", 0, 0, {}},
+                        "expected 0.05..8, found " + std::to_string(options.footprintScale));
+                mo.dynamic.footprintScale = options.footprintScale;
+            }
             multi = std::make_unique<MultiphaseRenderer>(scene, mo);
             multi->plan(first, last, render);
         }

@@ -19,6 +19,9 @@ struct RenderCommandOptions {
     std::string shadingRate;  // "sample" or "pixel"; empty = the scene's
     int truthSpp = -1;        // with compare: also measure both against this many spp
     int64_t memoryMb = 0;     // refuse renders estimated above this; 0: 3/4 of physical memory
+    // Multiphase: probe footprint over the shading points' spacing (texel spacing of the
+    // shader maps read); <= 0: the default (DynamicOptions::footprintScale). 0.05..8.
+    float footprintScale = 0.0f;
 };
 
 // Returns the process exit code: 0 success, 2 bad input (message already on stderr).

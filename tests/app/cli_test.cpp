@@ -198,6 +198,10 @@ TEST(Cli, BadInputExitsTwoNamingThePlace) {
          "(multiphase) needs about 0.5 GB, over the memory limit of 0.1 GB (--memory-mb)"},
         {"render examples/vase/scene.json --memory-mb -5 --out /tmp/x",
          "mpshade: --memory-mb: error: expected a positive number of MB\n"},
+        {"render examples/vase/scene.json --footprint-scale 9 --out /tmp/x",
+         "mpshade: --footprint-scale: error: expected 0.05..8, found 9"},
+        {"render examples/vase/scene.json --footprint-scale nan --out /tmp/x",
+         "mpshade: --footprint-scale: error: expected 0.05..8, found"},
         {"paint", "mpshade: error: "},
     };
     for (const BadRun& c : cases) {

@@ -92,6 +92,36 @@ TEST(ReferenceRenderer, TranslucentLayersCompositeFrontToBack) {
     EXPECT_EQ(stats.shadedPoints, 2u * 256u);
 }
 
+TEST(ReferenceRenderer, ColouredOpacityCompositesPerChannel) {
+    // The same two planes with Oi = (0.5, 0.25, 1): each channel composites on its own.
+    // Red plane: C = (0.5, 0, 0), T = (0.5, 0.75, 0); green behind adds 0.75 * 0.25 to
+    // green, T = (0.25, 0.5625, 0); the blue background is hidden. Alpha is the mean
+    // coverage, 1 - (0.25 + 0.5625 + 0) / 3.
+    const char* json = R"({
+      "settings": { "width": 8, "height": 8, "samples_per_pixel": 1, "background": [0, 0, 1] },
+      "camera": { "fov_y": 30, "eye": [0, 5, 0], "target": [0, 0, 0], "up": [0, 0, -1] },
+      "shaders": { "s": "s.sl" },
+      "objects": [
+        { "name": "front", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
+          "params": { "c": [1, 0, 0] }, "transform": { "translate": [0, 1, 0] } },
+        { "name": "back", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
+          "params": { "c": [0, 1, 0] } } ]
+    })";
+    const Scene scene = loadScene(writeScene(
+        "coloured", json, "surface s(color c = 0) { Ci = c; Oi = color(0.5, 0.25, 1.0); }"));
+    const ReferenceRenderer renderer(scene);
+    FrameStats stats;
+    const Image image = renderer.renderFrame(0, {}, stats);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            const float* p = image.pixel(x, y);
+            ASSERT_NEAR(p[0], 0.5f, 1e-5f);
+            ASSERT_NEAR(p[1], 0.1875f, 1e-5f);
+            ASSERT_NEAR(p[2], 0.0f, 1e-5f);
+            ASSERT_NEAR(p[3], 1.0f - 0.8125f / 3.0f, 1e-5f);
+        }
+}
+
 TEST(ReferenceRenderer, IsDeterministicForASeed) {
     const Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
     const ReferenceRenderer renderer(scene);
@@ -131,40 +161,49 @@ TEST(PixelFilter, PreservesAConstantImage) {
 }
 
 TEST(PixelFilter, MatchesTheTruncatedGaussianComputedDirectly) {
-    // One bright sample among dark ones: each pixel it reaches gets exactly its filter
-    // weight over the pixel's total, computed here from the formula in double precision.
-    const int w = 6, h = 5, spp = 2;
-    std::vector<float> xy;
-    for (int py = 0; py < h; ++py)
-        for (int px = 0; px < w; ++px)
-            for (int k = 0; k < spp; ++k)
-                xy.push_back(px + 0.2f + 0.55f * k), xy.push_back(py + 0.7f - 0.45f * k);
-    const PixelFilter filter{1.5f, 0.5f};
-    const SampleLayout layout(w, h, spp, xy, filter);
-    const size_t bright = layout.index(2, 2, 1);
-    std::vector<float> rgba(layout.count() * 4, 0.0f);
-    rgba[4 * bright] = 1.0f;
-    auto g = [&](double d) {
-        const double s2 = 2.0 * 0.5 * 0.5;
-        return std::fabs(d) < 1.5 ? std::max(0.0, std::exp(-d * d / s2) - std::exp(-2.25 / s2))
-                                  : 0.0;
-    };
-    Image image;
-    layout.resolve(rgba.data(), nullptr, image);
-    for (int py = 0; py < h; ++py)
-        for (int px = 0; px < w; ++px) {
-            double total = 0.0, mine = 0.0;
-            for (size_t s = 0; s < layout.count(); ++s) {
-                const double wgt = g(layout.x(s) - (px + 0.5)) * g(layout.y(s) - (py + 0.5));
-                total += wgt;
-                if (s == bright) mine = wgt;
+    // Radii whose reach (the pixels a sample can touch either side) differs: 1, 1 and 2.
+    for (const float radius : {1.0f, 1.5f, 2.0f}) {
+        SCOPED_TRACE(radius);
+        // One bright sample among dark ones: each pixel it reaches gets exactly its filter
+        // weight over the pixel's total, computed here from the formula in double precision.
+        const int w = 6, h = 5, spp = 2;
+        std::vector<float> xy;
+        for (int py = 0; py < h; ++py)
+            for (int px = 0; px < w; ++px)
+                for (int k = 0; k < spp; ++k)
+                    xy.push_back(px + 0.2f + 0.55f * k), xy.push_back(py + 0.7f - 0.45f * k);
+        const PixelFilter filter{radius, 0.5f};
+        const SampleLayout layout(w, h, spp, xy, filter);
+        const size_t bright = layout.index(2, 2, 1);
+        std::vector<float> rgba(layout.count() * 4, 0.0f);
+        rgba[4 * bright] = 1.0f;
+        auto g = [&](double d) {
+            const double s2 = 2.0 * 0.5 * 0.5;
+            const double r = radius;
+            return std::fabs(d) < r ? std::max(0.0, std::exp(-d * d / s2) - std::exp(-r * r / s2))
+                                    : 0.0;
+        };
+        Image image;
+        layout.resolve(rgba.data(), nullptr, image);
+        for (int py = 0; py < h; ++py)
+            for (int px = 0; px < w; ++px) {
+                double total = 0.0, mine = 0.0;
+                for (size_t s = 0; s < layout.count(); ++s) {
+                    const double wgt = g(layout.x(s) - (px + 0.5)) * g(layout.y(s) - (py + 0.5));
+                    total += wgt;
+                    if (s == bright) mine = wgt;
+                }
+                EXPECT_NEAR(image.pixel(px, py)[0], mine / total, 1e-6) << px << "," << py;
             }
-            EXPECT_NEAR(image.pixel(px, py)[0], mine / total, 1e-6) << px << "," << py;
+        // The bright sample at (2.75, 2.25) reaches the pixels around (2, 2) only; row 0's
+        // centre is 1.75 away, two rows up: within reach of radius 2 only.
+        EXPECT_GT(image.pixel(3, 1)[0], 0.0f);
+        EXPECT_EQ(image.pixel(0, 2)[0], 0.0f);
+        EXPECT_EQ(image.pixel(2, 4)[0], 0.0f);
+        if (radius == 2.0f) {
+            EXPECT_GT(image.pixel(2, 0)[0], 0.0f);
         }
-    // The bright sample at (2.75, 2.25) reaches the pixels around (2, 2) only.
-    EXPECT_GT(image.pixel(3, 1)[0], 0.0f);
-    EXPECT_EQ(image.pixel(0, 2)[0], 0.0f);
-    EXPECT_EQ(image.pixel(2, 4)[0], 0.0f);
+    }
 }
 
 TEST(PixelFilter, UniformPixelsResolveAsTheirSamples) {

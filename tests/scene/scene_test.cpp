@@ -267,6 +267,12 @@ TEST(Keyframes, InterpolateLinearlyAndHoldOutside) {
     EXPECT_TRUE(k.varies());
     k.values = {5.0f, 5.0f};
     EXPECT_FALSE(k.varies());
+    // Three keys, unevenly spaced: each span interpolates over its own length.
+    k.times = {0.0f, 1.0f, 5.0f};
+    k.values = {0.0f, 10.0f, 50.0f};
+    EXPECT_EQ(k.at(0.5f), 5.0f);
+    EXPECT_EQ(k.at(3.0f), 30.0f);
+    EXPECT_EQ(k.at(4.0f), 40.0f);
 }
 
 class ExampleScenes : public ::testing::TestWithParam<const char*> {};

@@ -62,6 +62,9 @@ const Case kCases[] = {
          float t = std::fmin(std::fmax((u - v) / ((v + 1.0f) - v), 0.0f), 1.0f);
          return t * t * (3 - 2 * t);
      }},
+    // Equal edges: a step at the edge, 1 on it.
+    {"smoothstep(v, v, u)", [](float u, float v, float) { return u < v ? 0.0f : 1.0f; }},
+    {"smoothstep(u, u, u)", [](float, float, float) { return 1.0f; }},
     {"u / v", [](float u, float v, float) { return safeDiv(u, v); }},
     {"u * v - s", [](float u, float v, float s) { return u * v - s; }},
     {"-u + v", [](float u, float v, float) { return -u + v; }},
