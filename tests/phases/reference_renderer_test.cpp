@@ -1,11 +1,13 @@
 // The reference renderer on cases with known answers: silhouette coverage of a sphere,
 // front-to-back compositing of translucent layers, determinism, and non-finite shaders.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 
 #include <gtest/gtest.h>
 
+#include "phases/image_compare.h"
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
 #include "test_support.h"
@@ -120,6 +122,37 @@ TEST(ReferenceRenderer, ColouredOpacityCompositesPerChannel) {
             ASSERT_NEAR(p[2], 0.0f, 1e-5f);
             ASSERT_NEAR(p[3], 1.0f - 0.8125f / 3.0f, 1e-5f);
         }
+    // Opacity over 1 counts as 1: the front plane alone, opaque.
+    const Scene over =
+        loadScene(writeScene("over_opaque", json, "surface s(color c = 0) { Ci = c; Oi = 2.0; }"));
+    const Image opaque = ReferenceRenderer(over).renderFrame(0, {}, stats);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            const float* p = opaque.pixel(x, y);
+            ASSERT_NEAR(p[0], 1.0f, 1e-5f);
+            ASSERT_NEAR(p[1], 0.0f, 1e-5f);
+            ASSERT_NEAR(p[2], 0.0f, 1e-5f);
+            ASSERT_NEAR(p[3], 1.0f, 1e-5f);
+        }
+}
+
+TEST(ImageCompare, ErrorsFromNumbersWorkedByHand) {
+    // Two pixels: RGB differences (0.1, 0, 0) and (0, 0.2, 0) -- and 1.5 against 0.5, which
+    // counts as 1 against 0.5 (clamped) -- so MSE = (0.01 + 0.04 + 0.25) / 6 = 0.05; alpha
+    // differs by +0.25 and -0.25: a mean |difference| of 0.25, not 0.
+    Image a(2, 1), b(2, 1);
+    const float pa[8] = {0.6f, 0.3f, 0.2f, 1.0f, 0.4f, 0.7f, 0.5f, 0.5f};
+    const float pb[8] = {0.5f, 0.3f, 0.2f, 0.75f, 0.4f, 0.5f, 0.5f, 0.75f};
+    std::copy(pa, pa + 8, a.rgba.begin());
+    std::copy(pb, pb + 8, b.rgba.begin());
+    a.pixel(1, 0)[2] = 1.5f;
+    b.pixel(1, 0)[2] = 0.5f;
+    const ImageError e = compareImages(a, b);
+    EXPECT_NEAR(e.rmse, std::sqrt(0.05), 1e-6);
+    EXPECT_NEAR(e.psnr, 10.0 * std::log10(1.0 / 0.05), 1e-4);
+    EXPECT_NEAR(e.maxAbs, 0.5, 1e-6);
+    EXPECT_NEAR(e.coverageDiff, 0.25, 1e-6);
+    EXPECT_EQ(compareImages(a, a).psnr, 99.0);
 }
 
 TEST(ReferenceRenderer, IsDeterministicForASeed) {
