@@ -20,7 +20,7 @@ struct RenderCommandOptions {
     int truthSpp = -1;        // with compare: also measure both against this many spp
     int64_t memoryMb = 0;     // refuse renders estimated above this; 0: 3/4 of physical memory
     // Multiphase: probe footprint over the shading points' spacing (texel spacing of the
-    // shader maps read); <= 0: the default (DynamicOptions::footprintScale). 0.05..8.
+    // shader maps read); 0: the default (DynamicOptions::footprintScale); else 0.05..8.
     float footprintScale = 0.0f;
 };
 

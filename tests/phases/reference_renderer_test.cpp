@@ -64,76 +64,55 @@ TEST(ReferenceRenderer, SphereCoverageMatchesItsSilhouette) {
     EXPECT_EQ(stats.rays, stats.samples);
 }
 
+// Two parallel planes facing the camera, red in front of green, on blue; their shader
+// sets the opacity.
+const char* kTwoPlanesScene = R"({
+  "settings": { "width": 16, "height": 16, "samples_per_pixel": 1, "background": [0, 0, 1] },
+  "camera": { "fov_y": 30, "eye": [0, 5, 0], "target": [0, 0, 0], "up": [0, 0, -1] },
+  "shaders": { "s": "s.sl" },
+  "objects": [
+    { "name": "front", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
+      "params": { "c": [1, 0, 0] }, "transform": { "translate": [0, 1, 0] } },
+    { "name": "back", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
+      "params": { "c": [0, 1, 0] } } ]
+})";
+
+// Every pixel of `image` is `rgba` within 1e-5.
+void expectEveryPixel(const Image& image, const float rgba[4]) {
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x)
+            for (int c = 0; c < 4; ++c)
+                ASSERT_NEAR(image.pixel(x, y)[c], rgba[c], 1e-5f)
+                    << "pixel (" << x << ", " << y << ") channel " << c;
+}
+
 TEST(ReferenceRenderer, TranslucentLayersCompositeFrontToBack) {
-    // Two parallel planes facing the camera, each Oi = 0.5: red in front of green, on blue.
-    const char* json = R"({
-      "settings": { "width": 16, "height": 16, "samples_per_pixel": 1, "background": [0, 0, 1] },
-      "camera": { "fov_y": 30, "eye": [0, 5, 0], "target": [0, 0, 0], "up": [0, 0, -1] },
-      "shaders": { "s": "s.sl" },
-      "objects": [
-        { "name": "front", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
-          "params": { "c": [1, 0, 0] }, "transform": { "translate": [0, 1, 0] } },
-        { "name": "back", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
-          "params": { "c": [0, 1, 0] } } ]
-    })";
-    const Scene scene =
-        loadScene(writeScene("layers", json, "surface s(color c = 0) { Ci = c; Oi = 0.5; }"));
+    // Each plane Oi = 0.5.
+    const Scene scene = loadScene(
+        writeScene("layers", kTwoPlanesScene, "surface s(color c = 0) { Ci = c; Oi = 0.5; }"));
     const ReferenceRenderer renderer(scene);
     FrameStats stats;
-    const Image image = renderer.renderFrame(0, {}, stats);
-    for (int y = 0; y < 16; ++y) {
-        for (int x = 0; x < 16; ++x) {
-            const float* p = image.pixel(x, y);
-            ASSERT_NEAR(p[0], 0.5f, 1e-5f);
-            ASSERT_NEAR(p[1], 0.25f, 1e-5f);
-            ASSERT_NEAR(p[2], 0.25f, 1e-5f);
-            ASSERT_NEAR(p[3], 0.75f, 1e-5f);
-        }
-    }
+    const float expected[4] = {0.5f, 0.25f, 0.25f, 0.75f};
+    expectEveryPixel(renderer.renderFrame(0, {}, stats), expected);
     EXPECT_EQ(stats.rays, 3u * 256u);  // each camera ray passes two layers and leaves
     EXPECT_EQ(stats.shadedPoints, 2u * 256u);
 }
 
 TEST(ReferenceRenderer, ColouredOpacityCompositesPerChannel) {
-    // The same two planes with Oi = (0.5, 0.25, 1): each channel composites on its own.
-    // Red plane: C = (0.5, 0, 0), T = (0.5, 0.75, 0); green behind adds 0.75 * 0.25 to
-    // green, T = (0.25, 0.5625, 0); the blue background is hidden. Alpha is the mean
-    // coverage, 1 - (0.25 + 0.5625 + 0) / 3.
-    const char* json = R"({
-      "settings": { "width": 8, "height": 8, "samples_per_pixel": 1, "background": [0, 0, 1] },
-      "camera": { "fov_y": 30, "eye": [0, 5, 0], "target": [0, 0, 0], "up": [0, 0, -1] },
-      "shaders": { "s": "s.sl" },
-      "objects": [
-        { "name": "front", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
-          "params": { "c": [1, 0, 0] }, "transform": { "translate": [0, 1, 0] } },
-        { "name": "back", "geometry": { "type": "plane", "size": [10, 10] }, "shader": "s",
-          "params": { "c": [0, 1, 0] } } ]
-    })";
-    const Scene scene = loadScene(writeScene(
-        "coloured", json, "surface s(color c = 0) { Ci = c; Oi = color(0.5, 0.25, 1.0); }"));
-    const ReferenceRenderer renderer(scene);
+    // Oi = (0.5, 0.25, 1): each channel composites on its own. Red plane: C = (0.5, 0, 0),
+    // T = (0.5, 0.75, 0); green behind adds 0.75 * 0.25 to green, T = (0.25, 0.5625, 0);
+    // the blue background is hidden. Alpha is the mean coverage, 1 - (0.25 + 0.5625 + 0) / 3.
+    const Scene scene =
+        loadScene(writeScene("coloured", kTwoPlanesScene,
+                             "surface s(color c = 0) { Ci = c; Oi = color(0.5, 0.25, 1.0); }"));
     FrameStats stats;
-    const Image image = renderer.renderFrame(0, {}, stats);
-    for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x) {
-            const float* p = image.pixel(x, y);
-            ASSERT_NEAR(p[0], 0.5f, 1e-5f);
-            ASSERT_NEAR(p[1], 0.1875f, 1e-5f);
-            ASSERT_NEAR(p[2], 0.0f, 1e-5f);
-            ASSERT_NEAR(p[3], 1.0f - 0.8125f / 3.0f, 1e-5f);
-        }
+    const float expected[4] = {0.5f, 0.1875f, 0.0f, 1.0f - 0.8125f / 3.0f};
+    expectEveryPixel(ReferenceRenderer(scene).renderFrame(0, {}, stats), expected);
     // Opacity over 1 counts as 1: the front plane alone, opaque.
-    const Scene over =
-        loadScene(writeScene("over_opaque", json, "surface s(color c = 0) { Ci = c; Oi = 2.0; }"));
-    const Image opaque = ReferenceRenderer(over).renderFrame(0, {}, stats);
-    for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 8; ++x) {
-            const float* p = opaque.pixel(x, y);
-            ASSERT_NEAR(p[0], 1.0f, 1e-5f);
-            ASSERT_NEAR(p[1], 0.0f, 1e-5f);
-            ASSERT_NEAR(p[2], 0.0f, 1e-5f);
-            ASSERT_NEAR(p[3], 1.0f, 1e-5f);
-        }
+    const Scene over = loadScene(
+        writeScene("over_opaque", kTwoPlanesScene, "surface s(color c = 0) { Ci = c; Oi = 2.0; }"));
+    const float opaque[4] = {1.0f, 0.0f, 0.0f, 1.0f};
+    expectEveryPixel(ReferenceRenderer(over).renderFrame(0, {}, stats), opaque);
 }
 
 TEST(ImageCompare, ErrorsFromNumbersWorkedByHand) {
@@ -195,16 +174,16 @@ TEST(PixelFilter, PreservesAConstantImage) {
 
 TEST(PixelFilter, MatchesTheTruncatedGaussianComputedDirectly) {
     // Radii whose reach (the pixels a sample can touch either side) differs: 1, 1 and 2.
+    // One bright sample among dark ones: each pixel it reaches gets exactly its filter
+    // weight over the pixel's total, computed here from the formula in double precision.
+    const int w = 6, h = 5, spp = 2;
+    std::vector<float> xy;
+    for (int py = 0; py < h; ++py)
+        for (int px = 0; px < w; ++px)
+            for (int k = 0; k < spp; ++k)
+                xy.push_back(px + 0.2f + 0.55f * k), xy.push_back(py + 0.7f - 0.45f * k);
     for (const float radius : {1.0f, 1.5f, 2.0f}) {
         SCOPED_TRACE(radius);
-        // One bright sample among dark ones: each pixel it reaches gets exactly its filter
-        // weight over the pixel's total, computed here from the formula in double precision.
-        const int w = 6, h = 5, spp = 2;
-        std::vector<float> xy;
-        for (int py = 0; py < h; ++py)
-            for (int px = 0; px < w; ++px)
-                for (int k = 0; k < spp; ++k)
-                    xy.push_back(px + 0.2f + 0.55f * k), xy.push_back(py + 0.7f - 0.45f * k);
         const PixelFilter filter{radius, 0.5f};
         const SampleLayout layout(w, h, spp, xy, filter);
         const size_t bright = layout.index(2, 2, 1);
