@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/compare_command.h"
+#include "app/eval_command.h"
 #include "app/factor_command.h"
 #include "app/output_files.h"
 #include "app/render_command.h"
@@ -71,6 +72,21 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
 
+    mpshade::EvalCommandOptions eval;
+    CLI::App* evalCmd = app.add_subcommand(
+        "eval", "Speed against error: ladders of both renderers against a ground truth");
+    evalCmd->add_option("scenes", eval.scenes, "Scene files (.json)")->required();
+    evalCmd->add_option("--out", eval.outDir, "Output folder (created if missing)")->required();
+    evalCmd->add_option("--frames", eval.frames,
+                        "Frames A:B (half-open; default every frame, with --quick the first 6)");
+    evalCmd
+        ->add_option("--truth-spp", eval.truthSpp,
+                     "Samples per pixel of the ground truth (the reference renderer)")
+        ->capture_default_str();
+    evalCmd->add_flag("--quick", eval.quick, "Shorter ladders and 6 frames: minutes, not hours");
+    evalCmd->add_option("--size", eval.size, "Image size WxH (overrides the scenes)");
+    evalCmd->add_flag("--quiet", eval.quiet, "No progress or summary on stderr");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -87,6 +103,7 @@ int main(int argc, char** argv) {
         if (renderCmd->parsed()) return mpshade::runRenderCommand(render);
         if (factorCmd->parsed()) return mpshade::runFactorCommand(factor);
         if (compareCmd->parsed()) return mpshade::runCompareCommand(compare);
+        if (evalCmd->parsed()) return mpshade::runEvalCommand(eval);
     } catch (const mpshade::OutputError& e) {
         std::fprintf(stderr, "mpshade: error: %s\n", e.what());
         return 1;

@@ -62,6 +62,12 @@ const FactoredShader& MultiphaseRenderer::factored(size_t object) const {
     return static_.shading(object).factored;
 }
 
+void MultiphaseRenderer::discardStaticWork() {
+    for (auto& rep : representations_) rep.reset();
+    kinds_.assign(kinds_.size(), Representation::Auto);
+    longestEdge_.assign(longestEdge_.size(), 0.0f);
+}
+
 void MultiphaseRenderer::plan(int first, int last, const RenderOptions& options) {
     planFirst_ = first;
     layoutWidth_ = options.width > 0 ? options.width : scene_.settings.width;

@@ -71,6 +71,12 @@ class MultiphaseRenderer {
     SampleBuffer renderSamples(int frame, const RenderOptions& options, FrameStats& stats,
                                const ProgressFn& progress = {});
 
+    // Drops every object's representation and shader-map tiles, as a camera cut to an
+    // unrelated view leaves nothing to reuse: the next frame runs every static phase it
+    // needs again (`mpshade eval` times its worst case this way). The factored shaders and
+    // ray scenes, fixed for the whole render, stay.
+    void discardStaticWork();
+
     // The current representation of object i (null before a frame has seen it).
     const ObjectRepresentation* representation(size_t object) const;
     const FactoredShader& factored(size_t object) const;

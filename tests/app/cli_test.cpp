@@ -99,6 +99,90 @@ TEST(Cli, MultiphaseComparesWithTheReference) {
     EXPECT_GT(pixels.avg[3], 0.3f);
 }
 
+// The value of a PSNR in eval.json: a number, or "inf" for an exact match.
+double psnrValue(const nlohmann::json& v) {
+    if (v.is_string() && v == "inf") return INFINITY;
+    return v.get<double>();
+}
+
+TEST(Cli, EvalWritesFrontsRatiosReportAndReusesTheTruth) {
+    const std::string out = tempDir("eval");
+    const std::string args =
+        "eval tests/data/scenes/ball.json --quick --frames 0:3 --truth-spp 8 --out " + out;
+    const CliRun run = mpshade(args);
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    std::ifstream file(out + "/eval.json");
+    const nlohmann::json doc = nlohmann::json::parse(file);
+    ASSERT_EQ(doc["scenes"].size(), 1u);
+    const nlohmann::json& s = doc["scenes"][0];
+    EXPECT_EQ(s["name"], "ball");
+    EXPECT_EQ(s["truth"]["frames_rendered"], 3);
+    EXPECT_EQ(s["truth"]["self_psnr_db"], "inf");
+    // Both ladders, every configuration over the three frames, errors finite and sane.
+    int reference = 0, multiphase = 0;
+    for (const auto& c : s["configs"]) {
+        (c["mode"] == "reference" ? reference : multiphase) += 1;
+        ASSERT_EQ(c["frames"].size(), 3u) << c["label"];
+        EXPECT_TRUE(c["frames"][0]["temporal_rmse"].is_null());
+        EXPECT_GE(c["frames"][1]["temporal_rmse"].get<double>(), 0.0);
+        const double psnr = psnrValue(c["psnr_db"]);
+        EXPECT_GT(psnr, 15.0) << c["label"];
+        EXPECT_LT(psnr, 80.0) << c["label"];
+        EXPECT_GE(c["sequence_seconds"].get<double>(), c["static_seconds"].get<double>());
+        EXPECT_EQ(c["nonfinite_samples"], 0);
+    }
+    EXPECT_EQ(reference, 4);
+    EXPECT_GE(multiphase, 5);
+    // More samples make the reference more accurate: 1 spp is well below 8 spp.
+    double ref1 = 0, ref8 = 0;
+    for (const auto& c : s["configs"]) {
+        if (c["mode"] != "reference") continue;
+        const int spp = c["settings"]["samples_per_pixel"];
+        if (spp == 1) ref1 = psnrValue(c["psnr_db"]);
+        if (spp == 8) ref8 = psnrValue(c["psnr_db"]);
+    }
+    EXPECT_GT(ref8, ref1 + 3.0);
+    // Each front is monotone: slower only if more accurate.
+    for (const char* mode : {"reference", "multiphase"}) {
+        const auto& front = s["pareto"][mode];
+        ASSERT_GE(front.size(), 1u) << mode;
+        for (size_t k = 1; k < front.size(); ++k) {
+            EXPECT_GT(front[k]["sequence_seconds"].get<double>(),
+                      front[k - 1]["sequence_seconds"].get<double>());
+            EXPECT_GT(psnrValue(front[k]["psnr_db"]), psnrValue(front[k - 1]["psnr_db"]));
+        }
+    }
+    EXPECT_GT(s["speedup_at_equal_psnr"]["default"]["sequence"].get<double>(), 0.0);
+    EXPECT_TRUE(s["worst_case_overhead"]["overhead"].is_number());
+    EXPECT_EQ(s["worst_case_overhead"]["cut_every_frame"]["settings"]["cut_every_frame"], true);
+    std::ifstream report(out + "/report.md");
+    const std::string md((std::istreambuf_iterator<char>(report)),
+                         std::istreambuf_iterator<char>());
+    EXPECT_NE(md.find("## ball"), std::string::npos);
+    EXPECT_NE(md.find("Speed at equal PSNR"), std::string::npos);
+
+    // A second run renders no truth frame: all three come from the cache.
+    const CliRun again = mpshade(args + " --quiet");
+    ASSERT_EQ(again.exitCode, 0) << again.output;
+    std::ifstream file2(out + "/eval.json");
+    const nlohmann::json doc2 = nlohmann::json::parse(file2);
+    EXPECT_EQ(doc2["scenes"][0]["truth"]["frames_cached"], 3);
+    EXPECT_EQ(doc2["scenes"][0]["truth"]["frames_rendered"], 0);
+}
+
+TEST(Cli, EvalBadInputExitsTwo) {
+    const std::string out = tempDir("eval_bad");
+    CliRun run = mpshade("eval tests/data/scenes/ball.json --frames 3:3 --out " + out);
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_NE(run.output.find("--frames"), std::string::npos) << run.output;
+    run = mpshade("eval tests/data/scenes/ball.json --truth-spp 1 --out " + out);
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_NE(run.output.find("--truth-spp"), std::string::npos) << run.output;
+    run = mpshade("eval tests/data/scenes/no_such.json --out " + out);
+    EXPECT_EQ(run.exitCode, 2);
+    EXPECT_NE(run.output.find("no_such.json"), std::string::npos) << run.output;
+}
+
 // A w x h RGBA float EXR of one colour.
 void writeFlat(const std::string& path, int w, int h, const std::array<float, 4>& rgba) {
     OIIO::ImageBuf buf(OIIO::ImageSpec(w, h, 4, OIIO::TypeDesc::FLOAT));

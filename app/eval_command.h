@@ -1,0 +1,27 @@
+// eval_command.h -- `mpshade eval`: speed against error for one or more scenes
+// (docs/evaluation.md). Per scene: a ground truth (the reference at --truth-spp, cached in
+// the output folder), a ladder of reference settings and one of multi-phase settings, each
+// timed over the same frames and measured against the truth; then the headline ratios, the
+// Pareto fronts, the worst case (a cut every frame), eval.json, report.md and plots.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace mpshade {
+
+struct EvalCommandOptions {
+    std::vector<std::string> scenes;
+    std::string outDir;
+    std::string frames;  // "A:B"; default: every frame (--quick: the first 6)
+    int truthSpp = 64;
+    bool quick = false;  // shorter ladders and fewer frames: a couple of minutes a scene
+    std::string size;    // "WxH": overrides the scenes' settings
+    bool quiet = false;
+};
+
+// Returns the exit code: 0, 2 for bad input (message on stderr), 1 if a file cannot be
+// written.
+int runEvalCommand(const EvalCommandOptions& options);
+
+}  // namespace mpshade
