@@ -60,6 +60,8 @@ std::vector<EvalConfig> ladders(int spp, bool quick) {
     };
     for (int s : quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, 8, 16})
         if (s != spp) add("spp", "spp=" + std::to_string(s), [&](EvalConfig& c) { c.spp = s; });
+    add("single_phase_frames", "never single-phase",
+        [](EvalConfig& c) { c.singlePhaseFrames = false; });
     add("shading_rate", "pixel", [](EvalConfig& c) { c.shadingRate = ShadingRate::Pixel; });
     add("shading_rate", "pixel spp=" + std::to_string(2 * spp), [&](EvalConfig& c) {
         c.shadingRate = ShadingRate::Pixel;

@@ -70,6 +70,7 @@ nlohmann::json runJson(const EvalRun& r, const SceneEvaluation& e) {
         settings["range_scale"] = c.rangeScale;
         settings["cache_mb"] = c.cacheMb;
         settings["cut_every_frame"] = c.cutEveryFrame;
+        settings["single_phase_frames"] = c.singlePhaseFrames;
     }
     nlohmann::json frames = nlohmann::json::array();
     for (const EvalFrame& f : r.frames)
@@ -81,7 +82,8 @@ nlohmann::json runJson(const EvalRun& r, const SceneEvaluation& e) {
                           {"max_abs_error", f.maxAbs},
                           {"temporal_rmse", f.temporalRmse >= 0.0 ? nlohmann::json(f.temporalRmse)
                                                                   : nlohmann::json(nullptr)},
-                          {"nonfinite_samples", f.nonFinite}});
+                          {"nonfinite_samples", f.nonFinite},
+                          {"single_phase", f.singlePhase}});
     return {{"label", c.label},
             {"mode", c.multiphase ? "multiphase" : "reference"},
             {"knob", c.knob},
@@ -97,6 +99,7 @@ nlohmann::json runJson(const EvalRun& r, const SceneEvaluation& e) {
             {"max_abs_error", r.maxAbs},
             {"temporal_rmse", r.temporalRmse},
             {"nonfinite_samples", r.nonFinite},
+            {"single_phase_frames", r.singlePhaseFrames},
             {"frames", frames}};
 }
 
@@ -297,8 +300,9 @@ std::string reportMarkdown(const std::vector<SceneEvaluation>& scenes,
            << fmt("%.2f s", ref.sequenceSeconds) << " at " << e.spp
            << " spp: " << fmt("%+.1f%%", 100.0 * e.worstCaseOverhead) << ".\n\n"
            << "| configuration | knob | sequence s | static s | dynamic s/frame | steady "
-              "frame s | PSNR dB | RMSE | largest | temporal RMSE | memory MB |\n"
-           << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+              "frame s | PSNR dB | RMSE | largest | temporal RMSE | memory MB | single-phase "
+              "frames |\n"
+           << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
         for (const EvalRun& r : e.runs)
             md << "| " << r.config.label << " | " << r.config.knob << " | "
                << fmt("%.2f", r.sequenceSeconds) << " | " << fmt("%.2f", r.staticSeconds) << " | "

@@ -29,6 +29,7 @@ MultiphaseOptions multiphaseOptions(const EvalConfig& c) {
     o.dynamic.probe.maxAnisotropy = c.maxAnisotropy;
     o.staticPhase.combinedDicing.maxEdgePixels = c.facetEdgePixels;
     o.mapMemoryBytes = static_cast<size_t>(c.cacheMb) << 20;
+    o.singlePhaseFrames = c.singlePhaseFrames;
     return o;
 }
 
@@ -121,6 +122,8 @@ EvalRun runEvalConfig(const std::string& scenePath, const EvalConfig& config, in
         e.rmse = std::sqrt(e.mse);
         e.maxAbs = compareImages(image, t).maxAbs;
         e.nonFinite = stats.nonFiniteSamples;
+        e.singlePhase = stats.singlePhase;
+        run.singlePhaseFrames += e.singlePhase ? 1 : 0;
         if (f > first) {
             e.temporalRmse =
                 temporalRmse(previous, image, truth[static_cast<size_t>(f - first - 1)], t);

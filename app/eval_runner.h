@@ -26,10 +26,11 @@ struct EvalConfig {
     float footprintScale = 0.6f;  // the map resolution bias: larger reads coarser levels
     ProbeFilter filter = ProbeFilter::Feline;
     float maxAnisotropy = 4.0f;
-    float facetEdgePixels = 0.5f;  // combined representation: the facet size target
-    float rangeScale = 1.0f;       // scales every object's range (distance factor - 1, angle)
-    int cacheMb = 96;              // the shader maps' tile budget
-    bool cutEveryFrame = false;    // every frame starts with no static work to reuse
+    float facetEdgePixels = 0.5f;   // combined representation: the facet size target
+    float rangeScale = 1.0f;        // scales every object's range (distance factor - 1, angle)
+    int cacheMb = 96;               // the shader maps' tile budget
+    bool cutEveryFrame = false;     // every frame starts with no static work to reuse
+    bool singlePhaseFrames = true;  // frames whose static work would not pay go single-phase
 };
 
 struct EvalFrame {
@@ -39,6 +40,7 @@ struct EvalFrame {
     double mse = 0.0, psnr = 0.0, rmse = 0.0, maxAbs = 0.0;
     double temporalRmse = -1.0;  // against the previous frame; -1 for the first
     uint64_t nonFinite = 0;
+    bool singlePhase = false;  // multi-phase chose to render this frame single-phase
 };
 
 struct EvalRun {
@@ -54,6 +56,7 @@ struct EvalRun {
     // channel, the mean temporal error.
     double psnr = 0.0, rmse = 0.0, maxAbs = 0.0, temporalRmse = 0.0;
     uint64_t nonFinite = 0;
+    int singlePhaseFrames = 0;
 };
 
 // Renders frames [first, last) of the scene at `scenePath` with `config`, comparing frame i

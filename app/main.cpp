@@ -37,6 +37,9 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--footprint-scale", render.footprintScale,
                           "Multiphase: shader map texels per shading point spacing, inverted "
                           "(default 0.6; larger reads coarser levels: faster, blurrier)");
+    renderCmd->add_flag("--no-single-phase", render.noSinglePhase,
+                        "Multiphase: every frame multi-phase, even where its static work would "
+                        "cost more than rendering the frames asked for single-phase");
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
     renderCmd->add_option("--memory-mb", render.memoryMb,
                           "Refuse a render estimated to need more memory than this (MB; "

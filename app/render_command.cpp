@@ -173,6 +173,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
                         "expected 0.05..8, found " + std::to_string(options.footprintScale));
                 mo.dynamic.footprintScale = options.footprintScale;
             }
+            mo.singlePhaseFrames = !options.noSinglePhase;
             multi = std::make_unique<MultiphaseRenderer>(scene, mo);
             multi->plan(first, last, render);
         }
@@ -246,6 +247,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
             if (multiphase) {
                 double covered = 0.0;
                 for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
+                entry["single_phase"] = stats.singlePhase;
                 entry["static_runs"] = stats.staticRuns;
                 entry["static_seconds"] = stats.staticSeconds;
                 entry["fill_seconds"] = stats.fillSeconds;

@@ -22,6 +22,9 @@ struct RenderCommandOptions {
     // Multiphase: probe footprint over the shading points' spacing (texel spacing of the
     // shader maps read); 0: the default (DynamicOptions::footprintScale); else 0.05..8.
     float footprintScale = 0.0f;
+    // Multiphase: never render a frame single-phase, even where the static work it needs
+    // would not pay for itself over the frames asked for (MultiphaseOptions).
+    bool noSinglePhase = false;
 };
 
 // Returns the process exit code: 0 success, 2 bad input (message already on stderr).

@@ -44,6 +44,10 @@ struct FrameStats {
     uint64_t probes = 0;          // bilinear probes
     uint64_t probeFallbacks = 0;  // answered from a coarser level (zero when render fills first)
     int shadePasses = 0;          // shading passes: 1, plus one per round of fills
+    // The frame was rendered single-phase (by the reference renderer): the static work it
+    // needed was estimated to cost more than shading the frames it would serve from scratch
+    // (multiphase_renderer.h). Every figure above is then the reference's.
+    bool singlePhase = false;
 };
 
 }  // namespace mpshade

@@ -89,10 +89,9 @@ void MultiphaseRenderer::plan(int first, int last, const RenderOptions& options)
     }
 }
 
-Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectState& state,
-                                              const CameraState& camera, int spp) {
+ObjectCostInputs MultiphaseRenderer::costInputs(size_t i, int frame, const ObjectState& state,
+                                                const CameraState& camera, int spp) const {
     const SceneObject& obj = scene_.objects[i];
-    Representation asked = options_.representation.value_or(obj.representation);
     const ObjectShading& shading = static_.shading(i);
     const ObjectRepresentation* previous = representations_[i].get();
     const int tile =
@@ -105,18 +104,6 @@ Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectS
                      static_cast<double>(shading.factored.staticPart.channelOutputs.size()) *
                      sizeof(float);
     in.haveMap = previous && previous->map;
-    if (asked != Representation::Auto) {
-        reports_[i].reason =
-            options_.representation ? "forced by the renderer's options" : "the scene asks for it";
-        std::string tooBig;
-        if (asked == Representation::ShaderMap && !in.haveMap &&
-            !shaderMapFits(in, tooBig, options_.costModel)) {
-            reports_[i].reason += ", but " + tooBig + ": facets instead";
-            return Representation::Facets;
-        }
-        return asked;
-    }
-    in.combinedFacets = static_.combinedFacets(i, state, camera);
     // The screen area: the object's bounding sphere, projected, within the screen.
     const Bounds3 b = surfaceBounds(*obj.surface);
     const float ppu = 0.5f * static_cast<float>(camera.height) / camera.tanHalfFovY;
@@ -129,11 +116,66 @@ Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectS
     in.combinedRuns = predictedCombinedRuns(i, frame, state);
     in.screenPixels = static_cast<double>(camera.width) * camera.height;
     in.staticCostUnits = shading.factored.staticCost;
+    in.originalCostUnits = shading.factored.originalCost;
     in.samplesPerPixel = spp;
     in.shadingRate = options_.dynamic.shadingRate;
+    return in;
+}
+
+Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectState& state,
+                                              const CameraState& camera, int spp,
+                                              ObjectCostInputs& in) {
+    const SceneObject& obj = scene_.objects[i];
+    Representation asked = options_.representation.value_or(obj.representation);
+    in = costInputs(i, frame, state, camera, spp);
+    if (asked == Representation::Facets)
+        in.combinedFacets = static_.combinedFacets(i, state, camera);
+    if (asked != Representation::Auto) {
+        reports_[i].reason =
+            options_.representation ? "forced by the renderer's options" : "the scene asks for it";
+        std::string tooBig;
+        if (asked == Representation::ShaderMap && !in.haveMap &&
+            !shaderMapFits(in, tooBig, options_.costModel)) {
+            reports_[i].reason += ", but " + tooBig + ": facets instead";
+            return Representation::Facets;
+        }
+        return asked;
+    }
+    in.combinedFacets = static_.combinedFacets(i, state, camera);
     const RepresentationChoice choice = chooseRepresentation(in, options_.costModel);
     reports_[i].reason = choice.reason;
     return choice.kind;
+}
+
+bool MultiphaseRenderer::singlePhasePays(const std::vector<size_t>& stale,
+                                         const std::vector<ObjectCostInputs>& staleInputs,
+                                         const std::vector<uint8_t>& visible, int frame) const {
+    // Over the frames F the new static work would serve: multi-phase pays that work, then
+    // every visible object's dynamic frames; single-phase pays the reference's frames for
+    // every visible object, since a frame rendered single-phase builds nothing and the
+    // next one meets the same choice.
+    int served = 1;
+    for (const ObjectCostInputs& in : staleInputs) served = std::max(served, in.frames);
+    double multi = 0.0, single = 0.0;
+    std::vector<int> staleAt(visible.size(), -1);
+    for (size_t k = 0; k < stale.size(); ++k) staleAt[stale[k]] = static_cast<int>(k);
+    for (size_t i = 0; i < visible.size(); ++i) {
+        if (!visible[i]) continue;
+        const int k = staleAt[i];
+        ObjectCostInputs in =
+            k >= 0 ? staleInputs[static_cast<size_t>(k)]
+                   : costInputs(i, frame, frame_.objects[i], frame_.camera, frame_.spp);
+        if (k < 0) in.combinedFacets = static_cast<double>(representations_[i]->mesh.facetCount());
+        const RepresentationChoice c = chooseRepresentation(in, options_.costModel);
+        const double frames = std::min(served, std::max(1, in.frames));
+        const Representation kind = k >= 0 ? kinds_[i] : representations_[i]->kind;
+        if (kind == Representation::Facets)
+            multi += (k >= 0 ? c.facetsStaticSeconds : 0.0) + frames * c.facetsFrameSeconds;
+        else
+            multi += (k >= 0 ? c.mapStaticSeconds : 0.0) + frames * c.mapFrameSeconds;
+        single += frames * c.singlePhaseFrameSeconds;
+    }
+    return single < multi;
 }
 
 int MultiphaseRenderer::predictedCombinedRuns(size_t object, int frame,
@@ -215,7 +257,29 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
             stale.push_back(i);
     }
     const auto staticStart = Clock::now();
-    for (size_t i : stale) kinds_[i] = chooseKind(i, frame, frame_.objects[i], camera, frame_.spp);
+    std::vector<ObjectCostInputs> staleInputs(stale.size());
+    std::vector<Representation> previousKinds = kinds_;
+    std::vector<std::string> previousReasons(stale.size());
+    for (size_t k = 0; k < stale.size(); ++k) {
+        const size_t i = stale[k];
+        previousReasons[k] = reports_[i].reason;
+        kinds_[i] = chooseKind(i, frame, frame_.objects[i], camera, frame_.spp, staleInputs[k]);
+    }
+    singlePhaseFrame_ = options_.singlePhaseFrames && !stale.empty() &&
+                        singlePhasePays(stale, staleInputs, visible, frame);
+    if (singlePhaseFrame_) {
+        // Nothing is built: the objects stay as they were, and the next frame decides again.
+        kinds_ = previousKinds;
+        for (size_t k = 0; k < stale.size(); ++k) reports_[stale[k]].reason = previousReasons[k];
+        if (!reference_) reference_ = std::make_unique<ReferenceRenderer>(scene_);
+        singlePhaseSamples_ = reference_->renderSamples(frame, options, stats, progress);
+        singlePhaseImage_ = Image{};
+        singlePhaseSamples_.layout->resolve(singlePhaseSamples_.rgba.data(), nullptr,
+                                            singlePhaseImage_);
+        stats.singlePhase = true;
+        stats.wallSeconds = secondsSince(start);
+        return;
+    }
     std::vector<StaticCosts> costs(stale.size());
     tbb::parallel_for(size_t{0}, stale.size(), [&](size_t k) {
         const size_t i = stale[k];
@@ -345,6 +409,10 @@ Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, F
                                       const ProgressFn& progress) {
     const auto start = Clock::now();
     render(frame, options, stats, progress);
+    if (singlePhaseFrame_) {
+        stats.wallSeconds = secondsSince(start);
+        return singlePhaseImage_;
+    }
     Image image;
     dynamic_.resolve(image);
     stats.resolveSeconds = dynamic_.stats().resolveSeconds;
@@ -356,7 +424,7 @@ Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, F
 SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& options,
                                                FrameStats& stats, const ProgressFn& progress) {
     render(frame, options, stats, progress);
-    return dynamic_.samples();
+    return singlePhaseFrame_ ? singlePhaseSamples_ : dynamic_.samples();
 }
 
 }  // namespace mpshade

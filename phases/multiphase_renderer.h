@@ -10,6 +10,10 @@
 //      (combined representation) whose facets measured longer than P/2 last frame. Auto
 //      objects get their representation chosen at their first run
 //      (representation_choice.h).
+//   2b. Unless the static work due would not pay for itself: when the estimates
+//      (representation_choice.h) of that work and of the multi-phase frames it serves
+//      exceed the reference renderer's for the same frames, the frame is rendered
+//      single-phase and nothing is built (singlePhaseFrames; stats say so).
 //   3. The dynamic phase warps and rasterizes, then shades; the shader-map tiles its probes
 //      lacked are filled in one batch and only the bands that lacked them are shaded
 //      again, so no sample reads a coarser level than its footprint asks and the image
@@ -39,6 +43,11 @@ struct MultiphaseOptions {
     size_t mapMemoryBytes = size_t{96} << 20;
     // Forces every object's representation (tests, benchmarks); unset: the scene's.
     std::optional<Representation> representation;
+    // A frame whose due static work, with the dynamic frames it would serve, is estimated
+    // to cost more than rendering those frames single-phase is rendered by the reference
+    // renderer instead, and nothing is built (a camera cut every frame, a short request).
+    // Off: every frame is multi-phase.
+    bool singlePhaseFrames = true;
 };
 
 // Per object, for stats.json: what the static phase chose and did.
@@ -90,7 +99,15 @@ class MultiphaseRenderer {
     // budget (or nothing the frame has not used is left).
     void keepMapsInBudget(size_t incoming, FrameStats& stats);
     Representation chooseKind(size_t object, int frame, const ObjectState& state,
-                              const CameraState& camera, int spp);
+                              const CameraState& camera, int spp, ObjectCostInputs& in);
+    // The cost estimate's inputs that need no dicing survey (combinedFacets is left 0).
+    ObjectCostInputs costInputs(size_t object, int frame, const ObjectState& state,
+                                const CameraState& camera, int spp) const;
+    // Whether this frame's due static work (objects `stale`, with their inputs) costs more,
+    // with the frames it serves, than rendering those frames single-phase.
+    bool singlePhasePays(const std::vector<size_t>& stale,
+                         const std::vector<ObjectCostInputs>& staleInputs,
+                         const std::vector<uint8_t>& visible, int frame) const;
     int framesSeenFrom(size_t object, int frame) const;
     int predictedCombinedRuns(size_t object, int frame, const ObjectState& state) const;
 
@@ -110,7 +127,11 @@ class MultiphaseRenderer {
     int layoutWidth_ = 0, layoutHeight_ = 0;  // the planned image size
     std::vector<ObjectReport> reports_;
     FrameState frame_;
-    uint32_t useStamp_ = 0;  // frames rendered: the maps' recency stamp
+    uint32_t useStamp_ = 0;                         // frames rendered: the maps' recency stamp
+    std::unique_ptr<ReferenceRenderer> reference_;  // made at the first single-phase frame
+    bool singlePhaseFrame_ = false;                 // the last frame was
+    Image singlePhaseImage_;
+    SampleBuffer singlePhaseSamples_;
 };
 
 }  // namespace mpshade

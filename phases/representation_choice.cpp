@@ -26,6 +26,13 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     RepresentationChoice c;
     c.facetsSeconds = (facetsStatic + frames * facetsFrame) * 1e-9;
     c.mapSeconds = (mapStatic + frames * mapFrame) * 1e-9;
+    c.facetsStaticSeconds = facetsStatic * 1e-9;
+    c.facetsFrameSeconds = facetsFrame * 1e-9;
+    c.mapStaticSeconds = mapStatic * 1e-9;
+    c.mapFrameSeconds = mapFrame * 1e-9;
+    c.singlePhaseFrameSeconds =
+        in.coveredPixels * static_cast<double>(in.samplesPerPixel) *
+        (in.originalCostUnits * model.referenceNsPerCostUnit + model.referenceSampleNs) * 1e-9;
     char text[320];
     std::string tooBig;
     if (!in.haveMap && !shaderMapFits(in, tooBig, model)) {

@@ -77,7 +77,7 @@ TEST(Cli, MultiphaseComparesWithTheReference) {
     const std::string out = tempDir("multiphase");
     const CliRun run = mpshade(
         "render examples/teapot/scene.json --mode multiphase --compare --frames 0:2 --size 96x64 "
-        "--spp 2 --out " +
+        "--spp 2 --no-single-phase --out " +
         out);
     ASSERT_EQ(run.exitCode, 0) << run.output;
     std::ifstream statsFile(out + "/stats.json");

@@ -21,6 +21,13 @@
 namespace mpshade {
 namespace {
 
+// The multi-phase machinery itself: no frame goes single-phase, however few are asked for.
+MultiphaseOptions machineryOnly() {
+    MultiphaseOptions o;
+    o.singlePhaseFrames = false;
+    return o;
+}
+
 CameraState lookAt(const glm::vec3& eye, const glm::vec3& target, int w, int h, float fovY = 40.0f,
                    float zNear = 0.05f) {
     CameraState c;
@@ -346,7 +353,7 @@ TEST(MultiphaseRenderer, ReDicesWhenTheViewLeavesTheRange) {
            text.substr(text.find(", \"shaders\""));
     std::ofstream(path) << text;
     const Scene scene = loadScene(path);
-    MultiphaseRenderer multi(scene);
+    MultiphaseRenderer multi(scene, machineryOnly());
     FrameStats s0, s1, s2;
     multi.renderSamples(0, {}, s0);
     multi.renderSamples(0, {}, s1);
@@ -364,7 +371,7 @@ TEST(MultiphaseRenderer, ExamplesMatchTheReference) {
     for (const char* path : {"examples/vase/scene.json", "examples/teapot/scene.json"}) {
         const Scene scene = loadScene(test::sourcePath(path));
         const ReferenceRenderer reference(scene);
-        MultiphaseRenderer multi(scene);
+        MultiphaseRenderer multi(scene, machineryOnly());
         RenderOptions options;
         options.width = 160;
         options.height = 100;
@@ -399,7 +406,7 @@ TEST(MultiphaseRenderer, ShaderMapRepresentationMatchesTheReference) {
         64;  // the vase's 104 charts: about a texel per pixel here
     scene.objects[1].shadermapResolution = 256;  // the floor: one chart
     const ReferenceRenderer reference(scene);
-    MultiphaseRenderer multi(scene);
+    MultiphaseRenderer multi(scene, machineryOnly());
     RenderOptions options;
     options.width = 160;
     options.height = 100;
@@ -456,6 +463,60 @@ TEST(MultiphaseRenderer, PrefilteredShaderMapsOnAMinifiedSurface) {
     EXPECT_LT(error[1], 0.02);
     RecordProperty("minified_rmse_point", std::to_string(error[0]));
     RecordProperty("minified_rmse_box", std::to_string(error[1]));
+}
+
+TEST(MultiphaseRenderer, StaticWorkThatWouldNotPayGoesSinglePhase) {
+    // The vase's static phase costs about eight reference frames: asked for one frame, the
+    // renderer renders it single-phase -- the reference's own image, bit for bit -- and
+    // builds nothing; asked for the whole animation, it builds both objects at once.
+    const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    RenderOptions options;
+    options.width = 120, options.height = 68;
+    const ReferenceRenderer reference(scene);
+    FrameStats rs;
+    const Image ref = reference.renderFrame(3, options, rs);
+
+    MultiphaseRenderer oneFrame(scene);
+    oneFrame.plan(3, 4, options);
+    FrameStats s;
+    const Image got = oneFrame.renderFrame(3, options, s);
+    EXPECT_TRUE(s.singlePhase);
+    EXPECT_EQ(s.staticRuns, 0);
+    EXPECT_EQ(oneFrame.representation(0), nullptr);
+    ASSERT_EQ(got.rgba.size(), ref.rgba.size());
+    EXPECT_EQ(got.rgba, ref.rgba);
+
+    MultiphaseRenderer whole(scene);
+    whole.plan(0, scene.frameCount(), options);
+    FrameStats w;
+    whole.renderFrame(0, options, w);
+    EXPECT_FALSE(w.singlePhase);
+    EXPECT_EQ(w.staticRuns, 2);
+
+    MultiphaseRenderer forced(scene, machineryOnly());
+    forced.plan(3, 4, options);
+    FrameStats f;
+    forced.renderFrame(3, options, f);
+    EXPECT_FALSE(f.singlePhase);
+    EXPECT_EQ(f.staticRuns, 2);
+}
+
+TEST(MultiphaseRenderer, DiscardedStaticWorkIsBuiltAgain) {
+    // A cut: after discardStaticWork the next frame runs every static phase again, and
+    // renders the image it rendered before (nothing depends on what was discarded).
+    const Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
+    RenderOptions options;
+    options.width = 96, options.height = 64;
+    MultiphaseRenderer multi(scene, machineryOnly());
+    FrameStats a, b, c;
+    const Image first = multi.renderFrame(1, options, a);
+    multi.renderFrame(2, options, b);
+    EXPECT_EQ(b.staticRuns, 0);
+    multi.discardStaticWork();
+    EXPECT_EQ(multi.representation(0), nullptr);
+    const Image again = multi.renderFrame(1, options, c);
+    EXPECT_EQ(c.staticRuns, 2);
+    EXPECT_EQ(again.rgba, first.rgba);
 }
 
 }  // namespace

@@ -326,6 +326,24 @@ TEST(RepresentationChoice, RulesBeforeTheEstimate) {
         << chooseRepresentation(in).reason;
 }
 
+TEST(RepresentationChoice, SinglePhaseEstimateIsSamplesTimesRayAndShader) {
+    // 1,000 covered pixels at 4 samples, a 100-unit shader: 4,000 x (100 x 0.3 + 350) ns.
+    ObjectCostInputs in;
+    in.coveredPixels = 1000.0;
+    in.samplesPerPixel = 4;
+    in.originalCostUnits = 100.0;
+    in.staticCostUnits = 60.0;
+    in.frames = 10;
+    const RepresentationChoice c = chooseRepresentation(in);
+    EXPECT_NEAR(c.singlePhaseFrameSeconds, 4000.0 * 380.0 * 1e-9, 1e-12);
+    // The per-kind parts add up to the totals over the frames.
+    EXPECT_NEAR(c.mapSeconds, c.mapStaticSeconds + 10.0 * c.mapFrameSeconds, 1e-12);
+    EXPECT_NEAR(c.facetsSeconds, c.facetsStaticSeconds + 10.0 * c.facetsFrameSeconds, 1e-12);
+    // Per pixel shades once a pixel but the reference still traces every sample.
+    in.shadingRate = ShadingRate::Pixel;
+    EXPECT_NEAR(chooseRepresentation(in).singlePhaseFrameSeconds, 4000.0 * 380.0 * 1e-9, 1e-12);
+}
+
 TEST(RepresentationChoice, MapsThatCannotFitAreNeverChosen) {
     // A cloud of 2,000,000 discs pinned 18M tiles in a pool of 4M and stopped the process;
     // the always-resident tiles now decide first, at their bound exactly.
