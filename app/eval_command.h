@@ -13,9 +13,9 @@ namespace mpshade {
 struct EvalCommandOptions {
     std::vector<std::string> scenes;
     std::string outDir;
-    std::string frames;  // "A:B"; default: every frame (--quick: the first 6)
+    std::string frames;  // "A:B"; default: every frame
     int truthSpp = 64;
-    bool quick = false;  // shorter ladders and fewer frames: a couple of minutes a scene
+    bool quick = false;  // shorter ladders, half the width and height: a minute or two a scene
     std::string size;    // "WxH": overrides the scenes' settings
     bool quiet = false;
 };

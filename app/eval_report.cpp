@@ -310,7 +310,8 @@ std::string reportMarkdown(const std::vector<SceneEvaluation>& scenes,
                << fmt("%.3f", r.steadyFrameSeconds) << " | " << psnrText(r.psnr) << " | "
                << fmt("%.4f", r.rmse) << " | " << fmt("%.3f", r.maxAbs) << " | "
                << fmt("%.4f", r.temporalRmse) << " | "
-               << (r.peakMemoryMb >= 0 ? fmt("%.0f", r.peakMemoryMb) : std::string("?")) << " |\n";
+               << (r.peakMemoryMb >= 0 ? fmt("%.0f", r.peakMemoryMb) : std::string("?")) << " | "
+               << (r.config.multiphase ? std::to_string(r.singlePhaseFrames) : "") << " |\n";
         auto frontText = [&](const std::vector<size_t>& front) {
             std::string out;
             for (size_t i : front)

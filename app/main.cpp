@@ -80,13 +80,14 @@ int main(int argc, char** argv) {
         "eval", "Speed against error: ladders of both renderers against a ground truth");
     evalCmd->add_option("scenes", eval.scenes, "Scene files (.json)")->required();
     evalCmd->add_option("--out", eval.outDir, "Output folder (created if missing)")->required();
-    evalCmd->add_option("--frames", eval.frames,
-                        "Frames A:B (half-open; default every frame, with --quick the first 6)");
+    evalCmd->add_option("--frames", eval.frames, "Frames A:B (half-open; default every frame)");
     evalCmd
         ->add_option("--truth-spp", eval.truthSpp,
                      "Samples per pixel of the ground truth (the reference renderer)")
         ->capture_default_str();
-    evalCmd->add_flag("--quick", eval.quick, "Shorter ladders and 6 frames: minutes, not hours");
+    evalCmd->add_flag(
+        "--quick", eval.quick,
+        "Shorter ladders at half the width and height (unless --size): a minute or two");
     evalCmd->add_option("--size", eval.size, "Image size WxH (overrides the scenes)");
     evalCmd->add_flag("--quiet", eval.quiet, "No progress or summary on stderr");
 

@@ -148,7 +148,12 @@ DicedSurface diceSurface(const Surface& surface, const DicingView& view, const R
     out.format = FixedPointFormat::forBounds(bounds);
     const int charts = chartCount(surface);
     out.charts = charts;
-    const bool closed = isClosed(surface);
+    // Back-facing patches of a closed surface are dropped only while no eye of the range
+    // can be inside its bounds or bring the near plane into it (then every face seen faces
+    // away: a camera inside a dome).
+    const bool closed =
+        isClosed(surface) && glm::length(view.eye - bounds.center()) / range.distanceFactor >
+                                 0.5f * bounds.diagonal() + 2.0f * view.nearDistance;
     const glm::vec3 objectCenter = bounds.center();
     const float eyeDistance = std::max(glm::length(view.eye - objectCenter), 1e-20f);
     EyeSet eyes;

@@ -50,6 +50,20 @@ void clusterVisibility(const FacetMesh& mesh, const ObjectState& state, const Ca
     }
 }
 
+// Back faces of a closed opaque surface are hidden only while the eye is outside the solid
+// and the near plane cuts none of it: from inside, or through a near-plane cut, every
+// surface seen faces away. Conservatively: culled while the object's bounding box, in its
+// own space, stays farther from the eye than the near plane's corners.
+bool backFacesHidden(const ObjectRepresentation& rep, const Surface& surface,
+                     const ObjectState& state, const CameraState& camera) {
+    if (!rep.opaque || !rep.closed) return false;
+    const Bounds3 b = surfaceBounds(surface);
+    const glm::vec3 nearest = glm::clamp(state.eye, b.lo, b.hi);
+    const float distance = glm::length(state.eye - nearest) * state.scale;  // world units
+    const float tx = camera.tanHalfFovY * camera.aspect, ty = camera.tanHalfFovY;
+    return distance > camera.zNear * std::sqrt(1.0f + tx * tx + ty * ty) * 1.01f;
+}
+
 constexpr size_t kBatch = 1024;  // shading points per run of the dynamic shader
 
 }  // namespace
@@ -99,6 +113,7 @@ void DynamicPhase::begin(const FrameState& frame,
     warps_.resize(n);
     warped_.resize(n);
     clusterVisible_.resize(n);
+    cullBack_.assign(n, 0);
     views_.assign(n, ObjectView{});
     const CameraState& camera = frame.camera;
     // The camera ray through screen position (x, y): d0 + x dx + y dy (world space).
@@ -118,7 +133,8 @@ void DynamicPhase::begin(const FrameState& frame,
         warps_[i] = std::make_unique<FixedPointWarp>(state.objectToWorld, camera, mesh.format);
         warps_[i]->warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.positionCount(),
                         warped_[i]);
-        clusterVisibility(mesh, state, camera, rep->opaque && rep->closed, clusterVisible_[i]);
+        cullBack_[i] = backFacesHidden(*rep, *scene_.objects[i].surface, state, camera) ? 1 : 0;
+        clusterVisibility(mesh, state, camera, cullBack_[i] != 0, clusterVisible_[i]);
         ObjectView& v = views_[i];
         v.rep = rep;
         v.uniforms = &frame.uniforms[i];
@@ -150,7 +166,7 @@ void DynamicPhase::begin(const FrameState& frame,
                      &warped_[i],
                      warps_[i].get(),
                      rep->opaque,
-                     rep->opaque && rep->closed,
+                     cullBack_[i] != 0,
                      clusterVisible_[i].data(),
                      rep->kind == Representation::Facets ? &costs_[i].longestEdgePixels : nullptr};
     }

@@ -106,6 +106,7 @@ class DynamicPhase {
     std::vector<std::unique_ptr<FixedPointWarp>> warps_;
     std::vector<WarpedVertices> warped_;
     std::vector<std::vector<uint8_t>> clusterVisible_;
+    std::vector<uint8_t> cullBack_;  // per object this frame: back faces hidden
     std::vector<ObjectView> views_;
     VisibilityBuffer visibility_;
     SampleBuffer samples_;
