@@ -149,7 +149,8 @@ Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectS
 
 bool MultiphaseRenderer::singlePhasePays(const std::vector<size_t>& stale,
                                          const std::vector<ObjectCostInputs>& staleInputs,
-                                         const std::vector<uint8_t>& visible, int frame) const {
+                                         const std::vector<uint8_t>& visible, int frame,
+                                         bool leastCost) const {
     // Over the frames F the new static work would serve: multi-phase pays that work, then
     // every visible object's dynamic frames; single-phase pays the reference's frames for
     // every visible object, since a frame rendered single-phase builds nothing and the
@@ -168,6 +169,17 @@ bool MultiphaseRenderer::singlePhasePays(const std::vector<size_t>& stale,
         if (k < 0) in.combinedFacets = static_cast<double>(representations_[i]->mesh.facetCount());
         const RepresentationChoice c = chooseRepresentation(in, options_.costModel);
         const double frames = std::min(served, std::max(1, in.frames));
+        if (k >= 0 && leastCost) {
+            // Unsurveyed: facets at a quarter of the 20-50 per covered pixel the survey
+            // usually finds, and whichever representation is cheaper.
+            ObjectCostInputs fewest = in;
+            fewest.combinedFacets = 5.0 * in.coveredPixels;
+            const RepresentationChoice f = chooseRepresentation(fewest, options_.costModel);
+            multi += std::min(f.facetsStaticSeconds + frames * f.facetsFrameSeconds,
+                              f.mapStaticSeconds + frames * f.mapFrameSeconds);
+            single += frames * f.singlePhaseFrameSeconds;
+            continue;
+        }
         const Representation kind = k >= 0 ? kinds_[i] : representations_[i]->kind;
         if (kind == Representation::Facets)
             multi += (k >= 0 ? c.facetsStaticSeconds : 0.0) + frames * c.facetsFrameSeconds;
@@ -257,20 +269,36 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
             stale.push_back(i);
     }
     const auto staticStart = Clock::now();
+    // First a check that needs no dicing survey: with every stale object at the least its
+    // representations could cost, does single-phase still win? (A cut every frame then
+    // costs the reference's frame plus this check.) Else the representations are chosen
+    // and the check is made again with their estimates.
     std::vector<ObjectCostInputs> staleInputs(stale.size());
-    std::vector<Representation> previousKinds = kinds_;
-    std::vector<std::string> previousReasons(stale.size());
-    for (size_t k = 0; k < stale.size(); ++k) {
-        const size_t i = stale[k];
-        previousReasons[k] = reports_[i].reason;
-        kinds_[i] = chooseKind(i, frame, frame_.objects[i], camera, frame_.spp, staleInputs[k]);
+    singlePhaseFrame_ = false;
+    if (options_.singlePhaseFrames && !stale.empty()) {
+        for (size_t k = 0; k < stale.size(); ++k)
+            staleInputs[k] =
+                costInputs(stale[k], frame, frame_.objects[stale[k]], camera, frame_.spp);
+        singlePhaseFrame_ = singlePhasePays(stale, staleInputs, visible, frame, true);
     }
-    singlePhaseFrame_ = options_.singlePhaseFrames && !stale.empty() &&
-                        singlePhasePays(stale, staleInputs, visible, frame);
+    if (!singlePhaseFrame_) {
+        std::vector<Representation> previousKinds = kinds_;
+        std::vector<std::string> previousReasons(stale.size());
+        for (size_t k = 0; k < stale.size(); ++k) {
+            const size_t i = stale[k];
+            previousReasons[k] = reports_[i].reason;
+            kinds_[i] = chooseKind(i, frame, frame_.objects[i], camera, frame_.spp, staleInputs[k]);
+        }
+        singlePhaseFrame_ = options_.singlePhaseFrames && !stale.empty() &&
+                            singlePhasePays(stale, staleInputs, visible, frame, false);
+        if (singlePhaseFrame_) {
+            // Nothing is built: the objects stay as they were; the next frame decides again.
+            kinds_ = previousKinds;
+            for (size_t k = 0; k < stale.size(); ++k)
+                reports_[stale[k]].reason = previousReasons[k];
+        }
+    }
     if (singlePhaseFrame_) {
-        // Nothing is built: the objects stay as they were, and the next frame decides again.
-        kinds_ = previousKinds;
-        for (size_t k = 0; k < stale.size(); ++k) reports_[stale[k]].reason = previousReasons[k];
         if (!reference_) reference_ = std::make_unique<ReferenceRenderer>(scene_);
         singlePhaseSamples_ = reference_->renderSamples(frame, options, stats, progress);
         singlePhaseImage_ = Image{};

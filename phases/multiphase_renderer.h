@@ -104,10 +104,12 @@ class MultiphaseRenderer {
     ObjectCostInputs costInputs(size_t object, int frame, const ObjectState& state,
                                 const CameraState& camera, int spp) const;
     // Whether this frame's due static work (objects `stale`, with their inputs) costs more,
-    // with the frames it serves, than rendering those frames single-phase.
+    // with the frames it serves, than rendering those frames single-phase. leastCost: the
+    // stale objects are not surveyed yet; each is taken at the least either
+    // representation could cost.
     bool singlePhasePays(const std::vector<size_t>& stale,
                          const std::vector<ObjectCostInputs>& staleInputs,
-                         const std::vector<uint8_t>& visible, int frame) const;
+                         const std::vector<uint8_t>& visible, int frame, bool leastCost) const;
     int framesSeenFrom(size_t object, int frame) const;
     int predictedCombinedRuns(size_t object, int frame, const ObjectState& state) const;
 
