@@ -70,6 +70,7 @@ std::vector<EvalConfig> ladders(int spp, bool quick) {
     for (float f : quick ? std::vector<float>{1.0f, 1.5f} : std::vector<float>{0.4f, 1.0f, 1.5f})
         add("footprint_scale", "footprint=" + std::to_string(f).substr(0, 3),
             [&](EvalConfig& c) { c.footprintScale = f; });
+    add("max_anisotropy", "aniso=2", [](EvalConfig& c) { c.maxAnisotropy = 2.0f; });
     if (quick) return out;
     add("shading_rate", "pixel spp=" + std::to_string(4 * spp), [&](EvalConfig& c) {
         c.shadingRate = ShadingRate::Pixel;
@@ -190,7 +191,7 @@ int runEvalCommand(const EvalCommandOptions& options) {
             e.name = sceneName(e.scene, names);
             // --quick: half the width and height (a quarter of the samples), every frame: the
             // static work is amortized as in the full render.
-            const int shrink = options.quick && width == 0 ? 2 : 1;
+            const int shrink = options.quick && !options.fullSize && width == 0 ? 2 : 1;
             e.width = width > 0 ? width : std::max(1, scene.settings.width / shrink);
             e.height = height > 0 ? height : std::max(1, scene.settings.height / shrink);
             e.spp = scene.settings.samplesPerPixel;

@@ -17,6 +17,7 @@ struct EvalCommandOptions {
     int truthSpp = 64;
     bool quick = false;  // shorter ladders, half the width and height: a minute or two a scene
     std::string size;    // "WxH": overrides the scenes' settings
+    bool fullSize = false;  // with quick: each scene at its own size
     bool quiet = false;
 };
 

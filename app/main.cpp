@@ -89,6 +89,8 @@ int main(int argc, char** argv) {
         "--quick", eval.quick,
         "Shorter ladders at half the width and height (unless --size): a minute or two");
     evalCmd->add_option("--size", eval.size, "Image size WxH (overrides the scenes)");
+    evalCmd->add_flag("--full-size", eval.fullSize,
+                      "With --quick: each scene at its own size, not half of it");
     evalCmd->add_flag("--quiet", eval.quiet, "No progress or summary on stderr");
 
     try {

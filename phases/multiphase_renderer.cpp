@@ -119,6 +119,7 @@ ObjectCostInputs MultiphaseRenderer::costInputs(size_t i, int frame, const Objec
     in.originalCostUnits = shading.factored.originalCost;
     in.samplesPerPixel = spp;
     in.shadingRate = options_.dynamic.shadingRate;
+    in.footprintScale = options_.dynamic.footprintScale;
     return in;
 }
 

@@ -17,8 +17,13 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
         0.5 * in.combinedFacets * staticPointNs * std::max(1, in.combinedRuns);
     const double facetsFrame = in.combinedFacets * model.facetNs + points * model.vertexPointNs;
     // Separate: the texels frames ask for and the always-resident levels, unless built.
+    const double samplesScale =
+        in.shadingRate == ShadingRate::Pixel ? 1.0 : in.samplesPerPixel / 4.0;
+    const double footprint = 0.6 / std::max(0.05f, in.footprintScale);
+    const double texelsPerPixel =
+        model.texelsPerCoveredPixel * samplesScale * footprint * footprint;
     const double runs = in.haveMap ? 0.0
-                                   : in.coveredPixels * model.texelsPerCoveredPixel +
+                                   : in.coveredPixels * texelsPerPixel +
                                          in.charts * model.pinnedTexelsPerChart;
     const double mapStatic = runs * staticPointNs;
     const double mapFrame = points * model.mapPointNs;

@@ -41,7 +41,10 @@ struct RepresentationCostModel {
     // ns a sample; the vase's 518,400, a quarter of them marble (3,542 units), 0.32 s.
     double referenceSampleNs = 350.0;
     double referenceNsPerCostUnit = 0.3;
-    double texelsPerCoveredPixel = 12.0;         // separate: texels filled per covered pixel
+    // Separate: texels filled per covered pixel at 4 samples per pixel and the default
+    // footprint scale 0.6; the texel density goes as the footprint's inverse square, so
+    // with the samples (per sample rate) and with 1 / scale^2.
+    double texelsPerCoveredPixel = 12.0;
     double pinnedTexelsPerChart = 34.0 * 34.0;   // the 32 x 32 level with its border
     double maxFacetsPerScreenPixel = 4.0;        // combined facets beyond this: always a map
     double maxPinnedBytes = 64.0 * 1024 * 1024;  // pinned levels beyond this: facets
@@ -65,6 +68,7 @@ struct ObjectCostInputs {
     double originalCostUnits = 0.0;  // the whole shader's, as the reference runs it
     int samplesPerPixel = 4;
     ShadingRate shadingRate = ShadingRate::Sample;
+    float footprintScale = 0.6f;  // the dynamic phase's probe footprint scale
     double pinnedBytes = 0.0;  // memory of a map's always-resident levels
     double pinnedTiles = 0.0;  // tiles of those levels
     bool haveMap = false;      // a map of it exists already: its cost is paid
