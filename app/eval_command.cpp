@@ -9,6 +9,7 @@
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 
+#include "app/command_line.h"
 #include "app/eval_report.h"
 #include "app/eval_runner.h"
 #include "app/eval_truth.h"
@@ -21,14 +22,6 @@ namespace mpshade {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-bool parseWhole(const std::string& s, long& out) {
-    if (s.empty() || s.size() > 9) return false;
-    for (char c : s)
-        if (c < '0' || c > '9') return false;
-    out = std::stol(s);
-    return true;
-}
 
 // The ladders. Multi-phase moves one knob at a time away from its defaults, plus the
 // combinations that measured on the fronts (pixel rate with more samples).
@@ -135,42 +128,14 @@ int runEvalCommand(const EvalCommandOptions& options) {
             throw InputError({"--truth-spp", 0, 0, {}},
                              "expected 2..1024, found " + std::to_string(options.truthSpp));
         int width = 0, height = 0;
-        if (!options.size.empty()) {
-            const auto x = options.size.find('x');
-            long w, h;
-            if (x == std::string::npos || !parseWhole(options.size.substr(0, x), w) ||
-                !parseWhole(options.size.substr(x + 1), h) || w < 1 || h < 1 || w > 16384 ||
-                h > 16384)
-                throw InputError(
-                    {"--size", 0, 0, {}},
-                    "expected WxH with each in 1..16384, found '" + options.size + "'");
-            width = static_cast<int>(w);
-            height = static_cast<int>(h);
-        }
+        parseImageSize(options.size, width, height);
         // Every scene is loaded (and so checked) before any work starts.
         std::vector<Scene> loaded;
         for (const std::string& path : options.scenes) loaded.push_back(loadScene(path));
         std::vector<std::pair<int, int>> ranges;
         for (size_t s = 0; s < loaded.size(); ++s) {
-            const int count = loaded[s].frameCount();
-            int first = 0, last = count;
-            if (!options.frames.empty()) {
-                const InputLocation where{"--frames", 0, 0, {}};
-                const auto colon = options.frames.find(':');
-                long a, b;
-                if (colon == std::string::npos || !parseWhole(options.frames.substr(0, colon), a) ||
-                    !parseWhole(options.frames.substr(colon + 1), b))
-                    throw InputError(where, "expected A:B, found '" + options.frames + "'");
-                if (!(a < b))
-                    throw InputError(where, "the range " + options.frames +
-                                                " is empty (half-open: 0:2 is frames 0 and 1)");
-                if (b > count)
-                    throw InputError(where, "the range " + options.frames + " goes past " +
-                                                options.scenes[s] + "'s " + std::to_string(count) +
-                                                " frames");
-                first = static_cast<int>(a);
-                last = static_cast<int>(b);
-            }
+            int first, last;
+            parseFrameRange(options.frames, loaded[s].frameCount(), first, last, options.scenes[s]);
             ranges.emplace_back(first, last);
         }
         prepareOutputFolder(options.outDir);

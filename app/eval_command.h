@@ -13,10 +13,10 @@ namespace mpshade {
 struct EvalCommandOptions {
     std::vector<std::string> scenes;
     std::string outDir;
-    std::string frames;  // "A:B"; default: every frame
+    std::string frames;  // "A:B" (half-open) or "N"; default: every frame
     int truthSpp = 64;
-    bool quick = false;  // shorter ladders, half the width and height: a minute or two a scene
-    std::string size;    // "WxH": overrides the scenes' settings
+    bool quick = false;     // shorter ladders, half the width and height: a minute or two a scene
+    std::string size;       // "WxH": overrides the scenes' settings
     bool fullSize = false;  // with quick: each scene at its own size
     bool quiet = false;
 };

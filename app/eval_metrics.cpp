@@ -5,6 +5,8 @@
 #include <limits>
 #include <numeric>
 
+#include "phases/image_compare.h"
+
 namespace mpshade {
 namespace {
 
@@ -20,15 +22,8 @@ double psnrOfMse(double mse) {
 }
 
 double meanSquaredError(const Image& test, const Image& truth) {
-    const size_t pixels = static_cast<size_t>(truth.width) * truth.height;
-    if (pixels == 0) return 0.0;
-    double sum = 0.0;
-    for (size_t p = 0; p < pixels; ++p)
-        for (size_t c = 0; c < 3; ++c) {
-            const double d = clamp01(test.rgba[p * 4 + c]) - clamp01(truth.rgba[p * 4 + c]);
-            sum += d * d;
-        }
-    return sum / static_cast<double>(pixels * 3);
+    const double rmse = compareImages(test, truth).rmse;
+    return rmse * rmse;
 }
 
 double temporalRmse(const Image& testA, const Image& testB, const Image& truthA,

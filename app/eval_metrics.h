@@ -14,7 +14,7 @@ namespace mpshade {
 // (an image against itself) is +infinity.
 double psnrOfMse(double mse);
 
-// Mean squared error of RGB, each channel clamped to [0, 1] (as compareImages does).
+// Mean squared error of RGB, each channel clamped to [0, 1]: compareImages' RMSE, squared.
 // Both the same size.
 double meanSquaredError(const Image& test, const Image& truth);
 

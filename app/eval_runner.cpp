@@ -117,10 +117,11 @@ EvalRun runEvalConfig(const std::string& scenePath, const EvalConfig& config, in
         e.index = f;
         e.wallSeconds = stats.wallSeconds;
         e.staticSeconds = stats.staticSeconds;
-        e.mse = meanSquaredError(image, t);
+        const ImageError error = compareImages(image, t);
+        e.rmse = error.rmse;
+        e.mse = error.rmse * error.rmse;
         e.psnr = psnrOfMse(e.mse);
-        e.rmse = std::sqrt(e.mse);
-        e.maxAbs = compareImages(image, t).maxAbs;
+        e.maxAbs = error.maxAbs;
         e.nonFinite = stats.nonFiniteSamples;
         e.singlePhase = stats.singlePhase;
         run.singlePhaseFrames += e.singlePhase ? 1 : 0;

@@ -80,7 +80,8 @@ int main(int argc, char** argv) {
         "eval", "Speed against error: ladders of both renderers against a ground truth");
     evalCmd->add_option("scenes", eval.scenes, "Scene files (.json)")->required();
     evalCmd->add_option("--out", eval.outDir, "Output folder (created if missing)")->required();
-    evalCmd->add_option("--frames", eval.frames, "Frames A:B (half-open; default every frame)");
+    evalCmd->add_option("--frames", eval.frames,
+                        "Frames A:B (half-open) or N; default every frame");
     evalCmd
         ->add_option("--truth-spp", eval.truthSpp,
                      "Samples per pixel of the ground truth (the reference renderer)")

@@ -10,6 +10,7 @@
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 
+#include "app/command_line.h"
 #include "app/image_output.h"
 #include "app/interrupt_watch.h"
 #include "app/memory_limit.h"
@@ -22,51 +23,6 @@
 
 namespace mpshade {
 namespace {
-
-bool parseInt(const std::string& s, long& out) {
-    if (s.empty() || s.size() > 9) return false;
-    for (char c : s)
-        if (c < '0' || c > '9') return false;
-    out = std::stol(s);
-    return true;
-}
-
-// "A:B" (half-open) or "N"; checked against the scene's frame count.
-void parseFrames(const std::string& spec, int frameCount, int& first, int& last) {
-    first = 0;
-    last = frameCount;
-    if (spec.empty()) return;
-    const InputLocation where{"--frames", 0, 0, {}};
-    long a, b;
-    const auto colon = spec.find(':');
-    if (colon == std::string::npos) {
-        if (!parseInt(spec, a)) throw InputError(where, "expected A:B or N, found '" + spec + "'");
-        b = a + 1;
-    } else if (!parseInt(spec.substr(0, colon), a) || !parseInt(spec.substr(colon + 1), b)) {
-        throw InputError(where, "expected A:B with whole numbers, found '" + spec + "'");
-    }
-    if (!(a < b))
-        throw InputError(
-            where, "the range " + spec + " is empty (frames are half-open: 0:2 is frames 0 and 1)");
-    if (b > frameCount)
-        throw InputError(where, "the range " + spec + " goes past the scene's " +
-                                    std::to_string(frameCount) +
-                                    " frames (0:" + std::to_string(frameCount) + ")");
-    first = static_cast<int>(a);
-    last = static_cast<int>(b);
-}
-
-void parseSize(const std::string& spec, int& width, int& height) {
-    if (spec.empty()) return;
-    const auto x = spec.find('x');
-    long w, h;
-    if (x == std::string::npos || !parseInt(spec.substr(0, x), w) ||
-        !parseInt(spec.substr(x + 1), h) || w < 1 || h < 1 || w > 16384 || h > 16384)
-        throw InputError({"--size", 0, 0, {}},
-                         "expected WxH with each in 1..16384, found '" + spec + "'");
-    width = static_cast<int>(w);
-    height = static_cast<int>(h);
-}
 
 class ProgressBar {
   public:
@@ -118,9 +74,9 @@ int runRenderCommand(const RenderCommandOptions& options) {
         RenderOptions render;
         render.seed = options.seed;
         render.samplesPerPixel = options.spp > 0 ? options.spp : 0;
-        parseSize(options.size, render.width, render.height);
+        parseImageSize(options.size, render.width, render.height);
         int first, last;
-        parseFrames(options.frames, scene.frameCount(), first, last);
+        parseFrameRange(options.frames, scene.frameCount(), first, last);
         const bool multiphase = options.mode == "multiphase";
         if (options.memoryMb < 0)
             throw InputError({"--memory-mb", 0, 0, {}}, "expected a positive number of MB");

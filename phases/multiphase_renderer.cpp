@@ -167,25 +167,23 @@ bool MultiphaseRenderer::singlePhasePays(const std::vector<size_t>& stale,
         ObjectCostInputs in =
             k >= 0 ? staleInputs[static_cast<size_t>(k)]
                    : costInputs(i, frame, frame_.objects[i], frame_.camera, frame_.spp);
-        if (k < 0) in.combinedFacets = static_cast<double>(representations_[i]->mesh.facetCount());
+        if (k < 0)
+            in.combinedFacets = static_cast<double>(representations_[i]->mesh.facetCount());
+        else if (leastCost)
+            // Unsurveyed: facets at a quarter of the 20-50 per covered pixel the survey
+            // usually finds.
+            in.combinedFacets = 5.0 * in.coveredPixels;
         const RepresentationChoice c = chooseRepresentation(in, options_.costModel);
         const double frames = std::min(served, std::max(1, in.frames));
-        if (k >= 0 && leastCost) {
-            // Unsurveyed: facets at a quarter of the 20-50 per covered pixel the survey
-            // usually finds, and whichever representation is cheaper.
-            ObjectCostInputs fewest = in;
-            fewest.combinedFacets = 5.0 * in.coveredPixels;
-            const RepresentationChoice f = chooseRepresentation(fewest, options_.costModel);
-            multi += std::min(f.facetsStaticSeconds + frames * f.facetsFrameSeconds,
-                              f.mapStaticSeconds + frames * f.mapFrameSeconds);
-            single += frames * f.singlePhaseFrameSeconds;
-            continue;
-        }
-        const Representation kind = k >= 0 ? kinds_[i] : representations_[i]->kind;
-        if (kind == Representation::Facets)
-            multi += (k >= 0 ? c.facetsStaticSeconds : 0.0) + frames * c.facetsFrameSeconds;
+        const double facets =
+            (k >= 0 ? c.facetsStaticSeconds : 0.0) + frames * c.facetsFrameSeconds;
+        const double map = (k >= 0 ? c.mapStaticSeconds : 0.0) + frames * c.mapFrameSeconds;
+        if (k >= 0 && leastCost)
+            multi += std::min(facets, map);  // whichever representation is cheaper
         else
-            multi += (k >= 0 ? c.mapStaticSeconds : 0.0) + frames * c.mapFrameSeconds;
+            multi += (k >= 0 ? kinds_[i] : representations_[i]->kind) == Representation::Facets
+                         ? facets
+                         : map;
         single += frames * c.singlePhaseFrameSeconds;
     }
     return single < multi;
@@ -302,9 +300,6 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     if (singlePhaseFrame_) {
         if (!reference_) reference_ = std::make_unique<ReferenceRenderer>(scene_);
         singlePhaseSamples_ = reference_->renderSamples(frame, options, stats, progress);
-        singlePhaseImage_ = Image{};
-        singlePhaseSamples_.layout->resolve(singlePhaseSamples_.rgba.data(), nullptr,
-                                            singlePhaseImage_);
         stats.singlePhase = true;
         stats.wallSeconds = secondsSince(start);
         return;
@@ -439,8 +434,10 @@ Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, F
     const auto start = Clock::now();
     render(frame, options, stats, progress);
     if (singlePhaseFrame_) {
+        Image image;
+        singlePhaseSamples_.layout->resolve(singlePhaseSamples_.rgba.data(), nullptr, image);
         stats.wallSeconds = secondsSince(start);
-        return singlePhaseImage_;
+        return image;
     }
     Image image;
     dynamic_.resolve(image);

@@ -131,8 +131,7 @@ class MultiphaseRenderer {
     FrameState frame_;
     uint32_t useStamp_ = 0;                         // frames rendered: the maps' recency stamp
     std::unique_ptr<ReferenceRenderer> reference_;  // made at the first single-phase frame
-    bool singlePhaseFrame_ = false;                 // the last frame was
-    Image singlePhaseImage_;
+    bool singlePhaseFrame_ = false;                 // the last frame was: its samples
     SampleBuffer singlePhaseSamples_;
 };
 
