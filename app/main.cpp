@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
                           "default: 3/4 of physical memory)");
     renderCmd->add_flag(
         "--compare", render.compare,
-        "Multiphase: also render the reference; report PSNR and speed in stats.json");
+        "Multiphase: also render the reference; report PSNR and speed in stats.json (every "
+        "frame multi-phase, as with --no-single-phase)");
 
     renderCmd->add_option("--truth-spp", render.truthSpp,
                           "With --compare: also measure both renderers against the reference "

@@ -129,7 +129,9 @@ int runRenderCommand(const RenderCommandOptions& options) {
                         "expected 0.05..8, found " + std::to_string(options.footprintScale));
                 mo.dynamic.footprintScale = options.footprintScale;
             }
-            mo.singlePhaseFrames = !options.noSinglePhase;
+            // --compare measures the multi-phase engine against the reference: a frame the
+            // reference rendered in its place would only be compared with itself.
+            mo.singlePhaseFrames = !options.noSinglePhase && !options.compare;
             multi = std::make_unique<MultiphaseRenderer>(scene, mo);
             multi->plan(first, last, render);
         }

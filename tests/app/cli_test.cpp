@@ -77,13 +77,15 @@ TEST(Cli, MultiphaseComparesWithTheReference) {
     const std::string out = tempDir("multiphase");
     const CliRun run = mpshade(
         "render examples/teapot/scene.json --mode multiphase --compare --frames 0:2 --size 96x64 "
-        "--spp 2 --no-single-phase --out " +
+        "--spp 2 --out " +
         out);
     ASSERT_EQ(run.exitCode, 0) << run.output;
     std::ifstream statsFile(out + "/stats.json");
     const nlohmann::json stats = nlohmann::json::parse(statsFile);
     EXPECT_EQ(stats["mode"], "multiphase");
     ASSERT_EQ(stats["frames"].size(), 2u);
+    // Two frames alone would go single-phase; --compare keeps every frame multi-phase.
+    EXPECT_EQ(stats["frames"][0]["single_phase"], false);
     EXPECT_EQ(stats["frames"][0]["static_runs"], 2);  // the teapot and the table
     EXPECT_EQ(stats["frames"][1]["static_runs"], 0);  // frame 1 is inside both ranges
     EXPECT_GT(stats["frames"][0]["facets"].get<double>(), 1000.0);
