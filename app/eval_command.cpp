@@ -60,10 +60,10 @@ std::vector<EvalConfig> ladders(int spp, bool quick) {
         c.shadingRate = ShadingRate::Pixel;
         c.spp = 2 * spp;
     });
-    for (float f : quick ? std::vector<float>{1.0f, 1.5f} : std::vector<float>{0.4f, 1.0f, 1.5f})
+    for (float f : quick ? std::vector<float>{0.6f, 1.5f} : std::vector<float>{0.4f, 0.6f, 1.5f})
         add("footprint_scale", "footprint=" + std::to_string(f).substr(0, 3),
             [&](EvalConfig& c) { c.footprintScale = f; });
-    add("max_anisotropy", "aniso=2", [](EvalConfig& c) { c.maxAnisotropy = 2.0f; });
+    add("max_anisotropy", "aniso=4", [](EvalConfig& c) { c.maxAnisotropy = 4.0f; });
     if (quick) return out;
     add("shading_rate", "pixel spp=" + std::to_string(4 * spp), [&](EvalConfig& c) {
         c.shadingRate = ShadingRate::Pixel;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "phases/dynamic_phase.h"
 #include "phases/image.h"
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
@@ -23,9 +24,10 @@ struct EvalConfig {
     int spp = 0;                   // 0: the scene's
     // Multi-phase only:
     ShadingRate shadingRate = ShadingRate::Sample;
-    float footprintScale = 0.6f;  // the map resolution bias: larger reads coarser levels
-    ProbeFilter filter = ProbeFilter::Feline;
-    float maxAnisotropy = 4.0f;
+    // The map resolution bias: larger reads coarser levels.
+    float footprintScale = DynamicOptions{}.footprintScale;
+    ProbeFilter filter = DynamicOptions{}.probe.filter;
+    float maxAnisotropy = DynamicOptions{}.probe.maxAnisotropy;
     float facetEdgePixels = 0.5f;   // combined representation: the facet size target
     float rangeScale = 1.0f;        // scales every object's range (distance factor - 1, angle)
     int cacheMb = 96;               // the shader maps' tile budget

@@ -409,7 +409,8 @@ struct Footprint {
     float major, minor;
 };
 
-Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy) {
+Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy,
+                      AnisotropyCap cap) {
     float d[4] = {q.dudx, q.dvdx, q.dudy, q.dvdy};
     bool finite = true;
     for (float& x : d) {
@@ -435,7 +436,14 @@ Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy
     }
     f.major = la;
     f.minor = lb;
-    // Cap the eccentricity by widening the minor axis.
+    if (cap == AnisotropyCap::ShrinkMajor && f.minor > 0.0f && f.minor * maxAnisotropy < f.major) {
+        const float shrink = f.minor * maxAnisotropy / f.major;
+        f.ax *= shrink, f.ay *= shrink;
+        f.major = f.minor * maxAnisotropy;
+        return f;
+    }
+    // Cap the eccentricity by widening the minor axis (also for ShrinkMajor when the minor
+    // axis is zero: there is no level to keep).
     if (f.minor * maxAnisotropy < f.major) {
         const float widen = f.major / (maxAnisotropy * std::max(f.minor, 1e-30f));
         if (f.minor > 0.0f) {
@@ -486,7 +494,8 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
                                        : footprintOf(q, res0,
                                                      options.filter == ProbeFilter::Trilinear
                                                          ? 1e30f
-                                                         : options.maxAnisotropy);
+                                                         : options.maxAnisotropy,
+                                                     options.cap);
         if (options.filter == ProbeFilter::Trilinear) {
             p.trilinear(q.chart, std::log2(std::max(f.major, 1e-30f)), q.u, q.v, o);
             return;

@@ -6,7 +6,7 @@
 //     footprint's longer axis in level-0 texels.
 //   Feline (McCormack et al. 1999): trilinear probes along the footprint ellipse's major
 //     axis; the minor axis picks the level. n = 2 (major / minor) - 1 probes (the ratio
-//     capped by maxAnisotropy, the minor axis widened to match), spread over a line of
+//     capped by maxAnisotropy, see AnisotropyCap), spread over a line of
 //     half length major - minor so the end probes' footprints reach the ellipse's ends,
 //     weighted by exp(-2 (d / major)^2) for a probe d texels from the centre.
 //   EWA (Heckbert 1989; Greene and Heckbert 1986): the elliptical Gaussian exp(-2 r^2) over
@@ -37,6 +37,17 @@ namespace mpshade {
 
 enum class ProbeFilter { Trilinear, Feline, EWA };
 
+// How a footprint more eccentric than maxAnisotropy is brought within it.
+//   WidenMinor: the minor axis grows to major / maxAnisotropy (a coarser level): a lone
+//     probe then never aliases, at the price of blur across the major axis (the classic
+//     choice, as GPUs and pbrt-v4 make it).
+//   ShrinkMajor: the major axis shrinks to minor * maxAnisotropy (the level stays the
+//     minor axis's): the probe under-filters along the major axis, which suits a caller
+//     that supersamples the screen anyway -- the renderer's samples at 1/sqrt(spp) pixel
+//     spacing integrate along it, and widening would blur what they resolve. Measured
+//     against 64-sample references in docs/multiphase.md.
+enum class AnisotropyCap { WidenMinor, ShrinkMajor };
+
 struct ProbeOptions {
     ProbeFilter filter = ProbeFilter::Feline;
     float maxAnisotropy = 16.0f;  // Feline and EWA: the longest footprint over the shortest
@@ -46,6 +57,7 @@ struct ProbeOptions {
     // Feline: taps per unit of anisotropy; 2 is McCormack et al.'s 2 ratio - 1 taps, one
     // minor axis apart; fewer spread the same line more thinly.
     float tapsPerRatio = 2.0f;
+    AnisotropyCap cap = AnisotropyCap::WidenMinor;
 };
 
 struct ProbeQuery {

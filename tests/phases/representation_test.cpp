@@ -380,6 +380,9 @@ TEST(RepresentationChoice, SeenOftenAMapSeenOnceFacets) {
     in.charts = 16;
     in.staticCostUnits = 3000;  // expensive: noise and occlusion rays
     in.screenPixels = 320 * 180;
+    // Fine map texels (12 a covered pixel): at one frame they cost more than the facets'
+    // vertices; at the default footprint (about 4) the map would win even there.
+    in.footprintScale = 0.6f;
     in.frames = 1;
     EXPECT_EQ(chooseRepresentation(in).kind, Representation::Facets);
     in.frames = 500;

@@ -227,6 +227,52 @@ TEST(ShaderMap, TheLevelAFootprintPicksIsPinned) {
     }
 }
 
+TEST(ShaderMap, AnisotropyCapWidensTheMinorAxisOrShortensTheMajor) {
+    // Stripes across u, 8 level-0 texels a period; a footprint 1 texel across them (du/dx)
+    // and 16 along them (dv/dy), capped at 2:1. Widening makes the minor axis 8 texels
+    // (level 3, where a texel spans a whole period: the stripes average out); shortening
+    // keeps level 0, where the stripes are resolved.
+    MapFixture f("surface s() { Ci = color(bake(sin(u * 6.2831853 * 32)), 0, 0) * (1 + time); }");
+    ShaderMapOptions options;
+    options.resolution = 256;
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    map.fillLevels(0, map.levels() - 1);
+    for (AnisotropyCap cap : {AnisotropyCap::WidenMinor, AnisotropyCap::ShrinkMajor}) {
+        ProbeOptions probe;
+        probe.filter = ProbeFilter::Feline;
+        probe.maxAnisotropy = 2.0f;
+        probe.levelBlend = 1.0f;
+        probe.cap = cap;
+        for (int k = 0; k < 8; ++k) {
+            const float u = (40.0f + k + 0.25f) / 32.0f * 0.5f + 0.01f, v = 0.5f;
+            const ProbeQuery q{0, u, v, 1.0f / 256.0f, 0.0f, 0.0f, 16.0f / 256.0f};
+            float out[3];
+            probeShaderMap(map, probe, {&q, 1}, out);
+            const float exact = f.direct(u, v)[0];
+            if (cap == AnisotropyCap::WidenMinor)
+                EXPECT_LT(std::fabs(out[0]), 0.15f) << "widened, at u = " << u;
+            else
+                EXPECT_NEAR(out[0], exact, 0.12f * std::fabs(exact) + 0.02f)
+                    << "shortened, at u = " << u;
+        }
+        // The levels read, exactly: the minor axis's (1 texel: level 0) when shortened,
+        // log2(16 / 2) = 3 when widened.
+        ShaderMapOptions sparse;
+        sparse.resolution = 256;
+        sparse.alwaysResidentLevels = 1;
+        ShaderMap empty(f.surface, *f.kernel, f.uniforms, sparse);
+        TileKey missing[64];
+        ProbeResidency residency{missing, 64};
+        residency.stopAtMissing = true;
+        const ProbeQuery q{0, 0.4f, 0.6f, 1.0f / 256.0f, 0.0f, 0.0f, 16.0f / 256.0f};
+        float out[3];
+        probeShaderMap(empty, probe, {&q, 1}, out, &residency);
+        std::set<int> levels;
+        for (size_t i = 0; i < residency.count; ++i) levels.insert(missing[i].level);
+        EXPECT_EQ(levels, std::set<int>({cap == AnisotropyCap::ShrinkMajor ? 0 : 3}));
+    }
+}
+
 TEST(ShaderMap, HalfPrecisionErrorIsBounded) {
     MapFixture f(kNoiseShader);
     ShaderMapOptions full, half;
