@@ -87,7 +87,9 @@ int runFactorCommand(const FactorCommandOptions& options) {
             binding = bindingOf(scene, *object);
             bindingText = "object '" + object->name + "' in " + options.scene;
         }
-        const FactoredShader f = factorShader(*ast, binding);
+        FactorOptions factorOptions;
+        if (options.storeAboveCost >= 0) factorOptions.storeAboveCost = options.storeAboveCost;
+        const FactoredShader f = factorShader(*ast, binding, factorOptions);
         const double ratio =
             f.staticInstructions > 0 ? double(f.dynamicInstructions) / f.staticInstructions : 0.0;
 
@@ -122,7 +124,8 @@ int runFactorCommand(const FactorCommandOptions& options) {
                                   {"cost",
                                    {{"unfactored", f.originalCost},
                                     {"static", f.staticCost},
-                                    {"dynamic", f.dynamicCost}}},
+                                    {"dynamic", f.dynamicCost},
+                                    {"static_repeated", f.recomputedStaticCost}}},
                                   {"dynamic_to_static_instructions", ratio},
                                   {"dynamic_lines", lines}};
             std::printf("%s\n", doc.dump(2).c_str());
@@ -134,6 +137,11 @@ int runFactorCommand(const FactorCommandOptions& options) {
         std::printf(
             "n-tuple: %d float%s (storing every static value a dynamic operation reads: %d)\n",
             f.chosenWidth, f.chosenWidth == 1 ? "" : "s", f.naiveWidth);
+        if (f.recomputedStaticCost > 0)
+            std::printf(
+                "  nothing stored: the static part (%d cost units a point) is cheaper to "
+                "repeat per point than to read back (--store-above-cost %d)\n",
+                f.recomputedStaticCost, factorOptions.storeAboveCost);
         if (!f.channels.empty())
             std::printf("  %-9s %-7s %-18s %s\n", "channel", "type", "holds", "computed at");
         for (size_t k = 0; k < f.channels.size();) {

@@ -12,6 +12,9 @@ struct FactorCommandOptions {
     std::string object;  // object in the scene whose binding to use (required with scene)
     bool json = false;   // machine-readable output
     bool dump = false;   // also print the IR of both parts
+    // FactorOptions::storeAboveCost: a static part costing at most this is repeated by the
+    // dynamic part rather than stored; -1: the engine's default; 0: always store.
+    int storeAboveCost = -1;
 };
 
 // Returns the exit code: 0 success, 2 bad input (message already on stderr).

@@ -61,6 +61,11 @@ int main(int argc, char** argv) {
     factorCmd->add_option("--object", factor.object, "Object in the scene");
     factorCmd->add_flag("--json", factor.json, "Machine-readable output");
     factorCmd->add_flag("--dump", factor.dump, "Also print the IR of both parts");
+    factorCmd
+        ->add_option("--store-above-cost", factor.storeAboveCost,
+                     "Store the static part only if it costs more than this per point (cost "
+                     "units; default 64, 0: always)")
+        ->check(CLI::Range(0, 1 << 30));
 
     mpshade::CompareCommandOptions compare;
     CLI::App* compareCmd = app.add_subcommand(

@@ -161,9 +161,12 @@ int runRenderCommand(const RenderCommandOptions& options) {
                 nlohmann::json objects = nlohmann::json::array();
                 for (size_t i = 0; i < multi->objectCount(); ++i) {
                     const ObjectReport& r = multi->report(i);
-                    const char* kind = r.kind == Representation::Facets      ? "facets"
-                                       : r.kind == Representation::ShaderMap ? "shadermap"
-                                                                             : "none (never seen)";
+                    // A static part not worth storing leaves geometry alone (factoring.h).
+                    const bool nothingStored = multi->factored(i).staticPart.channelOutputs.empty();
+                    const char* kind = r.kind == Representation::Auto     ? "none (never seen)"
+                                       : nothingStored                    ? "geometry"
+                                       : r.kind == Representation::Facets ? "facets"
+                                                                          : "shadermap";
                     objects.push_back({{"name", r.name},
                                        {"representation", kind},
                                        {"reason", r.reason},

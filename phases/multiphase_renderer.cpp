@@ -115,7 +115,9 @@ ObjectCostInputs MultiphaseRenderer::costInputs(size_t i, int frame, const Objec
     in.frames = std::max(1, framesSeenFrom(i, frame));
     in.combinedRuns = predictedCombinedRuns(i, frame, state);
     in.screenPixels = static_cast<double>(camera.width) * camera.height;
+    in.channels = static_cast<int>(shading.factored.staticPart.channelOutputs.size());
     in.staticCostUnits = shading.factored.staticCost;
+    in.recomputedCostUnits = shading.factored.recomputedStaticCost;
     in.originalCostUnits = shading.factored.originalCost;
     in.samplesPerPixel = spp;
     in.shadingRate = options_.dynamic.shadingRate;

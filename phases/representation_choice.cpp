@@ -22,9 +22,9 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     const double footprint = 0.6 / std::max(0.05f, in.footprintScale);
     const double texelsPerPixel =
         model.texelsPerCoveredPixel * samplesScale * footprint * footprint;
-    const double runs = in.haveMap ? 0.0
-                                   : in.coveredPixels * texelsPerPixel +
-                                         in.charts * model.pinnedTexelsPerChart;
+    const double runs =
+        in.haveMap ? 0.0
+                   : in.coveredPixels * texelsPerPixel + in.charts * model.pinnedTexelsPerChart;
     const double mapStatic = runs * staticPointNs;
     const double mapFrame = points * model.mapPointNs;
 
@@ -40,6 +40,20 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
         (in.originalCostUnits * model.referenceNsPerCostUnit + model.referenceSampleNs) * 1e-9;
     char text[320];
     std::string tooBig;
+    if (in.channels == 0) {
+        // Nothing to store (factoring.h, storeAboveCost): the facets need only the
+        // geometric tolerance, and no map is made.
+        c.kind = Representation::ShaderMap;
+        c.mapSeconds = frames * mapFrame * 1e-9;
+        c.mapStaticSeconds = 0.0;
+        std::snprintf(text, sizeof text,
+                      "auto: geometry only; the static part (%.0f cost units a point) costs "
+                      "less than reading it back, so the dynamic part runs the whole shader on "
+                      "facets diced to the geometric tolerance",
+                      in.recomputedCostUnits);
+        c.reason = text;
+        return c;
+    }
     if (!in.haveMap && !shaderMapFits(in, tooBig, model)) {
         c.kind = Representation::Facets;
         c.reason = "auto: facets; " + tooBig;

@@ -68,10 +68,12 @@ struct ObjectCostInputs {
     double originalCostUnits = 0.0;  // the whole shader's, as the reference runs it
     int samplesPerPixel = 4;
     ShadingRate shadingRate = ShadingRate::Sample;
-    float footprintScale = 1.0f;  // the dynamic phase's probe footprint scale
-    double pinnedBytes = 0.0;  // memory of a map's always-resident levels
-    double pinnedTiles = 0.0;  // tiles of those levels
-    bool haveMap = false;      // a map of it exists already: its cost is paid
+    float footprintScale = 1.0f;       // the dynamic phase's probe footprint scale
+    int channels = 1;                  // floats of the n-tuple; 0: nothing static is stored
+    double recomputedCostUnits = 0.0;  // with 0 channels: the static work the dynamic part repeats
+    double pinnedBytes = 0.0;          // memory of a map's always-resident levels
+    double pinnedTiles = 0.0;          // tiles of those levels
+    bool haveMap = false;              // a map of it exists already: its cost is paid
 };
 
 struct RepresentationChoice {

@@ -253,6 +253,8 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     costs.instructions += instructions;
     if (!useMap) {
         costs.programRuns += n;
+    } else if (channels == 0) {
+        // Nothing static is stored (factoring.h, storeAboveCost): no map to make.
     } else if (previous && previous->map && !obj.staticReadsFrame) {
         rep->map = previous->map;  // still valid: its tiles are kept
     } else {

@@ -34,6 +34,13 @@ struct FactorOptions {
     // Regroup sums and products so their static terms form one stored value (the patent's
     // C = A1 + A2 + A3 Kspec stores A1 + A2 and A3).
     bool reassociate = true;
+    // A static part whose whole cost (opCost units, per point) is at most this, with no
+    // occlusion, bake() or discontinuous operation in it, is not stored at all: the
+    // dynamic part runs the whole shader on the interpolated geometry. Reading an n-tuple
+    // costs a probe per point (20-60 ns on 2 cores, memory bound) plus the fills and the
+    // memory of a map, where 64 units run in about 10 ns (a diffuse() is 30; the
+    // interpreter's figures in docs/factoring.md). 0: always store what is static.
+    int storeAboveCost = 64;
 };
 
 // A rough per-lane cost of an operation, in units of one float add.

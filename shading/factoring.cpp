@@ -146,6 +146,17 @@ IrProgram dynamicPartOf(const IrProgram& p, const std::vector<int32_t>& channels
     return d;
 }
 
+// Whether a static part is so cheap that recomputing it per shading point costs less than
+// reading it back (FactorOptions::storeAboveCost): nothing in it that only the static phase
+// can do (occlusion rays, bake()) or that would alias if point-sampled.
+bool notWorthStoring(const IrProgram& staticPart, const FactorOptions& options) {
+    if (programCost(staticPart) > options.storeAboveCost) return false;
+    for (const Inst& inst : staticPart.insts)
+        if (inst.op == Op::Occlusion || inst.op == Op::Bake || isDiscontinuous(inst.op))
+            return false;
+    return true;
+}
+
 std::string describeValue(const IrProgram& p, int32_t v) {
     const ValueInfo* info =
         static_cast<size_t>(v) < p.info.size() ? &p.info[static_cast<size_t>(v)] : nullptr;
@@ -204,7 +215,14 @@ FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
     f.analyzed = options.reassociate ? reassociate(lowered, loweredTimes) : lowered;
     f.times = analyzeBindingTimes(f.analyzed, binding, options);
 
-    const std::vector<int32_t> cut = chooseChannels(f.analyzed, f.times, options);
+    std::vector<int32_t> cut = chooseChannels(f.analyzed, f.times, options);
+    if (!cut.empty()) {
+        const IrProgram stored = staticPartOf(f.analyzed, cut);
+        if (notWorthStoring(stored, options)) {
+            f.recomputedStaticCost = programCost(stored);
+            cut.clear();
+        }
+    }
     f.staticPart = staticPartOf(f.analyzed, cut);
     f.dynamicPart = dynamicPartOf(f.analyzed, cut);
     const std::vector<int> defining = definingInstructions(f.analyzed);

@@ -341,13 +341,29 @@ TEST(Cli, FactorShowsASmallTupleAndACheapDynamicPart) {
 TEST(Cli, FactorBindingChangesTheCut) {
     // Without a scene the shader's light is fixed; the teapot's point light moves, so its
     // diffuse light can no longer be stored.
-    const nlohmann::json fixed =
-        nlohmann::json::parse(mpshade("factor examples/shaders/plastic.sl --json").output);
-    const nlohmann::json moving =
-        nlohmann::json::parse(mpshade("factor examples/shaders/plastic.sl --scene "
-                                      "examples/teapot/scene.json --object teapot --json")
-                                  .output);
+    // Storing everything static (--store-above-cost 0) shows the cut itself.
+    const nlohmann::json fixed = nlohmann::json::parse(
+        mpshade("factor examples/shaders/plastic.sl --store-above-cost 0 --json").output);
+    const nlohmann::json moving = nlohmann::json::parse(
+        mpshade("factor examples/shaders/plastic.sl --scene examples/teapot/scene.json "
+                "--object teapot --store-above-cost 0 --json")
+            .output);
     EXPECT_GT(fixed["cost"]["static"].get<int>(), moving["cost"]["static"].get<int>());
+    EXPECT_EQ(fixed["cost"]["static_repeated"], 0);
+    // By default the teapot's three floats of fixed diffuse light (33 units) are not worth a
+    // probe: nothing is stored and the dynamic part runs the whole shader.
+    const CliRun byDefault = mpshade(
+        "factor examples/shaders/plastic.sl --scene examples/teapot/scene.json --object teapot");
+    EXPECT_NE(byDefault.output.find("nothing stored: the static part (33 cost units"),
+              std::string::npos)
+        << byDefault.output;
+    const nlohmann::json cheap = nlohmann::json::parse(
+        mpshade("factor examples/shaders/plastic.sl --scene examples/teapot/scene.json "
+                "--object teapot --json")
+            .output);
+    EXPECT_EQ(cheap["chosen_width"], 0);
+    EXPECT_EQ(cheap["cost"]["static_repeated"], moving["cost"]["static"]);
+    EXPECT_EQ(cheap["cost"]["dynamic"], cheap["cost"]["unfactored"]);
 }
 
 TEST(Cli, FactorBadInput) {

@@ -332,7 +332,9 @@ TEST(Factoring, ExplainsWhyEachLineIsDynamic) {
                                  "* k;\n  Ci = color(b);\n}");
     ShaderBinding b;
     b.params["k"].kind = ParamBinding::Kind::Animated;
-    const FactoredShader f = factorShader(*ast, b);
+    FactorOptions store;
+    store.storeAboveCost = 0;  // one noise (40 units) would otherwise be repeated, not stored
+    const FactoredShader f = factorShader(*ast, b, store);
     ASSERT_EQ(f.dynamicLines.size(), 1u);
     EXPECT_EQ(f.dynamicLines[0].line, 3);
     ASSERT_FALSE(f.dynamicLines[0].chain.empty());
@@ -403,6 +405,8 @@ TEST(Factoring, RandomShadersFactorExactly) {
         if (i % 5 == 0) b.lights[1].movesRelativeToObject = true;
         FactorOptions options;
         options.geometryInDynamicPhase = i % 4 != 0;
+        // Both ways of keeping cheap static work: repeated by the dynamic part, or stored.
+        if (i % 3 == 1) options.storeAboveCost = 0;
         expectExact(*ast, b, src, options);
         if (HasFailure()) break;
     }
@@ -410,4 +414,41 @@ TEST(Factoring, RandomShadersFactorExactly) {
 
 }  // namespace
 
+}  // namespace mpshade
+
+namespace mpshade {
+namespace {
+
+TEST(Factoring, AStaticPartCheaperThanAProbeIsRepeatedNotStored) {
+    // k is animated, so a * k is dynamic and the static part is what feeds it.
+    auto factor = [](const std::string& staticExpr, int limit) {
+        auto ast = compileShaderText("cheap.sl", "surface cheap(float k = 1) {\n  float a = " +
+                                                     staticExpr + ";\n  Ci = color(a * k);\n}");
+        ShaderBinding b;
+        b.params["k"].kind = ParamBinding::Kind::Animated;
+        FactorOptions options;
+        options.storeAboveCost = limit;
+        return factorShader(*ast, b, options);
+    };
+    // Two noises (40 units each), a vector scale (3) and an add (1): 84 units. Stored
+    // above the limit, repeated at it exactly.
+    const std::string twoNoises = "noise(P) + noise(P * 3)";
+    ASSERT_EQ(factor(twoNoises, 0).staticCost, 84);
+    const FactoredShader stored = factor(twoNoises, 83);
+    EXPECT_EQ(stored.chosenWidth, 1);
+    EXPECT_EQ(stored.recomputedStaticCost, 0);
+    const FactoredShader repeated = factor(twoNoises, 84);
+    EXPECT_EQ(repeated.chosenWidth, 0);
+    EXPECT_EQ(repeated.recomputedStaticCost, stored.staticCost);
+    EXPECT_EQ(repeated.staticCost, 0);
+    EXPECT_EQ(repeated.dynamicCost, repeated.originalCost);
+    EXPECT_EQ(repeated.dynamicPart.channelInputs, 0);
+    // What only the static phase may do, or what would alias point-sampled, stays stored
+    // however cheap: bake(), a discontinuity, occlusion rays.
+    EXPECT_EQ(factor("bake(u * 2)", 1000).chosenWidth, 1);
+    EXPECT_EQ(factor("step(0.5, noise(P))", 1000).chosenWidth, 1);
+    EXPECT_EQ(factor("occlusion(P, N, 1)", 1000).chosenWidth, 1);
+}
+
+}  // namespace
 }  // namespace mpshade
