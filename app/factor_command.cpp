@@ -139,9 +139,10 @@ int runFactorCommand(const FactorCommandOptions& options) {
             f.chosenWidth, f.chosenWidth == 1 ? "" : "s", f.naiveWidth);
         if (f.recomputedStaticCost > 0)
             std::printf(
-                "  nothing stored: the static part (%d cost units a point) is cheaper to "
-                "repeat per point than to read back (--store-above-cost %d)\n",
-                f.recomputedStaticCost, factorOptions.storeAboveCost);
+                "  %s: %d cost units of static work a point, cheaper to repeat than "
+                "to read back (--store-above-cost %d), run by the dynamic part\n",
+                f.chosenWidth == 0 ? "nothing stored" : "some not stored", f.recomputedStaticCost,
+                factorOptions.storeAboveCost);
         if (!f.channels.empty())
             std::printf("  %-9s %-7s %-18s %s\n", "channel", "type", "holds", "computed at");
         for (size_t k = 0; k < f.channels.size();) {

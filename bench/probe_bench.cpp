@@ -47,7 +47,9 @@ struct ProbeData {
         for (int c = 0; c < n; ++c)
             src += fmt::format("acc += noise(P * {}) * time;\n", 2.0 + 1.7 * c);
         src += "Ci = color(acc); }";
-        factored = factorShader(*compileShaderText("probe.sl", src), {});
+        FactorOptions storeAll;  // the map holds every noise, however cheap to repeat
+        storeAll.storeAboveCost = 0;
+        factored = factorShader(*compileShaderText("probe.sl", src), {}, storeAll);
         kernel = std::make_unique<ShaderKernel>(factored.staticPart);
         ShaderMapOptions options;
         options.resolution = kResolution;

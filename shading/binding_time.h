@@ -34,13 +34,15 @@ struct FactorOptions {
     // Regroup sums and products so their static terms form one stored value (the patent's
     // C = A1 + A2 + A3 Kspec stores A1 + A2 and A3).
     bool reassociate = true;
-    // A static part whose whole cost (opCost units, per point) is at most this, with no
-    // occlusion, bake() or discontinuous operation in it, is not stored at all: the
-    // dynamic part runs the whole shader on the interpolated geometry. Reading an n-tuple
-    // costs a probe per point (20-60 ns on 2 cores, memory bound) plus the fills and the
-    // memory of a map, where 64 units run in about 10 ns (a diffuse() is 30; the
-    // interpreter's figures in docs/factoring.md). 0: always store what is static.
-    int storeAboveCost = 64;
+    // Stored values whose static work costs at most this many opCost units a point, with
+    // no occlusion, bake(), noise or discontinuity in it, are not stored: the dynamic part
+    // repeats that work on the interpolated geometry (all of the static part, when every
+    // value qualifies: then no map is made). Reading a value back costs a probe per point
+    // (20-60 ns, memory bound) plus the fills and the memory of a map, where lighting and
+    // arithmetic run at about 0.16 ns a unit (the plastic's 33-unit static part: 5 ns a
+    // lane, `mpshade-bench --benchmark_filter=Factored/plastic`): 96 units is three lights'
+    // diffuse(). 0: store whatever the cut chooses.
+    int storeAboveCost = 96;
 };
 
 // A rough per-lane cost of an operation, in units of one float add.

@@ -146,15 +146,57 @@ IrProgram dynamicPartOf(const IrProgram& p, const std::vector<int32_t>& channels
     return d;
 }
 
-// Whether a static part is so cheap that recomputing it per shading point costs less than
-// reading it back (FactorOptions::storeAboveCost): nothing in it that only the static phase
-// can do (occlusion rays, bake()) or that would alias if point-sampled.
-bool notWorthStoring(const IrProgram& staticPart, const FactorOptions& options) {
-    if (programCost(staticPart) > options.storeAboveCost) return false;
-    for (const Inst& inst : staticPart.insts)
-        if (inst.op == Op::Occlusion || inst.op == Op::Bake || isDiscontinuous(inst.op))
+// Work a shader map exists for, however few cost units it counts: occlusion rays and bake()
+// only the static phase may do; noise patterns cost tens of nanoseconds a point (opCost's
+// 40 units underrate them against arithmetic and lighting) and alias when point-sampled.
+bool staticPhaseWork(Op op) {
+    switch (op) {
+        case Op::Occlusion:
+        case Op::Bake:
+        case Op::Noise:
+        case Op::Snoise:
+        case Op::Cellnoise:
+        case Op::Fbm:
+        case Op::Turbulence:
+            return true;
+        default:
             return false;
-    return true;
+    }
+}
+
+// The channels of `cut` cheaper to repeat per shading point than to read back
+// (FactorOptions::storeAboveCost): each one's own static work (what computing it alone
+// takes) holds no staticPhaseWork() and nothing that would alias if point-sampled, and
+// together they cost at most the limit (or each adds no more
+// than cheap arithmetic to the rest). Cheapest first, so a channel that shares a lighting
+// call with others (the three of a diffuse colour) goes with them.
+std::vector<int32_t> notWorthStoring(const IrProgram& p, const std::vector<int32_t>& cut,
+                                     const FactorOptions& options) {
+    std::vector<std::pair<int, int32_t>> candidates;
+    for (int32_t v : cut) {
+        const IrProgram alone = staticPartOf(p, {v});
+        const int cost = programCost(alone);
+        if (cost > options.storeAboveCost) continue;
+        bool clean = true;
+        for (const Inst& inst : alone.insts)
+            clean = clean && !staticPhaseWork(inst.op) && !isDiscontinuous(inst.op);
+        if (clean) candidates.emplace_back(cost, v);
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<int32_t> chosen;
+    int total = 0;
+    for (const auto& [cost, v] : candidates) {
+        chosen.push_back(v);
+        const int with = programCost(staticPartOf(p, chosen));
+        // Within the limit, or next to free: once the dynamic part repeats the lighting, a
+        // channel that is one add away from it costs that add (as the cut itself allows).
+        if (with <= options.storeAboveCost || with - total <= options.recomputeCostLimit)
+            total = with;
+        else
+            chosen.pop_back();
+    }
+    return chosen;
 }
 
 std::string describeValue(const IrProgram& p, int32_t v) {
@@ -216,12 +258,12 @@ FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
     f.times = analyzeBindingTimes(f.analyzed, binding, options);
 
     std::vector<int32_t> cut = chooseChannels(f.analyzed, f.times, options);
-    if (!cut.empty()) {
-        const IrProgram stored = staticPartOf(f.analyzed, cut);
-        if (notWorthStoring(stored, options)) {
-            f.recomputedStaticCost = programCost(stored);
-            cut.clear();
-        }
+    const std::vector<int32_t> repeated = notWorthStoring(f.analyzed, cut, options);
+    if (!repeated.empty()) {
+        f.recomputedStaticCost = programCost(staticPartOf(f.analyzed, repeated));
+        std::erase_if(cut, [&](int32_t v) {
+            return std::find(repeated.begin(), repeated.end(), v) != repeated.end();
+        });
     }
     f.staticPart = staticPartOf(f.analyzed, cut);
     f.dynamicPart = dynamicPartOf(f.analyzed, cut);

@@ -19,6 +19,13 @@
 namespace mpshade {
 namespace {
 
+// These maps hold what a test shader computes, however cheap it would be to repeat.
+FactorOptions storeEverything() {
+    FactorOptions o;
+    o.storeAboveCost = 0;
+    return o;
+}
+
 // A map of a shader's static part over a 4 x 4 plane; time keeps the rest dynamic.
 struct MapFixture {
     Surface surface = Plane{4.0f, 4.0f};
@@ -28,7 +35,7 @@ struct MapFixture {
 
     explicit MapFixture(const char* source) {
         auto ast = compileShaderText("map.sl", source);
-        factored = factorShader(*ast, {});
+        factored = factorShader(*ast, {}, storeEverything());
         kernel = std::make_unique<ShaderKernel>(factored.staticPart);
     }
 
@@ -305,7 +312,7 @@ TEST(ShaderMap, NoSeamsAcrossChartEdges) {
                       SubdivScheme::Catmark, "vase");
     auto ast = compileShaderText(
         "seam.sl", "surface seam() { Ci = color(noise(P * 3), fbm(P * 2, 2), 0) * (1 + time); }");
-    const FactoredShader f = factorShader(*ast, {});
+    const FactoredShader f = factorShader(*ast, {}, storeEverything());
     const ShaderKernel kernel(f.staticPart);
     ShaderMapOptions seamless, clamped;
     seamless.resolution = clamped.resolution = 16;

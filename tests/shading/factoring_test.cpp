@@ -87,9 +87,17 @@ bool close(float a, float b) {
     return std::fabs(a - b) <= 1e-5f * std::fmax(1.0f, std::fmax(std::fabs(a), std::fabs(b)));
 }
 
+// The minimum cut alone: every static value a dynamic operation needs is stored, however
+// cheap to repeat (FactorOptions::storeAboveCost has tests of its own).
+FactorOptions cutOnly() {
+    FactorOptions o;
+    o.storeAboveCost = 0;
+    return o;
+}
+
 // Checks static-then-dynamic against the unfactored shader; returns the factoring.
 FactoredShader expectExact(const ShaderAst& ast, const ShaderBinding& binding,
-                           const std::string& what, const FactorOptions& options = {},
+                           const std::string& what, const FactorOptions& options = cutOnly(),
                            int instances = 3) {
     static const Surface sphere = Sphere{1.0f};
     static const SurfaceRayScene occluder(sphere);
@@ -200,7 +208,7 @@ TEST(Factoring, PatentExampleStoresTwoValuesNotThree) {
     const FactoredShader f = expectExact(*ast, b, "patent example");
     EXPECT_EQ(f.naiveWidth, 3);
     EXPECT_EQ(f.chosenWidth, 2);
-    FactorOptions plain;
+    FactorOptions plain = cutOnly();
     plain.reassociate = false;
     EXPECT_EQ(expectExact(*ast, b, "patent example, no reassociation", plain).chosenWidth, 3);
 }
@@ -281,7 +289,7 @@ TEST(Factoring, DynamicBranchesLoopsAndNaN) {
             for (int i = 1; i <= 3; i += 1) { acc += noise(P * i) * time; }
             Ci = c + acc + color(log(noise(P) - 2) + sqrt(time - 1), 1 / (time - time), pow(-2, time));
         })");
-    const FactoredShader f = expectExact(*branch, {}, "branches and loops", {}, 6);
+    const FactoredShader f = expectExact(*branch, {}, "branches and loops", cutOnly(), 6);
     for (const Inst& inst : f.dynamicPart.insts) {
         EXPECT_NE(inst.op, Op::Noise);
         EXPECT_NE(inst.op, Op::Fbm);
@@ -430,24 +438,48 @@ TEST(Factoring, AStaticPartCheaperThanAProbeIsRepeatedNotStored) {
         options.storeAboveCost = limit;
         return factorShader(*ast, b, options);
     };
-    // Two noises (40 units each), a vector scale (3) and an add (1): 84 units. Stored
-    // above the limit, repeated at it exactly.
-    const std::string twoNoises = "noise(P) + noise(P * 3)";
-    ASSERT_EQ(factor(twoNoises, 0).staticCost, 84);
-    const FactoredShader stored = factor(twoNoises, 83);
+    // A sine and a cosine (8 units each), two scales and an add (1 each): 19 units.
+    // Stored above the limit, repeated at it exactly.
+    const std::string waves = "sin(u * 7) + cos(v * 5)";
+    ASSERT_EQ(factor(waves, 0).staticCost, 19);
+    const FactoredShader stored = factor(waves, 18);
     EXPECT_EQ(stored.chosenWidth, 1);
     EXPECT_EQ(stored.recomputedStaticCost, 0);
-    const FactoredShader repeated = factor(twoNoises, 84);
+    const FactoredShader repeated = factor(waves, 19);
     EXPECT_EQ(repeated.chosenWidth, 0);
     EXPECT_EQ(repeated.recomputedStaticCost, stored.staticCost);
     EXPECT_EQ(repeated.staticCost, 0);
     EXPECT_EQ(repeated.dynamicCost, repeated.originalCost);
     EXPECT_EQ(repeated.dynamicPart.channelInputs, 0);
     // What only the static phase may do, or what would alias point-sampled, stays stored
-    // however cheap: bake(), a discontinuity, occlusion rays.
+    // however cheap: bake(), noise, a discontinuity, occlusion rays.
     EXPECT_EQ(factor("bake(u * 2)", 1000).chosenWidth, 1);
-    EXPECT_EQ(factor("step(0.5, noise(P))", 1000).chosenWidth, 1);
+    EXPECT_EQ(factor("noise(P)", 1000).chosenWidth, 1);
+    EXPECT_EQ(factor("step(0.5, sin(u * 9))", 1000).chosenWidth, 1);
     EXPECT_EQ(factor("occlusion(P, N, 1)", 1000).chosenWidth, 1);
+}
+
+TEST(Factoring, CheapChannelsAreRepeatedAndCostlyOnesStored) {
+    // k is animated: the stored values are a noise pattern (fbm, 160 units) and the two
+    // fixed lights' diffuse colour (2 x 30 + 6 units). Only the diffuse colour is cheap to
+    // repeat; with a limit of 64 too, as each channel after the first adds only its sums.
+    auto ast = compileShaderText(
+        "mixed.sl",
+        "surface mixed(float k = 1) {\n  float a = fbm(P, 4);\n  color d = diffuse(N);\n"
+        "  Ci = color(a * k) + d * k;\n}");
+    ShaderBinding b = fixedLights();
+    b.params["k"].kind = ParamBinding::Kind::Animated;
+    const FactoredShader all = expectExact(*ast, b, "mixed, all stored", cutOnly());
+    ASSERT_EQ(all.chosenWidth, 4);
+    const FactoredShader some = expectExact(*ast, b, "mixed, cheap ones repeated", FactorOptions{});
+    ASSERT_EQ(some.chosenWidth, 1) << some.staticPart.dump();
+    EXPECT_EQ(some.recomputedStaticCost, 66);
+    EXPECT_EQ(some.channels[0].op, Op::Fbm);
+    EXPECT_EQ(some.recomputedStaticCost, all.staticCost - some.staticCost);
+    EXPECT_EQ(some.dynamicCost, all.dynamicCost + some.recomputedStaticCost);
+    FactorOptions tight;
+    tight.storeAboveCost = 64;
+    EXPECT_EQ(expectExact(*ast, b, "mixed, limit 64", tight).chosenWidth, 1);
 }
 
 }  // namespace
