@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
                           "(overrides the scene)");
     renderCmd->add_option("--footprint-scale", render.footprintScale,
                           "Multiphase: shader map texels per shading point spacing, inverted "
-                          "(default 0.6; larger reads coarser levels: faster, blurrier)");
+                          "(default 1; larger reads coarser levels: faster, blurrier)");
     renderCmd->add_flag("--no-single-phase", render.noSinglePhase,
                         "Multiphase: every frame multi-phase, even where its static work would "
                         "cost more than rendering the frames asked for single-phase");

@@ -104,6 +104,7 @@ ObjectCostInputs MultiphaseRenderer::costInputs(size_t i, int frame, const Objec
                      static_cast<double>(shading.factored.staticPart.channelOutputs.size()) *
                      sizeof(float);
     in.haveMap = previous && previous->map;
+    in.pinnedUpFront = options_.staticPhase.shaderMap.fillPinnedUpFront;
     // The screen area: the object's bounding sphere, projected, within the screen.
     const Bounds3 b = surfaceBounds(*obj.surface);
     const float ppu = 0.5f * static_cast<float>(camera.height) / camera.tanHalfFovY;

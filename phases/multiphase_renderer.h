@@ -32,8 +32,17 @@
 
 namespace mpshade {
 
+// Constant quality fills every tile a frame's probes lack before it shades, so no probe
+// falls back and the maps' always-resident levels are filled only where frames ask for
+// them (on the courtyard's 24 frames, filling them all up front took 1.0 s of 6.3).
+inline StaticPhaseOptions constantQualityStaticPhase() {
+    StaticPhaseOptions o;
+    o.shaderMap.fillPinnedUpFront = false;
+    return o;
+}
+
 struct MultiphaseOptions {
-    StaticPhaseOptions staticPhase;
+    StaticPhaseOptions staticPhase = constantQualityStaticPhase();
     DynamicOptions dynamic;  // its shadingRate is the scene's unless shadingRate is set
     std::optional<ShadingRate> shadingRate;
     RepresentationCostModel costModel;

@@ -22,9 +22,10 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     const double footprint = 0.6 / std::max(0.05f, in.footprintScale);
     const double texelsPerPixel =
         model.texelsPerCoveredPixel * samplesScale * footprint * footprint;
-    const double runs =
-        in.haveMap ? 0.0
-                   : in.coveredPixels * texelsPerPixel + in.charts * model.pinnedTexelsPerChart;
+    // The always-resident levels, when filled up front (ShaderMapOptions::fillPinnedUpFront;
+    // otherwise only the tiles frames ask for, already counted).
+    const double pinnedTexels = in.pinnedUpFront ? in.charts * model.pinnedTexelsPerChart : 0.0;
+    const double runs = in.haveMap ? 0.0 : in.coveredPixels * texelsPerPixel + pinnedTexels;
     const double mapStatic = runs * staticPointNs;
     const double mapFrame = points * model.mapPointNs;
 
@@ -70,8 +71,8 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
         std::snprintf(text, sizeof text,
                       "auto: shadermap; facets would number %.3g, over %.0f per screen pixel",
                       in.combinedFacets, model.maxFacetsPerScreenPixel);
-    } else if (!in.haveMap && in.charts * model.pinnedTexelsPerChart >
-                                  model.maxPinnedTexelsPerPoint * std::max(points, 1.0)) {
+    } else if (!in.haveMap &&
+               pinnedTexels > model.maxPinnedTexelsPerPoint * std::max(points, 1.0)) {
         c.kind = Representation::Facets;
         std::snprintf(text, sizeof text,
                       "auto: facets; a shader map would keep %.3g texels always resident for "

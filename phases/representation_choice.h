@@ -71,6 +71,7 @@ struct ObjectCostInputs {
     float footprintScale = 1.0f;       // the dynamic phase's probe footprint scale
     int channels = 1;                  // floats of the n-tuple; 0: nothing static is stored
     double recomputedCostUnits = 0.0;  // with 0 channels: the static work the dynamic part repeats
+    bool pinnedUpFront = true;         // a map's always-resident levels are filled when it is made
     double pinnedBytes = 0.0;          // memory of a map's always-resident levels
     double pinnedTiles = 0.0;          // tiles of those levels
     bool haveMap = false;              // a map of it exists already: its cost is paid

@@ -63,7 +63,7 @@ ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
         tilesPerSide_.push_back((resolution(level) + options.tileSize - 1) / options.tileSize);
     pool_ = pool ? std::move(pool) : std::make_shared<TilePool>(tileBytesFor(options, channels_));
     MPSHADE_CHECK(pool_->tileBytes() == tileBytesFor(options, channels_));
-    if (options.alwaysResidentLevels > 0)
+    if (options.alwaysResidentLevels > 0 && options.fillPinnedUpFront)
         fillLevels(std::max(0, levels_ - options.alwaysResidentLevels), levels_ - 1);
 }
 

@@ -31,9 +31,9 @@
 // with the same values up to float rounding: a tile does not depend on what else was
 // resident when it was filled.
 //
-// Residency: the coarsest `alwaysResidentLevels` levels of every chart are filled at
-// construction, so a probe always finds data: it falls back to the finest resident coarser
-// level (patent col. 10).
+// Residency: the coarsest `alwaysResidentLevels` levels of every chart are never evicted,
+// and are filled at construction (unless fillPinnedUpFront is off), so a probe always
+// finds data: it falls back to the finest resident coarser level (patent col. 10).
 #pragma once
 
 #include <algorithm>
@@ -64,8 +64,13 @@ struct ShaderMapOptions {
     // from their children where resident) measured the least error against 64-sample
     // references as well as the least work (docs/shader-maps.md).
     int supersampleLimit = 1;
-    int alwaysResidentLevels = 6;  // 1x1 .. 32x32 per chart, filled at construction
-    bool seamless = true;          // borders from the neighbouring chart; false: clamp to edge
+    int alwaysResidentLevels = 6;  // 1x1 .. 32x32 per chart, never evicted
+    // Fill those levels at construction, so a probe always finds data to fall back to (a
+    // caller that keeps a frame rate). false: they are filled when first asked for, like
+    // any tile, and then never evicted -- for a caller that fills every tile its probes
+    // lack before it shades (constant quality, `render`), which never falls back.
+    bool fillPinnedUpFront = true;
+    bool seamless = true;  // borders from the neighbouring chart; false: clamp to edge
 };
 
 // A tile: chart, level, and tile column and row within the level.

@@ -463,7 +463,7 @@ TEST(MultiphaseRenderer, MapsStayInTheirMemoryBudget) {
     RenderOptions options;
     options.width = 96, options.height = 54;
     MultiphaseOptions tight, roomy;
-    tight.mapMemoryBytes = size_t{6} << 20;
+    tight.mapMemoryBytes = size_t{1} << 20;
     MultiphaseRenderer a(scene, tight), b(scene, roomy);
     uint64_t evicted = 0;
     for (int frame = 0; frame < 40; frame += 8) {

@@ -280,6 +280,41 @@ TEST(ShaderMap, AnisotropyCapWidensTheMinorAxisOrShortensTheMajor) {
     }
 }
 
+TEST(ShaderMap, AlwaysResidentLevelsFilledUpFrontOrWhenFirstAsked) {
+    // A plane is one chart; at 256 texels a side its six coarsest levels (32 x 32 .. 1 x 1)
+    // are 4 + 5 tiles of 16 x 16.
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions eagerOptions, lazyOptions;
+    eagerOptions.resolution = lazyOptions.resolution = 256;
+    lazyOptions.fillPinnedUpFront = false;
+    const ShaderMap eager(f.surface, *f.kernel, f.uniforms, eagerOptions);
+    EXPECT_EQ(eager.residentTiles(), 9u);
+    ShaderMap lazy(f.surface, *f.kernel, f.uniforms, lazyOptions);
+    EXPECT_EQ(lazy.residentTiles(), 0u);
+    // A footprint of 16 level-0 texels reads level 4 (16 x 16 texels, one tile): lacking,
+    // reported, then filled -- and, being always resident, never offered for eviction.
+    ProbeOptions probe;
+    probe.filter = ProbeFilter::Trilinear;
+    const ProbeQuery q = query(0.4f, 0.6f, 16.0f / 256.0f, 16.0f / 256.0f);
+    TileKey missing[8];
+    ProbeResidency residency{missing, 8};
+    residency.stopAtMissing = true;
+    float out[3];
+    probeShaderMap(lazy, probe, {&q, 1}, out, &residency);
+    ASSERT_EQ(residency.count, 1u);
+    EXPECT_EQ(missing[0].level, 4);
+    lazy.fill({missing, 1});
+    EXPECT_EQ(lazy.residentTiles(), 1u);
+    std::vector<TilePool::Held> evictable;
+    lazy.pool()->evictable(~0u, evictable);
+    EXPECT_TRUE(evictable.empty());
+    // The same values as the eager map's.
+    float a[3], b[3];
+    probeShaderMap(lazy, probe, {&q, 1}, a);
+    probeShaderMap(eager, probe, {&q, 1}, b);
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(a[c], b[c]);
+}
+
 TEST(ShaderMap, HalfPrecisionErrorIsBounded) {
     MapFixture f(kNoiseShader);
     ShaderMapOptions full, half;
