@@ -19,7 +19,7 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     // Separate: the texels frames ask for and the always-resident levels, unless built.
     const double samplesScale =
         in.shadingRate == ShadingRate::Pixel ? 1.0 : in.samplesPerPixel / 4.0;
-    const double footprint = 1.0 / std::max(0.05f, in.footprintScale);
+    const double footprint = 0.6 / std::max(0.05f, in.footprintScale);
     const double texelsPerPixel =
         model.texelsPerCoveredPixel * samplesScale * footprint * footprint;
     // The always-resident levels, when filled up front (ShaderMapOptions::fillPinnedUpFront;

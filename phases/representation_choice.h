@@ -41,13 +41,10 @@ struct RepresentationCostModel {
     // ns a sample; the vase's 518,400, a quarter of them marble (3,542 units), 0.32 s.
     double referenceSampleNs = 350.0;
     double referenceNsPerCostUnit = 0.3;
-    // Separate: texels filled per covered pixel at 4 samples per pixel and footprint scale
-    // 1, where a surface is first seen; the density goes with the samples (per sample
-    // rate) and with 1 / scale^2. Measured on the first frames of the examples (texels
-    // filled over covered pixels in stats.json): teapot 10, vase 20, gallery 22, courtyard
-    // 25 -- over the 4 of a square footprint, for surfaces seen at an angle (the level
-    // follows the minor axis), tiles partly seen and two levels where they blend.
-    double texelsPerCoveredPixel = 18.0;
+    // Separate: texels filled per covered pixel at 4 samples per pixel and the default
+    // footprint scale 0.6; the texel density goes as the footprint's inverse square, so
+    // with the samples (per sample rate) and with 1 / scale^2.
+    double texelsPerCoveredPixel = 12.0;
     double pinnedTexelsPerChart = 34.0 * 34.0;   // the 32 x 32 level with its border
     double maxFacetsPerScreenPixel = 4.0;        // combined facets beyond this: always a map
     double maxPinnedBytes = 64.0 * 1024 * 1024;  // pinned levels beyond this: facets

@@ -339,20 +339,15 @@ TEST(RepresentationChoice, SinglePhaseEstimateIsSamplesTimesRayAndShader) {
     // The per-kind parts add up to the totals over the frames.
     EXPECT_NEAR(c.mapSeconds, c.mapStaticSeconds + 10.0 * c.mapFrameSeconds, 1e-12);
     EXPECT_NEAR(c.facetsSeconds, c.facetsStaticSeconds + 10.0 * c.facetsFrameSeconds, 1e-12);
-    // Map texels go as the footprint's inverse square: at 8 samples and scale 1.2, 18 x 2 /
-    // 1.44 = 25 a covered pixel, plus the chart's always-resident 34 x 34, each at the
-    // static part's 60 units x 1.4 ns plus 60 ns of geometry; without the always-resident
-    // levels when those are filled only where frames ask.
+    // Map texels go as the footprint's inverse square: at 8 samples and scale 1.2, 12 x 2 /
+    // 4 = 6 a covered pixel, plus the chart's always-resident 34 x 34, each at the static
+    // part's 60 units x 1.4 ns plus 60 ns of geometry.
     in.samplesPerPixel = 8;
     in.footprintScale = 1.2f;
     EXPECT_NEAR(chooseRepresentation(in).mapStaticSeconds,
-                (1000.0 * 25.0 + 34.0 * 34.0) * (60.0 * 1.4 + 60.0) * 1e-9, 1e-9);
-    in.pinnedUpFront = false;
-    EXPECT_NEAR(chooseRepresentation(in).mapStaticSeconds,
-                1000.0 * 25.0 * (60.0 * 1.4 + 60.0) * 1e-9, 1e-9);
-    in.pinnedUpFront = true;
+                (1000.0 * 6.0 + 34.0 * 34.0) * (60.0 * 1.4 + 60.0) * 1e-9, 1e-9);
     in.samplesPerPixel = 4;
-    in.footprintScale = 1.0f;
+    in.footprintScale = 0.6f;
     // Per pixel shades once a pixel but the reference still traces every sample.
     in.shadingRate = ShadingRate::Pixel;
     EXPECT_NEAR(chooseRepresentation(in).singlePhaseFrameSeconds, 4000.0 * 380.0 * 1e-9, 1e-12);
@@ -385,6 +380,9 @@ TEST(RepresentationChoice, SeenOftenAMapSeenOnceFacets) {
     in.charts = 16;
     in.staticCostUnits = 3000;  // expensive: noise and occlusion rays
     in.screenPixels = 320 * 180;
+    // Fine map texels (12 a covered pixel): at one frame they cost more than the facets'
+    // vertices; at the default footprint (about 4) the map would win even there.
+    in.footprintScale = 0.6f;
     in.frames = 1;
     EXPECT_EQ(chooseRepresentation(in).kind, Representation::Facets);
     in.frames = 500;
