@@ -425,6 +425,46 @@ TEST(MultiphaseRenderer, ShaderMapRepresentationMatchesTheReference) {
     EXPECT_GT(rep->map->channels(), 0);
 }
 
+TEST(MultiphaseRenderer, StaticPartNotWorthStoringLeavesGeometryOnly) {
+    // The teapot's plastic under a moving light: the fixed lights' diffuse (33 units) is not
+    // worth a probe, so nothing is stored: no map, facets to the geometric tolerance, the
+    // whole shader per sample -- and the frame is as close to the reference as with the
+    // diffuse light stored in a map (storeAboveCost 0).
+    const Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
+    size_t teapot = 0;
+    while (scene.objects[teapot].name != "teapot") ++teapot;
+    const ReferenceRenderer reference(scene);
+    MultiphaseRenderer multi(scene, machineryOnly());
+    RenderOptions options;
+    options.width = 160;
+    options.height = 100;
+    options.samplesPerPixel = 2;
+    FrameStats rs, ms;
+    const Image ref = reference.renderFrame(3, options, rs);
+    const Image got = multi.renderFrame(3, options, ms);
+    EXPECT_EQ(multi.factored(teapot).chosenWidth, 0);
+    EXPECT_EQ(multi.factored(teapot).recomputedStaticCost, 33);
+    const ObjectRepresentation* rep = multi.representation(teapot);
+    ASSERT_NE(rep, nullptr);
+    EXPECT_EQ(rep->kind, Representation::ShaderMap);  // diced for the geometric tolerance
+    EXPECT_EQ(rep->map, nullptr);
+    EXPECT_EQ(rep->mesh.channels, 0);
+    EXPECT_NE(multi.report(teapot).reason.find("geometry only"), std::string::npos)
+        << multi.report(teapot).reason;
+    MultiphaseOptions storeAll = machineryOnly();
+    storeAll.staticPhase.factor.storeAboveCost = 0;
+    MultiphaseRenderer stored(scene, storeAll);
+    FrameStats ss;
+    const Image withMap = stored.renderFrame(3, options, ss);
+    ASSERT_NE(stored.representation(teapot)->map, nullptr);
+    const ImageError e = compareImages(got, ref), m = compareImages(withMap, ref);
+    EXPECT_GT(e.psnr, 30.0);  // against 2 samples: the reference's own noise counts
+    EXPECT_GT(e.psnr, m.psnr - 0.25) << "stored in a map: " << m.psnr;
+    EXPECT_LT(e.coverageDiff, 0.01);
+    RecordProperty("geometry_only_psnr", std::to_string(e.psnr));
+    RecordProperty("stored_psnr", std::to_string(m.psnr));
+}
+
 TEST(MultiphaseRenderer, PrefilteredShaderMapsOnAMinifiedSurface) {
     // A high-frequency procedural ground plane towards the horizon: far texels cover many
     // cycles of the pattern. Point-sampled coarse levels alias; box-prefiltered ones (the
