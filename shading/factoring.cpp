@@ -173,6 +173,9 @@ bool staticPhaseWork(Op op) {
 std::vector<int32_t> notWorthStoring(const IrProgram& p, const std::vector<int32_t>& cut,
                                      const FactorOptions& options) {
     std::vector<std::pair<int, int32_t>> candidates;
+    // Each candidate costs a pass over the program: an n-tuple this wide is no cheap
+    // shader, and the passes stay linear in practice.
+    if (cut.size() > 256) return {};
     for (int32_t v : cut) {
         const IrProgram alone = staticPartOf(p, {v});
         const int cost = programCost(alone);
