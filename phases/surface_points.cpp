@@ -70,7 +70,8 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
         rows[ShadingBatch::P + 2][i] = P.z;
         const glm::vec3 toP = P - view.eye;
         const float len = glm::length(toP);
-        const glm::vec3 I = len > 0.0f ? toP / len : glm::normalize(d);
+        // One division, not three (divisions dominated this loop's profile).
+        const glm::vec3 I = len > 0.0f ? toP * (1.0f / len) : glm::normalize(d);
         rows[ShadingBatch::I][i] = I.x;
         rows[ShadingBatch::I + 1][i] = I.y;
         rows[ShadingBatch::I + 2][i] = I.z;
@@ -84,7 +85,10 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
             float* ny = rows[ShadingBatch::N + 1];
             float* nz = rows[ShadingBatch::N + 2];
             const float l = std::sqrt(nx[i] * nx[i] + ny[i] * ny[i] + nz[i] * nz[i]);
-            if (l > 0.0f) nx[i] /= l, ny[i] /= l, nz[i] /= l;
+            if (l > 0.0f) {
+                const float inv = 1.0f / l;
+                nx[i] *= inv, ny[i] *= inv, nz[i] *= inv;
+            }
         }
         if (useMap) {
             const ChartPoint& c0 = mesh.attributeChartPoint[a[0]];
