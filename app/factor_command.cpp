@@ -88,7 +88,7 @@ int runFactorCommand(const FactorCommandOptions& options) {
             bindingText = "object '" + object->name + "' in " + options.scene;
         }
         FactorOptions factorOptions;
-        if (options.storeAboveCost >= 0) factorOptions.storeAboveCost = options.storeAboveCost;
+        factorOptions.storeAboveCost = options.storeAboveCost;
         const FactoredShader f = factorShader(*ast, binding, factorOptions);
         const double ratio =
             f.staticInstructions > 0 ? double(f.dynamicInstructions) / f.staticInstructions : 0.0;

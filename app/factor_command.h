@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "shading/binding_time.h"
+
 namespace mpshade {
 
 struct FactorCommandOptions {
@@ -12,9 +14,9 @@ struct FactorCommandOptions {
     std::string object;  // object in the scene whose binding to use (required with scene)
     bool json = false;   // machine-readable output
     bool dump = false;   // also print the IR of both parts
-    // FactorOptions::storeAboveCost: a static part costing at most this is repeated by the
-    // dynamic part rather than stored; -1: the engine's default; 0: always store.
-    int storeAboveCost = -1;
+    // FactorOptions::storeAboveCost: stored values whose static work costs at most this
+    // (opCost units a point) are repeated by the dynamic part instead; 0: store them all.
+    int storeAboveCost = FactorOptions{}.storeAboveCost;
 };
 
 // Returns the exit code: 0 success, 2 bad input (message already on stderr).

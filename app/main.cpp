@@ -63,8 +63,9 @@ int main(int argc, char** argv) {
     factorCmd->add_flag("--dump", factor.dump, "Also print the IR of both parts");
     factorCmd
         ->add_option("--store-above-cost", factor.storeAboveCost,
-                     "Store the static part only if it costs more than this per point (cost "
-                     "units; default 64, 0: always)")
+                     "Store a static value only if its work costs more than this per point "
+                     "(cost units; 0: store every one)")
+        ->capture_default_str()
         ->check(CLI::Range(0, 1 << 30));
 
     mpshade::CompareCommandOptions compare;

@@ -167,35 +167,35 @@ bool staticPhaseWork(Op op) {
 // The channels of `cut` cheaper to repeat per shading point than to read back
 // (FactorOptions::storeAboveCost): each one's own static work (what computing it alone
 // takes) holds no staticPhaseWork() and nothing that would alias if point-sampled, and
-// together they cost at most the limit (or each adds no more
-// than cheap arithmetic to the rest). Cheapest first, so a channel that shares a lighting
-// call with others (the three of a diffuse colour) goes with them.
+// together they cost at most the limit (or each adds no more than cheap arithmetic to the
+// rest). Cheapest first, so a channel that shares a lighting call with others (the three
+// of a diffuse colour) goes with them. `cost` receives the static work they take together.
 std::vector<int32_t> notWorthStoring(const IrProgram& p, const std::vector<int32_t>& cut,
-                                     const FactorOptions& options) {
+                                     const FactorOptions& options, int& cost) {
+    cost = 0;
     std::vector<std::pair<int, int32_t>> candidates;
     // Each candidate costs a pass over the program: an n-tuple this wide is no cheap
     // shader, and the passes stay linear in practice.
     if (cut.size() > 256) return {};
     for (int32_t v : cut) {
         const IrProgram alone = staticPartOf(p, {v});
-        const int cost = programCost(alone);
-        if (cost > options.storeAboveCost) continue;
+        const int own = programCost(alone);
+        if (own > options.storeAboveCost) continue;
         bool clean = true;
         for (const Inst& inst : alone.insts)
             clean = clean && !staticPhaseWork(inst.op) && !isDiscontinuous(inst.op);
-        if (clean) candidates.emplace_back(cost, v);
+        if (clean) candidates.emplace_back(own, v);
     }
     std::stable_sort(candidates.begin(), candidates.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
     std::vector<int32_t> chosen;
-    int total = 0;
-    for (const auto& [cost, v] : candidates) {
-        chosen.push_back(v);
+    for (const auto& candidate : candidates) {
+        chosen.push_back(candidate.second);
         const int with = programCost(staticPartOf(p, chosen));
         // Within the limit, or next to free: once the dynamic part repeats the lighting, a
         // channel that is one add away from it costs that add (as the cut itself allows).
-        if (with <= options.storeAboveCost || with - total <= options.recomputeCostLimit)
-            total = with;
+        if (with <= options.storeAboveCost || with - cost <= options.recomputeCostLimit)
+            cost = with;
         else
             chosen.pop_back();
     }
@@ -261,13 +261,11 @@ FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
     f.times = analyzeBindingTimes(f.analyzed, binding, options);
 
     std::vector<int32_t> cut = chooseChannels(f.analyzed, f.times, options);
-    const std::vector<int32_t> repeated = notWorthStoring(f.analyzed, cut, options);
-    if (!repeated.empty()) {
-        f.recomputedStaticCost = programCost(staticPartOf(f.analyzed, repeated));
-        std::erase_if(cut, [&](int32_t v) {
-            return std::find(repeated.begin(), repeated.end(), v) != repeated.end();
-        });
-    }
+    const std::vector<int32_t> repeated =
+        notWorthStoring(f.analyzed, cut, options, f.recomputedStaticCost);
+    std::erase_if(cut, [&](int32_t v) {
+        return std::find(repeated.begin(), repeated.end(), v) != repeated.end();
+    });
     f.staticPart = staticPartOf(f.analyzed, cut);
     f.dynamicPart = dynamicPartOf(f.analyzed, cut);
     const std::vector<int> defining = definingInstructions(f.analyzed);

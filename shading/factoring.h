@@ -50,7 +50,7 @@ struct FactoredShader {
     int originalInstructions = 0, staticInstructions = 0, dynamicInstructions = 0;
     int originalCost = 0, staticCost = 0, dynamicCost = 0;
     // The static work left to the dynamic part because storing it would cost more than
-    // repeating it (FactorOptions::storeAboveCost); 0 when an n-tuple is stored.
+    // repeating it (FactorOptions::storeAboveCost); 0 when the cut's values are all stored.
     int recomputedStaticCost = 0;
     std::vector<DynamicLine> dynamicLines;
 };

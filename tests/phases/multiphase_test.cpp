@@ -21,6 +21,15 @@
 namespace mpshade {
 namespace {
 
+// A small frame at 2 samples, for rendering side by side with the reference.
+RenderOptions smallFrame() {
+    RenderOptions o;
+    o.width = 160;
+    o.height = 100;
+    o.samplesPerPixel = 2;
+    return o;
+}
+
 // The multi-phase machinery itself: no frame goes single-phase, however few are asked for.
 MultiphaseOptions machineryOnly() {
     MultiphaseOptions o;
@@ -372,10 +381,7 @@ TEST(MultiphaseRenderer, ExamplesMatchTheReference) {
         const Scene scene = loadScene(test::sourcePath(path));
         const ReferenceRenderer reference(scene);
         MultiphaseRenderer multi(scene, machineryOnly());
-        RenderOptions options;
-        options.width = 160;
-        options.height = 100;
-        options.samplesPerPixel = 2;
+        const RenderOptions options = smallFrame();
         RenderOptions dense = options;
         dense.samplesPerPixel = 16;
         for (int frame : {0, 5}) {
@@ -407,10 +413,7 @@ TEST(MultiphaseRenderer, ShaderMapRepresentationMatchesTheReference) {
     scene.objects[1].shadermapResolution = 256;  // the floor: one chart
     const ReferenceRenderer reference(scene);
     MultiphaseRenderer multi(scene, machineryOnly());
-    RenderOptions options;
-    options.width = 160;
-    options.height = 100;
-    options.samplesPerPixel = 2;
+    const RenderOptions options = smallFrame();
     FrameStats rs, ms;
     const Image ref = reference.renderFrame(2, options, rs);
     const Image got = multi.renderFrame(2, options, ms);
@@ -435,10 +438,7 @@ TEST(MultiphaseRenderer, StaticPartNotWorthStoringLeavesGeometryOnly) {
     while (scene.objects[teapot].name != "teapot") ++teapot;
     const ReferenceRenderer reference(scene);
     MultiphaseRenderer multi(scene, machineryOnly());
-    RenderOptions options;
-    options.width = 160;
-    options.height = 100;
-    options.samplesPerPixel = 2;
+    const RenderOptions options = smallFrame();
     FrameStats rs, ms;
     const Image ref = reference.renderFrame(3, options, rs);
     const Image got = multi.renderFrame(3, options, ms);
