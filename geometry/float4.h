@@ -3,7 +3,12 @@
 // channels. Loads and stores go through memcpy: any alignment, no aliasing questions.
 #pragma once
 
+#include <cmath>
 #include <cstring>
+
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 namespace mpshade {
 
@@ -17,6 +22,19 @@ inline Float4 loadFloat4(const float* p) {
 
 inline void storeFloat4(float* p, Float4 v) {
     std::memcpy(p, &v, sizeof v);
+}
+
+inline Float4 splatFloat4(float x) {
+    return Float4{x, x, x, x};
+}
+
+// Lane-wise square root, correctly rounded as std::sqrt is.
+inline Float4 sqrtFloat4(Float4 v) {
+#if defined(__SSE__)
+    return reinterpret_cast<Float4>(_mm_sqrt_ps(reinterpret_cast<__m128>(v)));
+#else
+    return Float4{std::sqrt(v[0]), std::sqrt(v[1]), std::sqrt(v[2]), std::sqrt(v[3])};
+#endif
 }
 
 }  // namespace mpshade

@@ -5,10 +5,10 @@
 
 #include <glm/geometric.hpp>
 
+#include "geometry/float4.h"
 #include "phases/compositing.h"
 
 namespace mpshade {
-
 size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, bool stopAtMissing,
                           const SurfacePoints& points, float* color, float* opacity,
                           uint8_t* missed, SurfaceShadingScratch& scratch,
@@ -26,17 +26,26 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
     float* rows[ShadingBatch::kInputRows];
     for (int r = 0; r < ShadingBatch::kInputRows; ++r) rows[r] = batch.row(r);
     const bool readsN = !attr.rows[VertexAttributes::Nx].empty();
-    // Per facet (consecutive points mostly share one: the samples of a pixel, the pixels of
-    // a facet): its corners and the rearranged triple products.
+    scratch.b1.resize(n), scratch.b2.resize(n);
+    if (useMap) scratch.derivatives.resize(4 * n);
+    float* __restrict bary1 = scratch.b1.data();
+    float* __restrict bary2 = scratch.b2.data();
+    float* __restrict px = rows[ShadingBatch::P];
+    float* __restrict py = rows[ShadingBatch::P + 1];
+    float* __restrict pz = rows[ShadingBatch::P + 2];
+
+    // 1. Where each point's ray meets its facet: the barycentric weights (and, for a probe,
+    //    their screen derivatives) and P. Per facet (consecutive points mostly share one:
+    //    the samples of a pixel, the pixels of a facet): its corners and the rearranged
+    //    triple products. The loops after this one have no branch on the facet and
+    //    vectorize.
     size_t facet = ~size_t{0};
-    const uint32_t* a = nullptr;
     glm::vec3 P0(0.0f), e1(0.0f), e2(0.0f), A1(0.0f), A2(0.0f), Dn(0.0f);
     float dxA1 = 0.0f, dyA1 = 0.0f, dxA2 = 0.0f, dyA2 = 0.0f, dxDn = 0.0f, dyDn = 0.0f;
     for (size_t i = 0; i < n; ++i) {
         if (points.facet[i] != facet) {
             facet = points.facet[i];
             const uint32_t* p = &mesh.positionIndex[3 * facet];
-            a = &mesh.attributeIndex[3 * facet];
             P0 = mesh.format.dequantize(mesh.qx[p[0]], mesh.qy[p[0]], mesh.qz[p[0]]);
             e1 = mesh.format.dequantize(mesh.qx[p[1]], mesh.qy[p[1]], mesh.qz[p[1]]) - P0;
             e2 = mesh.format.dequantize(mesh.qx[p[2]], mesh.qy[p[2]], mesh.qz[p[2]]) - P0;
@@ -63,53 +72,105 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
                 db2dy = (dyA2 - b2 * dyDn) * inv;
             }
         }
-        const float b0 = 1.0f - b1 - b2;
+        bary1[i] = b1, bary2[i] = b2;
         const glm::vec3 P = P0 + b1 * e1 + b2 * e2;
-        rows[ShadingBatch::P][i] = P.x;
-        rows[ShadingBatch::P + 1][i] = P.y;
-        rows[ShadingBatch::P + 2][i] = P.z;
-        const glm::vec3 toP = P - view.eye;
-        const float len = glm::length(toP);
-        // One division, not three (divisions dominated this loop's profile).
-        const glm::vec3 I = len > 0.0f ? toP * (1.0f / len) : glm::normalize(d);
-        rows[ShadingBatch::I][i] = I.x;
-        rows[ShadingBatch::I + 1][i] = I.y;
-        rows[ShadingBatch::I + 2][i] = I.z;
-        for (int row : rep.geometryRows) {
-            const std::vector<float>& r = attr.rows[static_cast<size_t>(row)];
-            rows[row < VertexAttributes::U ? row : row + 3][i] =
-                b0 * r[a[0]] + b1 * r[a[1]] + b2 * r[a[2]];
-        }
-        if (readsN) {
-            float* nx = rows[ShadingBatch::N];
-            float* ny = rows[ShadingBatch::N + 1];
-            float* nz = rows[ShadingBatch::N + 2];
-            const float l = std::sqrt(nx[i] * nx[i] + ny[i] * ny[i] + nz[i] * nz[i]);
-            if (l > 0.0f) {
-                const float inv = 1.0f / l;
-                nx[i] *= inv, ny[i] *= inv, nz[i] *= inv;
-            }
-        }
+        px[i] = P.x, py[i] = P.y, pz[i] = P.z;
         if (useMap) {
+            float* dd = &scratch.derivatives[4 * i];
+            dd[0] = db1dx, dd[1] = db1dy, dd[2] = db2dx, dd[3] = db2dy;
+        }
+    }
+
+    // 2. I, the unit direction from the eye, with one division (divisions dominated this
+    //    function's profile). A point at the eye takes its ray's direction.
+    {
+        float* __restrict ix = rows[ShadingBatch::I];
+        float* __restrict iy = rows[ShadingBatch::I + 1];
+        float* __restrict iz = rows[ShadingBatch::I + 2];
+        const float ex = view.eye.x, ey = view.eye.y, ez = view.eye.z;
+        const Float4 zero = splatFloat4(0.0f), one = splatFloat4(1.0f);
+        const Float4 ex4 = splatFloat4(ex), ey4 = splatFloat4(ey), ez4 = splatFloat4(ez);
+        size_t i = 0;
+        for (; i + 4 <= n; i += 4) {
+            const Float4 tx = loadFloat4(px + i) - ex4, ty = loadFloat4(py + i) - ey4,
+                         tz = loadFloat4(pz + i) - ez4;
+            const Float4 len2 = tx * tx + ty * ty + tz * tz;
+            const Float4 inv = one / sqrtFloat4(len2 > zero ? len2 : one);
+            storeFloat4(ix + i, tx * inv);
+            storeFloat4(iy + i, ty * inv);
+            storeFloat4(iz + i, tz * inv);
+        }
+        for (; i < n; ++i) {
+            const float tx = px[i] - ex, ty = py[i] - ey, tz = pz[i] - ez;
+            const float len2 = tx * tx + ty * ty + tz * tz;
+            const float inv = 1.0f / std::sqrt(len2 > 0.0f ? len2 : 1.0f);
+            ix[i] = tx * inv, iy[i] = ty * inv, iz[i] = tz * inv;
+        }
+        for (size_t k = 0; k < n; ++k)
+            if (!(ix[k] * ix[k] + iy[k] * iy[k] + iz[k] * iz[k] > 0.0f)) {
+                const glm::vec3 I =
+                    glm::normalize(view.d0 + points.x[k] * view.dx + points.y[k] * view.dy);
+                ix[k] = I.x, iy[k] = I.y, iz[k] = I.z;
+            }
+    }
+
+    // 3. The facet's vertex attributes at the weights, a row at a time.
+    const uint32_t* const attributeIndex = mesh.attributeIndex.data();
+    auto interpolate = [&](const float* __restrict r, float* __restrict out) {
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[i])];
+            const float b1 = bary1[i], b2 = bary2[i];
+            out[i] = (1.0f - b1 - b2) * r[a[0]] + b1 * r[a[1]] + b2 * r[a[2]];
+        }
+    };
+    for (int row : rep.geometryRows)
+        interpolate(attr.rows[static_cast<size_t>(row)].data(),
+                    rows[row < VertexAttributes::U ? row : row + 3]);
+    if (readsN) {
+        float* __restrict nx = rows[ShadingBatch::N];
+        float* __restrict ny = rows[ShadingBatch::N + 1];
+        float* __restrict nz = rows[ShadingBatch::N + 2];
+        const Float4 zero = splatFloat4(0.0f), one = splatFloat4(1.0f);
+        size_t i = 0;
+        for (; i + 4 <= n; i += 4) {
+            const Float4 x = loadFloat4(nx + i), y = loadFloat4(ny + i), z = loadFloat4(nz + i);
+            const Float4 l2 = x * x + y * y + z * z;
+            const Float4 inv = l2 > zero ? one / sqrtFloat4(l2 > zero ? l2 : one) : one;
+            storeFloat4(nx + i, x * inv);
+            storeFloat4(ny + i, y * inv);
+            storeFloat4(nz + i, z * inv);
+        }
+        for (; i < n; ++i) {
+            const float l2 = nx[i] * nx[i] + ny[i] * ny[i] + nz[i] * nz[i];
+            const float inv = l2 > 0.0f ? 1.0f / std::sqrt(l2 > 0.0f ? l2 : 1.0f) : 1.0f;
+            nx[i] *= inv, ny[i] *= inv, nz[i] *= inv;
+        }
+    }
+
+    // 4. The n-tuple: the chart point and its footprint for the probe, or the facet's.
+    if (useMap) {
+        const float s = view.footprintScale;
+        const float* __restrict dd = scratch.derivatives.data();
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[i])];
             const ChartPoint& c0 = mesh.attributeChartPoint[a[0]];
             const ChartPoint& c1 = mesh.attributeChartPoint[a[1]];
             const ChartPoint& c2 = mesh.attributeChartPoint[a[2]];
             const float du1 = c1.u - c0.u, du2 = c2.u - c0.u, dv1 = c1.v - c0.v, dv2 = c2.v - c0.v;
+            const float b1 = bary1[i], b2 = bary2[i];
+            const float* d = dd + 4 * i;
             ProbeQuery& q = scratch.queries[i];
             q.chart = c0.chart;
             q.u = c0.u + b1 * du1 + b2 * du2;
             q.v = c0.v + b1 * dv1 + b2 * dv2;
-            const float s = view.footprintScale;
-            q.dudx = s * (du1 * db1dx + du2 * db2dx);
-            q.dudy = s * (du1 * db1dy + du2 * db2dy);
-            q.dvdx = s * (dv1 * db1dx + dv2 * db2dx);
-            q.dvdy = s * (dv1 * db1dy + dv2 * db2dy);
-        } else {
-            for (size_t c = 0; c < channels; ++c) {
-                const std::vector<float>& r = attr.rows[VertexAttributes::kGeometryRows + c];
-                batch.channel(c)[i] = b0 * r[a[0]] + b1 * r[a[1]] + b2 * r[a[2]];
-            }
+            q.dudx = s * (du1 * d[0] + du2 * d[2]);
+            q.dudy = s * (du1 * d[1] + du2 * d[3]);
+            q.dvdx = s * (dv1 * d[0] + dv2 * d[2]);
+            q.dvdy = s * (dv1 * d[1] + dv2 * d[3]);
         }
+    } else {
+        for (size_t c = 0; c < channels; ++c)
+            interpolate(attr.rows[VertexAttributes::kGeometryRows + c].data(), batch.channel(c));
     }
     size_t missedCount = 0;
     if (stopAtMissing && missed) std::fill(missed, missed + n, uint8_t{0});

@@ -45,8 +45,9 @@ struct SurfaceShadingScratch {
     ShadingBatch batch;
     std::vector<ProbeQuery> queries;
     std::vector<float> probed, workspace;
-    std::vector<TileKey> lacking;  // the probes' report buffer
-    std::vector<TileKey> missing;  // lacking tiles of the calls since it was cleared
+    std::vector<float> b1, b2, derivatives;  // per point: barycentric weights; 4 derivatives
+    std::vector<TileKey> lacking;            // the probes' report buffer
+    std::vector<TileKey> missing;            // lacking tiles of the calls since it was cleared
 };
 
 struct SurfaceShadingCounters {

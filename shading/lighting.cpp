@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "geometry/float4.h"
 #include "geometry/point_cloud.h"
 #include "geometry/ray_scene.h"
 #include "shading/scalar_ops.h"
@@ -138,12 +139,78 @@ void shadeLanes(const LightSample& light, const float* const* args, float* const
     }
 }
 
+// shadeLanes for diffuse and specular, four lanes at a time in vector registers (the
+// compiler does not vectorize the loop above), with the same operations in the same order:
+// the results are bitwise those of the scalar loop, which takes the last m % 4 lanes.
+template <Op kOp, bool kPoint>
+int shadeFourLanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
+    static_assert(kOp == Op::Diffuse || kOp == Op::Specular);
+    const Float4 zero = splatFloat4(0.0f), one = splatFloat4(1.0f);
+    const Float4 lpx = splatFloat4(light.position.x), lpy = splatFloat4(light.position.y),
+                 lpz = splatFloat4(light.position.z);
+    const Float4 ccr = splatFloat4(light.color.x), ccg = splatFloat4(light.color.y),
+                 ccb = splatFloat4(light.color.z);
+    auto positive4 = [&](Float4 x) { return x > zero ? x : zero; };
+    const int whole = m & ~3;
+    for (int l = 0; l < whole; l += 4) {
+        Float4 Lx, Ly, Lz, cr, cg, cb;
+        if constexpr (kPoint) {
+            const Float4 dx = lpx - loadFloat4(args[0] + l), dy = lpy - loadFloat4(args[1] + l),
+                         dz = lpz - loadFloat4(args[2] + l);
+            const Float4 d2 = dx * dx + dy * dy + dz * dz;
+            const auto ok = d2 > zero;
+            const Float4 safe = ok ? d2 : one;
+            const Float4 root = one / sqrtFloat4(safe), recip = one / safe;
+            const Float4 inv = ok ? root : zero, fall = ok ? recip : zero;
+            Lx = dx * inv, Ly = dy * inv, Lz = dz * inv;
+            cr = ccr * fall, cg = ccg * fall, cb = ccb * fall;
+        } else {
+            Lx = splatFloat4(light.toLight.x), Ly = splatFloat4(light.toLight.y),
+            Lz = splatFloat4(light.toLight.z);
+            cr = ccr, cg = ccg, cb = ccb;
+        }
+        const Float4 nx = loadFloat4(args[3] + l), ny = loadFloat4(args[4] + l),
+                     nz = loadFloat4(args[5] + l);
+        const Float4 ndl = positive4(nx * Lx + ny * Ly + nz * Lz);
+        Float4 f;
+        if constexpr (kOp == Op::Diffuse) {
+            f = ndl;
+        } else {
+            const Float4 hx = Lx + loadFloat4(args[6] + l), hy = Ly + loadFloat4(args[7] + l),
+                         hz = Lz + loadFloat4(args[8] + l);
+            const Float4 hl = sqrtFloat4(hx * hx + hy * hy + hz * hz);
+            const auto ok = (hl > zero) & (ndl > zero);
+            const Float4 ndh = positive4((nx * hx + ny * hy + nz * hz) / (ok ? hl : one));
+            const Float4 param = loadFloat4(args[9] + l), floor = splatFloat4(0.01f);
+            const Float4 p = param > floor ? param : floor;
+            const Float4 r = one < p ? one : p;  // std::min(p, 1)
+            const Float4 a2 = r * r * r * r;
+            const Float4 denom = (one - ndh) * (one + ndh) + ndh * ndh * a2;
+            const Float4 D = a2 / (splatFloat4(kPi) * denom * denom);
+            f = ok ? D * ndl * splatFloat4(0.25f) : zero;
+        }
+        storeFloat4(rgb[0] + l, cr * f);
+        storeFloat4(rgb[1] + l, cg * f);
+        storeFloat4(rgb[2] + l, cb * f);
+    }
+    return whole;
+}
+
 template <Op kOp>
 void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
-    if (light.kind == LightKind::Point)
-        shadeLanes<kOp, true>(light, args, rgb, m);
+    const bool point = light.kind == LightKind::Point;
+    int done = 0;
+    if constexpr (kOp == Op::Diffuse || kOp == Op::Specular)
+        done = point ? shadeFourLanes<kOp, true>(light, args, rgb, m)
+                     : shadeFourLanes<kOp, false>(light, args, rgb, m);
+    if (done == m) return;
+    const float* rest[10] = {};
+    for (int k = 0; k < (kOp == Op::Diffuse ? 6 : 10); ++k) rest[k] = args[k] + done;
+    float* restRgb[3] = {rgb[0] + done, rgb[1] + done, rgb[2] + done};
+    if (point)
+        shadeLanes<kOp, true>(light, rest, restRgb, m - done);
     else
-        shadeLanes<kOp, false>(light, args, rgb, m);
+        shadeLanes<kOp, false>(light, rest, restRgb, m - done);
 }
 
 }  // namespace

@@ -169,6 +169,59 @@ TEST(Occlusion, StratifiedDirectionsCountExactlyUnderASphere) {
     EXPECT_EQ(open, 48.0f / 64.0f);
 }
 
+TEST(Lighting, EveryLaneOfARunMatchesTheOneLaneFormula) {
+    // shadeLight takes four lanes at a time in vector registers and the rest one at a time;
+    // each lane must be the one-lane formula's value, at edge inputs too: a point at the
+    // light, a normal facing away, roughness NaN, 0 and above 1, a zero normal.
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    constexpr int m = 23;  // five runs of four and three single lanes
+    LightSample point, distant;
+    point.kind = LightKind::Point;
+    point.position = glm::vec3(0.3f, 2.0f, -0.5f);
+    point.color = glm::vec3(3.0f, 2.0f, 1.0f);
+    distant.kind = LightKind::Distant;
+    distant.toLight = glm::normalize(glm::vec3(0.2f, 1.0f, 0.4f));
+    distant.color = glm::vec3(0.5f, 1.0f, 1.5f);
+    std::vector<float> in(10 * m), out(3 * m);
+    for (int l = 0; l < m; ++l) {
+        const glm::vec3 N = glm::normalize(glm::vec3(uni(rng), 1.0f, uni(rng)));
+        const glm::vec3 V = glm::normalize(glm::vec3(uni(rng), 1.0f + uni(rng), uni(rng)));
+        const glm::vec3 P(uni(rng), uni(rng), uni(rng));
+        for (int k = 0; k < 3; ++k) {
+            in[k * m + l] = P[k];
+            in[(3 + k) * m + l] = N[k];
+            in[(6 + k) * m + l] = V[k];
+        }
+        in[9 * m + l] = 0.05f + 0.9f * (0.5f + 0.5f * uni(rng));
+    }
+    for (int k = 0; k < 3; ++k) in[k * m + 2] = point.position[k];           // at the light
+    for (int k = 0; k < 3; ++k) in[(3 + k) * m + 5] = -in[(3 + k) * m + 5];  // facing away
+    for (int k = 0; k < 3; ++k) in[(3 + k) * m + 21] = 0.0f;  // zero normal, in the tail
+    in[9 * m + 1] = std::nanf("");
+    in[9 * m + 6] = 0.0f;
+    in[9 * m + 9] = 3.0f;
+    const float* args[10];
+    for (int k = 0; k < 10; ++k) args[k] = &in[static_cast<size_t>(k) * m];
+    float* rgb[3] = {&out[0], &out[m], &out[2 * m]};
+    for (const LightSample& light : {point, distant})
+        for (Op op : {Op::Diffuse, Op::Specular}) {
+            shadeLight(op, light, args, rgb, m);
+            for (int l = 0; l < m; ++l) {
+                const auto at = [&](int row) {
+                    return glm::vec3(in[row * m + l], in[(row + 1) * m + l], in[(row + 2) * m + l]);
+                };
+                const glm::vec3 want = shadeLightOne(op, light, at(0), at(3), at(6), in[9 * m + l]);
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_TRUE(std::isfinite(out[k * m + l])) << "lane " << l;
+                    ASSERT_NEAR(out[k * m + l], want[k], 1e-5f * (1.0f + std::fabs(want[k])))
+                        << "lane " << l << " channel " << k << " op " << static_cast<int>(op)
+                        << (light.kind == LightKind::Point ? " point" : " distant");
+                }
+            }
+        }
+}
+
 TEST(Lighting, GgxRoughnessIsFlooredAtAHundredth) {
     // docs/shading-language.md: roughness is clamped to [0.01, 1]. At the mirror
     // direction (H = N) D = 1 / (pi alpha^2), alpha = r^2: a roughness of 0.001 must give
