@@ -100,39 +100,45 @@ void setUp(const ScreenTriangle& tri, int64_t ox, int64_t oy, Setup& s) {
     }
 }
 
-// One row of samples against one facet, single layer: a depth test where the sample is
-// inside. Returns the samples inside. The hot loop of the rasterizer: plain arithmetic on
-// doubles that GCC vectorizes, compiled for AVX2 and for the baseline, chosen at run time.
-__attribute__((target_clones("avx2", "default"))) uint32_t rowDepthTest(
-    const int32_t* fx, const int32_t* fy, size_t n, int32_t ox, int32_t oy, const Setup& s,
-    bool edges, float* inv, uint32_t* object, uint32_t* facet, uint32_t o, uint32_t f) {
+// Rows of samples against one facet, single layer: a depth test where the sample is
+// inside. `rows` runs of n samples, `stride` apart in every array. Returns the samples
+// inside. The hot loop of the rasterizer: plain arithmetic on doubles that GCC vectorizes,
+// compiled for AVX2 and for the baseline, chosen at run time; one call per facet and tile,
+// since facets a few pixels across made the call per row cost as much as its work.
+__attribute__((target_clones("avx2", "default"))) uint32_t boxDepthTest(
+    const int32_t* fx, const int32_t* fy, size_t rows, size_t n, size_t stride, int32_t ox,
+    int32_t oy, const Setup& s, bool edges, float* inv, uint32_t* object, uint32_t* facet,
+    uint32_t o, uint32_t f) {
     const double c0 = s.c[0], c1 = s.c[1], c2 = s.c[2];
     const double a0 = s.a[0], a1 = s.a[1], a2 = s.a[2];
     const double b0 = s.b[0], b1 = s.b[1], b2 = s.b[2];
     const double zc = s.zc, zx = s.zx, zy = s.zy;
     uint32_t inside = 0;
-    if (edges) {
-        for (size_t i = 0; i < n; ++i) {
-            const double lx = fx[i] - ox, ly = fy[i] - oy;
-            const bool in = (c0 + a0 * lx + b0 * ly > 0.0) & (c1 + a1 * lx + b1 * ly > 0.0) &
-                            (c2 + a2 * lx + b2 * ly > 0.0);
-            const float z = static_cast<float>(zc + zx * lx + zy * ly);
-            const bool hit = in & (z > inv[i]);
-            inside += in;
-            inv[i] = hit ? z : inv[i];
-            object[i] = hit ? o : object[i];
-            facet[i] = hit ? f : facet[i];
+    for (size_t r = 0; r < rows;
+         ++r, fx += stride, fy += stride, inv += stride, object += stride, facet += stride) {
+        if (edges) {
+            for (size_t i = 0; i < n; ++i) {
+                const double lx = fx[i] - ox, ly = fy[i] - oy;
+                const bool in = (c0 + a0 * lx + b0 * ly > 0.0) & (c1 + a1 * lx + b1 * ly > 0.0) &
+                                (c2 + a2 * lx + b2 * ly > 0.0);
+                const float z = static_cast<float>(zc + zx * lx + zy * ly);
+                const bool hit = in & (z > inv[i]);
+                inside += in;
+                inv[i] = hit ? z : inv[i];
+                object[i] = hit ? o : object[i];
+                facet[i] = hit ? f : facet[i];
+            }
+        } else {
+            for (size_t i = 0; i < n; ++i) {
+                const double lx = fx[i] - ox, ly = fy[i] - oy;
+                const float z = static_cast<float>(zc + zx * lx + zy * ly);
+                const bool hit = z > inv[i];
+                inv[i] = hit ? z : inv[i];
+                object[i] = hit ? o : object[i];
+                facet[i] = hit ? f : facet[i];
+            }
+            inside += static_cast<uint32_t>(n);
         }
-    } else {
-        for (size_t i = 0; i < n; ++i) {
-            const double lx = fx[i] - ox, ly = fy[i] - oy;
-            const float z = static_cast<float>(zc + zx * lx + zy * ly);
-            const bool hit = z > inv[i];
-            inv[i] = hit ? z : inv[i];
-            object[i] = hit ? o : object[i];
-            facet[i] = hit ? f : facet[i];
-        }
-        inside = static_cast<uint32_t>(n);
     }
     return inside;
 }
@@ -346,7 +352,19 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
         const int tx1 = std::min(width, tx0 + tile) - 1, ty1 = std::min(height, ty0 + tile) - 1;
         const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
         const size_t rowSamples = static_cast<size_t>(tw) * spp;
-        scratch.prepare(rowSamples * th, layers, farInv);
+        // One layer: straight into the frame's buffer (a tile's row of samples is
+        // contiguous there); several: a tile-local k-buffer, copied out at the end.
+        const bool direct = layers == 1;
+        if (direct) {
+            for (int py = ty0; py <= ty1; ++py) {
+                const size_t g = samples.index(tx0, py, 0);
+                std::fill_n(&out.invDepth[g], rowSamples, farInv);
+                std::fill_n(&out.object[g], rowSamples, 0u);
+                std::fill_n(&out.facet[g], rowSamples, 0u);
+            }
+        } else {
+            scratch.prepare(rowSamples * th, layers, farInv);
+        }
         const int32_t ox = tx0 << kSub, oy = ty0 << kSub;
         const double cornerX[2] = {0.0, static_cast<double>(tw << kSub)};
         const double cornerY[2] = {0.0, static_cast<double>(th << kSub)};
@@ -385,17 +403,20 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
                               maxY = std::max({tri.y[0], tri.y[1], tri.y[2]});
                 const int bx0 = std::max(tx0, minX >> kSub), by0 = std::max(ty0, minY >> kSub);
                 const int bx1 = std::min(tx1, maxX >> kSub), by1 = std::min(ty1, maxY >> kSub);
+                if (direct) {
+                    const size_t g = samples.index(bx0, by0, 0);
+                    s.fragments += boxDepthTest(fx + g, fy + g, static_cast<size_t>(by1 - by0 + 1),
+                                                static_cast<size_t>(bx1 - bx0 + 1) * spp,
+                                                static_cast<size_t>(width) * spp, ox, oy, su,
+                                                !whole, &out.invDepth[g], &out.object[g],
+                                                &out.facet[g], c.object, item.facet);
+                    continue;
+                }
                 for (int py = by0; py <= by1; ++py) {
                     const size_t g = samples.index(bx0, py, 0);
                     const size_t n = static_cast<size_t>(bx1 - bx0 + 1) * spp;
                     const size_t l = static_cast<size_t>(py - ty0) * rowSamples +
                                      static_cast<size_t>(bx0 - tx0) * spp;
-                    if (layers == 1) {
-                        s.fragments += rowDepthTest(fx + g, fy + g, n, ox, oy, su, !whole,
-                                                    &scratch.inv[l], &scratch.object[l],
-                                                    &scratch.facet[l], c.object, item.facet);
-                        continue;
-                    }
                     for (size_t i = 0; i < n; ++i) {
                         const double lx = fx[g + i] - ox, ly = fy[g + i] - oy;
                         bool in = true;
@@ -414,18 +435,19 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
         // Out to the frame's buffer, row by row.
         for (int py = ty0; py <= ty1; ++py) {
             const size_t g = samples.index(tx0, py, 0);
+            if (direct) {
+                const float* __restrict inv = &out.invDepth[g];
+                uint8_t* __restrict count = &out.count[g];
+                for (size_t i = 0; i < rowSamples; ++i) count[i] = inv[i] > farInv ? 1 : 0;
+                continue;
+            }
             const size_t l = static_cast<size_t>(py - ty0) * rowSamples;
             const size_t gl = g * static_cast<size_t>(layers), ll = l * static_cast<size_t>(layers);
             const size_t nl = rowSamples * static_cast<size_t>(layers);
             std::copy_n(&scratch.inv[ll], nl, &out.invDepth[gl]);
             std::copy_n(&scratch.object[ll], nl, &out.object[gl]);
             std::copy_n(&scratch.facet[ll], nl, &out.facet[gl]);
-            if (layers == 1) {
-                for (size_t i = 0; i < rowSamples; ++i)
-                    out.count[g + i] = scratch.inv[l + i] > farInv ? 1 : 0;
-            } else {
-                std::copy_n(&scratch.count[l], rowSamples, &out.count[g]);
-            }
+            std::copy_n(&scratch.count[l], rowSamples, &out.count[g]);
         }
     });
     stats = RasterStats{};
