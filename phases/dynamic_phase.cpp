@@ -78,11 +78,16 @@ struct DynamicPhase::Band {
         std::vector<float> x, y;              // per shading point, pixels
         std::vector<uint32_t> fragmentPoint;  // per visibility slot of the band
         std::vector<float> color, opacity;    // 3 per shading point
-        std::vector<uint32_t> pending;        // points still to shade
+        // Points are grouped by object: object o's are [objectStart[o], objectStart[o + 1]).
+        std::vector<uint32_t> objectStart;
+        bool fresh = false;             // no point shaded yet: every point is pending
+        std::vector<uint32_t> pending;  // otherwise, the points still to shade
     };
     struct Scratch {
         State work;  // the band being shaded, unless it has a state of its own
-        std::vector<uint32_t> order, objectStart, cursor, stillPending;
+        std::vector<uint32_t> cursor, stillPending, permutation;
+        std::vector<uint32_t> unsortedObject, unsortedFacet;
+        std::vector<float> unsortedX, unsortedY;
         std::vector<uint32_t> batchFacet;
         std::vector<float> batchX, batchY, batchColor, batchOpacity;
         std::vector<uint8_t> batchMissed;
@@ -246,24 +251,41 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     const size_t firstSlot = firstSample * static_cast<size_t>(layers);
 
     // 1. Shading points, once per frame.
+    const size_t objects = objects_.size();
     if (!st.built) {
-        st.object.clear(), st.facet.clear(), st.x.clear(), st.y.clear();
         st.fragmentPoint.resize((endSample - firstSample) * static_cast<size_t>(layers));
-        auto addPoint = [&](uint32_t o, uint32_t f, float x, float y) {
-            st.object.push_back(o);
-            st.facet.push_back(f);
-            st.x.push_back(x);
-            st.y.push_back(y);
-            return static_cast<uint32_t>(st.object.size() - 1);
-        };
+        st.objectStart.assign(objects + 1, 0);
         if (options_.shadingRate == ShadingRate::Sample) {
+            // A point per fragment, placed by object as it is made (a counting sort).
+            for (size_t smp = firstSample; smp < endSample; ++smp)
+                for (int l = 0; l < vis.count[smp]; ++l)
+                    ++st.objectStart[vis.object[smp * layers + l] + 1];
+            for (size_t o = 0; o < objects; ++o) st.objectStart[o + 1] += st.objectStart[o];
+            const size_t points = st.objectStart[objects];
+            st.object.resize(points), st.facet.resize(points);
+            st.x.resize(points), st.y.resize(points);
+            s.cursor.assign(st.objectStart.begin(), st.objectStart.end() - 1);
             for (size_t smp = firstSample; smp < endSample; ++smp)
                 for (int l = 0; l < vis.count[smp]; ++l) {
                     const size_t slot = smp * layers + l;
-                    st.fragmentPoint[slot - firstSlot] =
-                        addPoint(vis.object[slot], vis.facet[slot], layout.x(smp), layout.y(smp));
+                    const uint32_t o = vis.object[slot];
+                    const uint32_t at = s.cursor[o]++;
+                    st.object[at] = o;
+                    st.facet[at] = vis.facet[slot];
+                    st.x[at] = layout.x(smp);
+                    st.y[at] = layout.y(smp);
+                    st.fragmentPoint[slot - firstSlot] = at;
                 }
         } else {
+            s.unsortedObject.clear(), s.unsortedFacet.clear();
+            s.unsortedX.clear(), s.unsortedY.clear();
+            auto addPoint = [&](uint32_t o, uint32_t f, float x, float y) {
+                s.unsortedObject.push_back(o);
+                s.unsortedFacet.push_back(f);
+                s.unsortedX.push_back(x);
+                s.unsortedY.push_back(y);
+                return static_cast<uint32_t>(s.unsortedObject.size() - 1);
+            };
             struct Group {
                 uint32_t object;
                 int layer;
@@ -318,57 +340,41 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
                             st.fragmentPoint[(first + k) * layers + l - firstSlot] =
                                 pointOf[member[k * layers + l]];
                 }
+            // Grouped by object (a counting sort), the fragments following their points.
+            const size_t points = s.unsortedObject.size();
+            for (uint32_t o : s.unsortedObject) ++st.objectStart[o + 1];
+            for (size_t o = 0; o < objects; ++o) st.objectStart[o + 1] += st.objectStart[o];
+            st.object.resize(points), st.facet.resize(points);
+            st.x.resize(points), st.y.resize(points);
+            s.cursor.assign(st.objectStart.begin(), st.objectStart.end() - 1);
+            s.permutation.resize(points);
+            for (size_t p = 0; p < points; ++p) {
+                const uint32_t at = s.cursor[s.unsortedObject[p]]++;
+                s.permutation[p] = at;
+                st.object[at] = s.unsortedObject[p];
+                st.facet[at] = s.unsortedFacet[p];
+                st.x[at] = s.unsortedX[p];
+                st.y[at] = s.unsortedY[p];
+            }
+            for (size_t smp = firstSample; smp < endSample; ++smp)
+                for (int l = 0; l < vis.count[smp]; ++l) {
+                    uint32_t& point = st.fragmentPoint[smp * layers + l - firstSlot];
+                    point = s.permutation[point];
+                }
         }
         const size_t points = st.object.size();
         st.color.resize(3 * points);
         st.opacity.resize(3 * points);
-        st.pending.resize(points);
-        for (uint32_t p = 0; p < points; ++p) st.pending[p] = p;
+        st.pending.clear();
+        st.fresh = true;
         st.built = true;
     }
 
-    // 2. The pending points by object (counting sort), each object's in batches; those
-    //    whose probes lacked tiles stay pending.
-    const size_t objects = objects_.size();
-    s.objectStart.assign(objects + 1, 0);
-    for (uint32_t p : st.pending) ++s.objectStart[st.object[p] + 1];
-    for (size_t o = 0; o < objects; ++o) s.objectStart[o + 1] += s.objectStart[o];
-    s.order.resize(st.pending.size());
-    s.cursor.assign(s.objectStart.begin(), s.objectStart.end() - 1);
-    for (uint32_t p : st.pending) s.order[s.cursor[st.object[p]]++] = p;
-    s.batchFacet.resize(kBatch);
-    s.batchX.resize(kBatch), s.batchY.resize(kBatch);
-    s.batchColor.resize(3 * kBatch), s.batchOpacity.resize(3 * kBatch);
+    // 2. Each object's points in batches; those whose probes lacked tiles stay pending.
+    //    The first time, every point: the batches are runs of the band's own arrays.
     s.batchMissed.resize(kBatch);
     s.stillPending.clear();
-    for (size_t o = 0; o < objects; ++o) {
-        if (s.objectStart[o + 1] == s.objectStart[o]) continue;
-        SurfaceShadingCounters counters;
-        s.surface.missing.clear();
-        for (size_t b = s.objectStart[o]; b < s.objectStart[o + 1]; b += kBatch) {
-            const size_t m = std::min(kBatch, s.objectStart[o + 1] - b);
-            for (size_t i = 0; i < m; ++i) {
-                const uint32_t p = s.order[b + i];
-                s.batchFacet[i] = st.facet[p];
-                s.batchX[i] = st.x[p];
-                s.batchY[i] = st.y[p];
-            }
-            const SurfacePoints batch{s.batchFacet.data(), s.batchX.data(), s.batchY.data(), m};
-            const size_t missed = shadeSurfacePoints(
-                views_[o], options_.probe, !acceptFallbacks, batch, s.batchColor.data(),
-                s.batchOpacity.data(), s.batchMissed.data(), s.surface, counters);
-            for (size_t i = 0; i < m; ++i) {
-                const uint32_t p = s.order[b + i];
-                if (missed > 0 && s.batchMissed[i]) {
-                    s.stillPending.push_back(p);
-                    continue;
-                }
-                for (int k = 0; k < 3; ++k) {
-                    st.color[3 * p + k] = s.batchColor[3 * i + k];
-                    st.opacity[3 * p + k] = s.batchOpacity[3 * i + k];
-                }
-            }
-        }
+    auto addObjectCosts = [&](size_t o, const SurfaceShadingCounters& counters) {
         for (const TileKey& key : s.surface.missing)
             lacking.push_back({static_cast<uint32_t>(o), key});
         ObjectFrameCost& cost = s.costs[o];
@@ -376,6 +382,70 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
         cost.probeFallbacks += counters.fallbacks;
         s.counters.instructions += counters.instructions;
         s.counters.nonFinite += counters.nonFinite;
+    };
+    // After a fill, the points still pending (in order, so grouped by object), gathered
+    // into batches and their results scattered back.
+    auto shadePending = [&] {
+        s.batchFacet.resize(kBatch);
+        s.batchX.resize(kBatch), s.batchY.resize(kBatch);
+        s.batchColor.resize(3 * kBatch), s.batchOpacity.resize(3 * kBatch);
+        size_t first = 0;
+        while (first < st.pending.size()) {
+            const uint32_t o = st.object[st.pending[first]];
+            size_t last = first;
+            while (last < st.pending.size() && st.object[st.pending[last]] == o) ++last;
+            SurfaceShadingCounters counters;
+            s.surface.missing.clear();
+            for (size_t b = first; b < last; b += kBatch) {
+                const size_t m = std::min(kBatch, last - b);
+                for (size_t i = 0; i < m; ++i) {
+                    const uint32_t p = st.pending[b + i];
+                    s.batchFacet[i] = st.facet[p];
+                    s.batchX[i] = st.x[p];
+                    s.batchY[i] = st.y[p];
+                }
+                const SurfacePoints batch{s.batchFacet.data(), s.batchX.data(), s.batchY.data(), m};
+                const size_t missed = shadeSurfacePoints(
+                    views_[o], options_.probe, !acceptFallbacks, batch, s.batchColor.data(),
+                    s.batchOpacity.data(), s.batchMissed.data(), s.surface, counters);
+                for (size_t i = 0; i < m; ++i) {
+                    const uint32_t p = st.pending[b + i];
+                    if (missed > 0 && s.batchMissed[i]) {
+                        s.stillPending.push_back(p);
+                        continue;
+                    }
+                    for (int k = 0; k < 3; ++k) {
+                        st.color[3 * p + k] = s.batchColor[3 * i + k];
+                        st.opacity[3 * p + k] = s.batchOpacity[3 * i + k];
+                    }
+                }
+            }
+            addObjectCosts(o, counters);
+            first = last;
+        }
+    };
+    if (st.fresh) {
+        for (size_t o = 0; o < objects; ++o) {
+            const size_t begin = st.objectStart[o], end = st.objectStart[o + 1];
+            if (begin == end) continue;
+            SurfaceShadingCounters counters;
+            s.surface.missing.clear();
+            for (size_t b = begin; b < end; b += kBatch) {
+                const size_t m = std::min(kBatch, end - b);
+                const SurfacePoints batch{&st.facet[b], &st.x[b], &st.y[b], m};
+                const size_t missed = shadeSurfacePoints(
+                    views_[o], options_.probe, !acceptFallbacks, batch, &st.color[3 * b],
+                    &st.opacity[3 * b], s.batchMissed.data(), s.surface, counters);
+                if (missed > 0)
+                    for (size_t i = 0; i < m; ++i)
+                        if (s.batchMissed[i])
+                            s.stillPending.push_back(static_cast<uint32_t>(b + i));
+            }
+            addObjectCosts(o, counters);
+        }
+        st.fresh = false;
+    } else {
+        shadePending();
     }
     st.pending.swap(s.stillPending);
     if (!st.pending.empty()) {
@@ -402,7 +472,8 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
             same = std::memcmp(first, first + 4 * k, 4 * sizeof(float)) == 0;
         uniform_[pixel] = same ? 1 : 0;
     }
-    for (uint32_t o : st.object) ++s.costs[o].shadingPoints;
+    for (size_t o = 0; o < objects; ++o)
+        s.costs[o].shadingPoints += st.objectStart[o + 1] - st.objectStart[o];
     st.built = false;
     if (&st != &s.work) std::swap(s.work, st);  // its buffers go back to the thread
     bandDone_[band] = 1;
