@@ -359,8 +359,6 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
             for (int py = ty0; py <= ty1; ++py) {
                 const size_t g = samples.index(tx0, py, 0);
                 std::fill_n(&out.invDepth[g], rowSamples, farInv);
-                std::fill_n(&out.object[g], rowSamples, 0u);
-                std::fill_n(&out.facet[g], rowSamples, 0u);
             }
         } else {
             scratch.prepare(rowSamples * th, layers, farInv);

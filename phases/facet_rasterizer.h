@@ -50,7 +50,8 @@ struct RasterObject {
 struct VisibilityBuffer {
     int width = 0, height = 0, spp = 1, layers = 1;
     std::vector<uint8_t> count;  // surfaces kept per sample
-    // `layers` slots per sample: slot sample * layers + l.
+    // `layers` slots per sample: slot sample * layers + l. Only a sample's first count[s]
+    // slots hold surfaces; the others' values are unspecified.
     std::vector<float> invDepth;  // 1 / view depth (world units)
     std::vector<uint32_t> object, facet;
     void resize(int w, int h, int samplesPerPixel, int k);
