@@ -133,6 +133,8 @@ void DynamicPhase::begin(const FrameState& frame,
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
         const ObjectRepresentation* rep = objects_[i];
         if (!rep) return;
+        const ScopedSpan task(options.trace, "warp object", PhaseKind::Dynamic,
+                              static_cast<int64_t>(i), frame.index);
         const ObjectState& state = frame.objects[i];
         const FacetMesh& mesh = rep->mesh;
         warps_[i] = std::make_unique<FixedPointWarp>(state.objectToWorld, camera, mesh.format);
@@ -161,6 +163,8 @@ void DynamicPhase::begin(const FrameState& frame,
             stats_.facetBytes += objects_[i]->bytes();
         }
     stats_.warpSeconds = secondsSince(start);
+    if (options.trace)
+        options.trace->span("warp", PhaseKind::Dynamic, start, Clock::now(), -1, frame.index);
 
     start = Clock::now();
     std::vector<RasterObject> raster(n);
@@ -178,6 +182,8 @@ void DynamicPhase::begin(const FrameState& frame,
     rasterizer_.rasterize(raster, *layout_, camera.zFar, options.raster, visibility_,
                           stats_.raster);
     stats_.rasterSeconds = secondsSince(start);
+    if (options.trace)
+        options.trace->span("rasterize", PhaseKind::Dynamic, start, Clock::now(), -1, frame.index);
     if (samples_.layout != layout_) {
         samples_.reset(layout_);
         uniform_.assign(static_cast<size_t>(layout_->width()) * layout_->height(), 0);
@@ -195,10 +201,13 @@ bool DynamicPhase::complete() const {
 
 std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
     const auto start = Clock::now();
+    const ScopedSpan span(options_.trace, "shade", PhaseKind::Dynamic, -1, frame_->index);
     ++stats_.shadePasses;
     tbb::enumerable_thread_specific<std::vector<TileRequest>> lacking;
     tbb::parallel_for(size_t{0}, bandDone_.size(), [&](size_t b) {
-        if (!bandDone_[b]) shadeBand(b, acceptFallbacks, lacking.local());
+        if (bandDone_[b]) return;
+        const ScopedSpan task(options_.trace, "band", PhaseKind::Dynamic, -1, frame_->index);
+        shadeBand(b, acceptFallbacks, lacking.local());
     });
     std::vector<TileRequest> all;
     for (const std::vector<TileRequest>& l : lacking) all.insert(all.end(), l.begin(), l.end());
@@ -216,6 +225,8 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
         for (Band::Scratch& s : scratch_->scratch) {
             for (size_t i = 0; i < costs_.size() && i < s.costs.size(); ++i) {
                 costs_[i].shadingPoints += s.costs[i].shadingPoints;
+                costs_[i].instructions += s.costs[i].instructions;
+                costs_[i].shadeSeconds += s.costs[i].shadeSeconds;
                 costs_[i].probes += s.costs[i].probes;
                 costs_[i].probeFallbacks += s.costs[i].probeFallbacks;
                 s.costs[i] = ObjectFrameCost{};
@@ -374,10 +385,13 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     //    The first time, every point: the batches are runs of the band's own arrays.
     s.batchMissed.resize(kBatch);
     s.stillPending.clear();
-    auto addObjectCosts = [&](size_t o, const SurfaceShadingCounters& counters) {
+    auto addObjectCosts = [&](size_t o, const SurfaceShadingCounters& counters,
+                              Clock::time_point began) {
         for (const TileKey& key : s.surface.missing)
             lacking.push_back({static_cast<uint32_t>(o), key});
         ObjectFrameCost& cost = s.costs[o];
+        cost.shadeSeconds += secondsSince(began);
+        cost.instructions += counters.instructions;
         cost.probes += counters.probes;
         cost.probeFallbacks += counters.fallbacks;
         s.counters.instructions += counters.instructions;
@@ -394,6 +408,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
             const uint32_t o = st.object[st.pending[first]];
             size_t last = first;
             while (last < st.pending.size() && st.object[st.pending[last]] == o) ++last;
+            const auto began = Clock::now();
             SurfaceShadingCounters counters;
             s.surface.missing.clear();
             for (size_t b = first; b < last; b += kBatch) {
@@ -420,7 +435,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
                     }
                 }
             }
-            addObjectCosts(o, counters);
+            addObjectCosts(o, counters, began);
             first = last;
         }
     };
@@ -428,6 +443,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
         for (size_t o = 0; o < objects; ++o) {
             const size_t begin = st.objectStart[o], end = st.objectStart[o + 1];
             if (begin == end) continue;
+            const auto began = Clock::now();
             SurfaceShadingCounters counters;
             s.surface.missing.clear();
             for (size_t b = begin; b < end; b += kBatch) {
@@ -441,7 +457,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
                         if (s.batchMissed[i])
                             s.stillPending.push_back(static_cast<uint32_t>(b + i));
             }
-            addObjectCosts(o, counters);
+            addObjectCosts(o, counters, began);
         }
         st.fresh = false;
     } else {
@@ -481,6 +497,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
 
 void DynamicPhase::resolve(Image& out) {
     const auto start = Clock::now();
+    const ScopedSpan span(options_.trace, "resolve", PhaseKind::Resolve, -1, frame_->index);
     layout_->resolve(samples_.rgba.data(), uniform_.data(), out);
     stats_.resolveSeconds = secondsSince(start);
 }

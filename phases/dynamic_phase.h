@@ -25,6 +25,7 @@
 
 #include "phases/facet_rasterizer.h"
 #include "phases/object_representation.h"
+#include "phases/phase_trace.h"
 #include "phases/sample_pattern.h"
 #include "phases/scene_resources.h"
 #include "phases/surface_points.h"
@@ -46,6 +47,9 @@ struct DynamicOptions {
     // stratum), or half a pixel per pixel.
     float footprintScale = 1.0f;
     int bandRows = 4;  // pixel rows per unit of shading work
+    // Where the warp, rasterization, shading bands and resolve report their spans (not
+    // owned; null: nowhere).
+    PhaseTrace* trace = nullptr;
 };
 
 // What one object cost this frame.
@@ -54,6 +58,8 @@ struct ObjectFrameCost {
     uint64_t facets = 0;  // in its representation
     uint64_t verticesWarped = 0;
     uint64_t shadingPoints = 0;  // runs of the dynamic shader
+    uint64_t instructions = 0;   // dynamic shader instructions, times lanes
+    double shadeSeconds = 0.0;   // probing and shading its points, summed over threads
     uint64_t probes = 0, probeFallbacks = 0;
     uint64_t tilesLacked = 0;  // distinct tiles its probes asked for that were not resident
     // Combined representation: the longest projected facet edge among its visible

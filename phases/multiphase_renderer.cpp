@@ -43,6 +43,7 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
       resources_(scene, SceneResources::RayScenes::ForOcclusion),
       static_(scene, resources_, options.staticPhase),
       dynamic_(scene) {
+    options_.dynamic.trace = options.trace;
     const size_t n = scene.objects.size();
     representations_.resize(n);
     kinds_.assign(n, Representation::Auto);
@@ -241,6 +242,8 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     stats = FrameStats{};
     frame_ =
         frameStateAt(resources_, frame, options.width, options.height, options.samplesPerPixel);
+    frameStaticSeconds_.assign(scene_.objects.size(), 0.0);
+    frameDynamic_.assign(scene_.objects.size(), ObjectFrameCost{});
     const CameraState& camera = frame_.camera;
     if (!layout_ ||
         !layout_->matches(frame_.width, frame_.height, frame_.spp, options.seed, options.filter))
@@ -302,14 +305,19 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     }
     if (singlePhaseFrame_) {
         if (!reference_) reference_ = std::make_unique<ReferenceRenderer>(scene_);
+        const ScopedSpan span(options_.trace, "single-phase frame", PhaseKind::Reference, -1,
+                              frame);
         singlePhaseSamples_ = reference_->renderSamples(frame, options, stats, progress);
         stats.singlePhase = true;
         stats.wallSeconds = secondsSince(start);
         return;
     }
     std::vector<StaticCosts> costs(stale.size());
+    const auto buildStart = Clock::now();
     tbb::parallel_for(size_t{0}, stale.size(), [&](size_t k) {
         const size_t i = stale[k];
+        const ScopedSpan task(options_.trace, "build", PhaseKind::Static, static_cast<int64_t>(i),
+                              frame);
         representations_[i] =
             static_.build(i, kinds_[i], frame_.objects[i], camera, frame_.uniforms[i],
                           representations_[i].get(), costs[k]);
@@ -321,6 +329,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         ++r.staticRuns;
         r.staticCosts.runs += costs[k].runs;
         r.staticCosts.seconds += costs[k].seconds;
+        frameStaticSeconds_[stale[k]] += costs[k].seconds;
         r.staticCosts.instructions += costs[k].instructions;
         r.staticCosts.programRuns += costs[k].programRuns;
         r.staticCosts.tilesFilled += costs[k].tilesFilled;
@@ -331,6 +340,9 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     }
     stats.staticRuns = static_cast<int>(stale.size());
     stats.staticSeconds = secondsSince(staticStart);
+    if (options_.trace && !stale.empty())
+        options_.trace->span("static phase", PhaseKind::Static, buildStart, Clock::now(), -1,
+                             frame);
     if (progress) progress(1, 4);
 
     // 3. The dynamic phase; lacking tiles filled between shading passes.
@@ -343,6 +355,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     dynamic_.begin(frame_, drawn, layout_, dynamicOptions);
     if (progress) progress(2, 4);
     StaticCosts fills;
+    FillTiming fillTiming{options_.trace, frame, {}};
     for (int pass = 0;; ++pass) {
         const bool last = pass >= 6;  // a safety net: each pass fills what the last lacked
         const std::vector<TileRequest> lacking = dynamic_.shade(last);
@@ -353,8 +366,10 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         size_t incoming = 0;
         for (const TileRequest& r : lacking) incoming += drawn[r.object]->map->tileBytes();
         keepMapsInBudget(incoming, stats);
-        static_.fill(lacking, drawn, fills);
+        static_.fill(lacking, drawn, fills, &fillTiming);
         stats.fillSeconds += secondsSince(fillStart);
+        if (options_.trace)
+            options_.trace->span("fill", PhaseKind::Static, fillStart, Clock::now(), -1, frame);
         for (const TileRequest& r : lacking) ++reports_[r.object].staticCosts.tilesFilled;
     }
     stats.staticSeconds += stats.fillSeconds;
@@ -364,8 +379,13 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     stats.texelsFilled += fills.texelsFilled;
     if (progress) progress(3, 4);
 
+    for (size_t i = 0; i < fillTiming.objectSeconds.size(); ++i) {
+        frameStaticSeconds_[i] += fillTiming.objectSeconds[i];
+        reports_[i].staticCosts.seconds += fillTiming.objectSeconds[i];
+    }
     const DynamicFrameStats& d = dynamic_.stats();
     const std::vector<ObjectFrameCost>& objectCosts = dynamic_.objectCosts();
+    frameDynamic_ = objectCosts;
     for (size_t i = 0; i < n; ++i) {
         if (!drawn[i]) continue;
         longestEdge_[i] = objectCosts[i].longestEdgePixels;
@@ -435,6 +455,7 @@ void MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
 Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
                                       const ProgressFn& progress) {
     const auto start = Clock::now();
+    const ScopedSpan span(options_.trace, "frame", PhaseKind::Frame, -1, frame);
     render(frame, options, stats, progress);
     if (singlePhaseFrame_) {
         Image image;

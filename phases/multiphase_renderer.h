@@ -57,6 +57,9 @@ struct MultiphaseOptions {
     // renderer instead, and nothing is built (a camera cut every frame, a short request).
     // Off: every frame is multi-phase.
     bool singlePhaseFrames = true;
+    // Where every phase reports its spans (phase_trace.h; not owned, must outlive the
+    // renderer). Null: nowhere, and nothing is measured for it.
+    PhaseTrace* trace = nullptr;
 };
 
 // Per object, for stats.json: what the static phase chose and did.
@@ -100,6 +103,11 @@ class MultiphaseRenderer {
     const FactoredShader& factored(size_t object) const;
     const ObjectReport& report(size_t object) const { return reports_[object]; }
     size_t objectCount() const { return reports_.size(); }
+    // Per object, what the last frame cost: its static work (building, filling tiles), in
+    // seconds summed over threads; and its dynamic work (not drawn: all zero; a frame
+    // rendered single-phase has none).
+    const std::vector<double>& lastFrameStaticSeconds() const { return frameStaticSeconds_; }
+    const std::vector<ObjectFrameCost>& lastFrameDynamicCosts() const { return frameDynamic_; }
 
   private:
     void render(int frame, const RenderOptions& options, FrameStats& stats,
@@ -142,6 +150,8 @@ class MultiphaseRenderer {
     std::unique_ptr<ReferenceRenderer> reference_;  // made at the first single-phase frame
     bool singlePhaseFrame_ = false;                 // the last frame was: its samples
     SampleBuffer singlePhaseSamples_;
+    std::vector<double> frameStaticSeconds_;
+    std::vector<ObjectFrameCost> frameDynamic_;
 };
 
 }  // namespace mpshade

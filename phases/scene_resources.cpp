@@ -27,6 +27,7 @@ FrameState frameStateAt(const SceneResources& resources, int frame, int width, i
                         int spp) {
     const Scene& scene = resources.scene();
     FrameState f;
+    f.index = frame;
     f.width = width > 0 ? width : scene.settings.width;
     f.height = height > 0 ? height : scene.settings.height;
     f.spp = spp > 0 ? spp : scene.settings.samplesPerPixel;

@@ -53,6 +53,7 @@ class SceneResources {
 // parameter block, lights in its coordinates, and the uniforms pointing at them. The spans
 // in `uniforms` point into `params` and `lights`, which must not be resized.
 struct FrameState {
+    int index = 0;                       // the frame's number
     int width = 0, height = 0, spp = 1;  // resolved: the options', else the scene's
     float time = 0.0f;
     CameraState camera;

@@ -282,7 +282,8 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
 
 void StaticPhase::fill(std::span<const TileRequest> requests,
                        std::span<const ObjectRepresentation* const> representations,
-                       StaticCosts& costs) const {
+                       StaticCosts& costs, FillTiming* timing) const {
+    if (timing) timing->objectSeconds.resize(objects_.size(), 0.0);
     if (requests.empty()) return;
     const auto start = Clock::now();
     std::map<uint32_t, std::vector<TileKey>> perObject;
@@ -291,17 +292,29 @@ void StaticPhase::fill(std::span<const TileRequest> requests,
         ShaderMap* map;
         std::vector<TileKey>* keys;
         size_t instructionsPerRun;
+        uint32_t object;
+        double seconds = 0.0;
     };
     std::vector<Work> work;
     for (auto& [object, keys] : perObject) {
         const ObjectRepresentation* rep = representations[object];
         if (rep && rep->map)
-            work.push_back(
-                {rep->map.get(), &keys, objects_[object]->staticKernel->instructionCount()});
+            work.push_back({rep->map.get(), &keys,
+                            objects_[object]->staticKernel->instructionCount(), object});
     }
     std::vector<FillStats> before(work.size());
     for (size_t w = 0; w < work.size(); ++w) before[w] = work[w].map->fillStats();
-    tbb::parallel_for(size_t{0}, work.size(), [&](size_t w) { work[w].map->fill(*work[w].keys); });
+    tbb::parallel_for(size_t{0}, work.size(), [&](size_t w) {
+        const auto began = Clock::now();
+        work[w].map->fill(*work[w].keys);
+        const auto ended = Clock::now();
+        work[w].seconds = std::chrono::duration<double>(ended - began).count();
+        if (timing && timing->trace)
+            timing->trace->span("fill tiles", PhaseKind::Static, began, ended, work[w].object,
+                                timing->frame);
+    });
+    if (timing)
+        for (const Work& w : work) timing->objectSeconds[w.object] += w.seconds;
     for (size_t w = 0; w < work.size(); ++w) {
         const FillStats& after = work[w].map->fillStats();
         costs.instructions +=

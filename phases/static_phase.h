@@ -13,6 +13,7 @@
 
 #include "phases/dicing.h"
 #include "phases/object_representation.h"
+#include "phases/phase_trace.h"
 #include "phases/scene_resources.h"
 #include "shading/factoring.h"
 
@@ -49,6 +50,14 @@ struct StaticCosts {
     uint64_t tilesFilled = 0, tilesFromChildren = 0, texelsFilled = 0, programRuns = 0;
 };
 
+// Where a fill's time went: each map's fill reported as a span on the thread that ran it,
+// and added to its object's seconds (sized to the scene's objects by fill()).
+struct FillTiming {
+    PhaseTrace* trace = nullptr;  // not owned; null: no spans
+    int64_t frame = -1;
+    std::vector<double> objectSeconds;
+};
+
 class StaticPhase {
   public:
     StaticPhase(const Scene& scene, const SceneResources& resources,
@@ -76,8 +85,8 @@ class StaticPhase {
     // Fills the requested tiles lacking from the representations' maps: each map's tiles
     // in one batch (finest level first), maps in parallel.
     void fill(std::span<const TileRequest> requests,
-              std::span<const ObjectRepresentation* const> representations,
-              StaticCosts& costs) const;
+              std::span<const ObjectRepresentation* const> representations, StaticCosts& costs,
+              FillTiming* timing = nullptr) const;
 
   private:
     static DicingView dicingView(const ObjectState& state, const CameraState& camera);
