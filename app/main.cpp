@@ -8,6 +8,7 @@
 #include "app/eval_command.h"
 #include "app/factor_command.h"
 #include "app/output_files.h"
+#include "app/profile_command.h"
 #include "app/render_command.h"
 
 int main(int argc, char** argv) {
@@ -101,6 +102,22 @@ int main(int argc, char** argv) {
                       "With --quick: each scene at its own size, not half of it");
     evalCmd->add_flag("--quiet", eval.quiet, "No progress or summary on stderr");
 
+    mpshade::ProfileCommandOptions profile;
+    CLI::App* profileCmd = app.add_subcommand(
+        "profile",
+        "What each phase costs, per object and per frame: profile.md and a Chrome trace "
+        "(trace.json)");
+    profileCmd->add_option("scene", profile.scene, "Scene file (.json)")->required();
+    profileCmd->add_option("--out", profile.outDir, "Output folder (created if missing)")
+        ->required();
+    profileCmd->add_option("--frames", profile.frames,
+                           "Frames A:B (half-open) or N; default every frame");
+    profileCmd->add_option("--size", profile.size, "Image size WxH (overrides the scene)");
+    profileCmd->add_option("--spp", profile.spp, "Samples per pixel (overrides the scene)");
+    profileCmd->add_option("--seed", profile.seed, "Seed of the sample positions")
+        ->capture_default_str();
+    profileCmd->add_flag("--quiet", profile.quiet, "No progress or summary on stderr");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -118,6 +135,7 @@ int main(int argc, char** argv) {
         if (factorCmd->parsed()) return mpshade::runFactorCommand(factor);
         if (compareCmd->parsed()) return mpshade::runCompareCommand(compare);
         if (evalCmd->parsed()) return mpshade::runEvalCommand(eval);
+        if (profileCmd->parsed()) return mpshade::runProfileCommand(profile);
     } catch (const mpshade::OutputError& e) {
         std::fprintf(stderr, "mpshade: error: %s\n", e.what());
         return 1;

@@ -15,6 +15,7 @@
 #include "app/interrupt_watch.h"
 #include "app/memory_limit.h"
 #include "app/output_files.h"
+#include "controller/cost_profile.h"
 #include "geometry/error.h"
 #include "phases/image_compare.h"
 #include "phases/multiphase_renderer.h"
@@ -161,14 +162,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
                 nlohmann::json objects = nlohmann::json::array();
                 for (size_t i = 0; i < multi->objectCount(); ++i) {
                     const ObjectReport& r = multi->report(i);
-                    // A static part not worth storing leaves geometry alone (factoring.h).
-                    const bool nothingStored = multi->factored(i).staticPart.channelOutputs.empty();
-                    const char* kind = r.kind == Representation::Auto     ? "none (never seen)"
-                                       : nothingStored                    ? "geometry"
-                                       : r.kind == Representation::Facets ? "facets"
-                                                                          : "shadermap";
                     objects.push_back({{"name", r.name},
-                                       {"representation", kind},
+                                       {"representation", representationName(*multi, i)},
                                        {"reason", r.reason},
                                        {"static_runs", r.staticRuns},
                                        {"static_seconds", r.staticCosts.seconds},

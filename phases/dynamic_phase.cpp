@@ -133,7 +133,7 @@ void DynamicPhase::begin(const FrameState& frame,
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
         const ObjectRepresentation* rep = objects_[i];
         if (!rep) return;
-        const ScopedSpan task(options.trace, "warp object", PhaseKind::Dynamic,
+        const ScopedSpan task(options.trace, "warp object", PhaseKind::Dynamic, SpanLevel::Task,
                               static_cast<int64_t>(i), frame.index);
         const ObjectState& state = frame.objects[i];
         const FacetMesh& mesh = rep->mesh;
@@ -164,7 +164,8 @@ void DynamicPhase::begin(const FrameState& frame,
         }
     stats_.warpSeconds = secondsSince(start);
     if (options.trace)
-        options.trace->span("warp", PhaseKind::Dynamic, start, Clock::now(), -1, frame.index);
+        options.trace->span("warp", PhaseKind::Dynamic, SpanLevel::Phase, start, Clock::now(), -1,
+                            frame.index);
 
     start = Clock::now();
     std::vector<RasterObject> raster(n);
@@ -183,7 +184,8 @@ void DynamicPhase::begin(const FrameState& frame,
                           stats_.raster);
     stats_.rasterSeconds = secondsSince(start);
     if (options.trace)
-        options.trace->span("rasterize", PhaseKind::Dynamic, start, Clock::now(), -1, frame.index);
+        options.trace->span("rasterize", PhaseKind::Dynamic, SpanLevel::Phase, start, Clock::now(),
+                            -1, frame.index);
     if (samples_.layout != layout_) {
         samples_.reset(layout_);
         uniform_.assign(static_cast<size_t>(layout_->width()) * layout_->height(), 0);
@@ -201,12 +203,14 @@ bool DynamicPhase::complete() const {
 
 std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
     const auto start = Clock::now();
-    const ScopedSpan span(options_.trace, "shade", PhaseKind::Dynamic, -1, frame_->index);
+    const ScopedSpan span(options_.trace, "shade", PhaseKind::Dynamic, SpanLevel::Phase, -1,
+                          frame_->index);
     ++stats_.shadePasses;
     tbb::enumerable_thread_specific<std::vector<TileRequest>> lacking;
     tbb::parallel_for(size_t{0}, bandDone_.size(), [&](size_t b) {
         if (bandDone_[b]) return;
-        const ScopedSpan task(options_.trace, "band", PhaseKind::Dynamic, -1, frame_->index);
+        const ScopedSpan task(options_.trace, "band", PhaseKind::Dynamic, SpanLevel::Task, -1,
+                              frame_->index);
         shadeBand(b, acceptFallbacks, lacking.local());
     });
     std::vector<TileRequest> all;
@@ -497,7 +501,8 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
 
 void DynamicPhase::resolve(Image& out) {
     const auto start = Clock::now();
-    const ScopedSpan span(options_.trace, "resolve", PhaseKind::Resolve, -1, frame_->index);
+    const ScopedSpan span(options_.trace, "resolve", PhaseKind::Resolve, SpanLevel::Phase, -1,
+                          frame_->index);
     layout_->resolve(samples_.rgba.data(), uniform_.data(), out);
     stats_.resolveSeconds = secondsSince(start);
 }

@@ -246,9 +246,12 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     frameDynamic_.assign(scene_.objects.size(), ObjectFrameCost{});
     const CameraState& camera = frame_.camera;
     if (!layout_ ||
-        !layout_->matches(frame_.width, frame_.height, frame_.spp, options.seed, options.filter))
+        !layout_->matches(frame_.width, frame_.height, frame_.spp, options.seed, options.filter)) {
+        const ScopedSpan span(options_.trace, "sample layout", PhaseKind::Dynamic, SpanLevel::Phase,
+                              -1, frame);
         layout_ = std::make_shared<const SampleLayout>(frame_.width, frame_.height, frame_.spp,
                                                        options.seed, options.filter);
+    }
     DynamicOptions dynamicOptions = options_.dynamic;
     if (options_.shadingRate)
         dynamicOptions.shadingRate = *options_.shadingRate;
@@ -305,19 +308,18 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     }
     if (singlePhaseFrame_) {
         if (!reference_) reference_ = std::make_unique<ReferenceRenderer>(scene_);
-        const ScopedSpan span(options_.trace, "single-phase frame", PhaseKind::Reference, -1,
-                              frame);
+        const ScopedSpan span(options_.trace, "single-phase frame", PhaseKind::Reference,
+                              SpanLevel::Phase, -1, frame);
         singlePhaseSamples_ = reference_->renderSamples(frame, options, stats, progress);
         stats.singlePhase = true;
         stats.wallSeconds = secondsSince(start);
         return;
     }
     std::vector<StaticCosts> costs(stale.size());
-    const auto buildStart = Clock::now();
     tbb::parallel_for(size_t{0}, stale.size(), [&](size_t k) {
         const size_t i = stale[k];
-        const ScopedSpan task(options_.trace, "build", PhaseKind::Static, static_cast<int64_t>(i),
-                              frame);
+        const ScopedSpan task(options_.trace, "build", PhaseKind::Static, SpanLevel::Task,
+                              static_cast<int64_t>(i), frame);
         representations_[i] =
             static_.build(i, kinds_[i], frame_.objects[i], camera, frame_.uniforms[i],
                           representations_[i].get(), costs[k]);
@@ -341,8 +343,8 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     stats.staticRuns = static_cast<int>(stale.size());
     stats.staticSeconds = secondsSince(staticStart);
     if (options_.trace && !stale.empty())
-        options_.trace->span("static phase", PhaseKind::Static, buildStart, Clock::now(), -1,
-                             frame);
+        options_.trace->span("static phase", PhaseKind::Static, SpanLevel::Phase, staticStart,
+                             Clock::now(), -1, frame);
     if (progress) progress(1, 4);
 
     // 3. The dynamic phase; lacking tiles filled between shading passes.
@@ -355,7 +357,9 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     dynamic_.begin(frame_, drawn, layout_, dynamicOptions);
     if (progress) progress(2, 4);
     StaticCosts fills;
-    FillTiming fillTiming{options_.trace, frame, {}};
+    FillTiming fillTiming;
+    fillTiming.trace = options_.trace;
+    fillTiming.frame = frame;
     for (int pass = 0;; ++pass) {
         const bool last = pass >= 6;  // a safety net: each pass fills what the last lacked
         const std::vector<TileRequest> lacking = dynamic_.shade(last);
@@ -369,7 +373,8 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         static_.fill(lacking, drawn, fills, &fillTiming);
         stats.fillSeconds += secondsSince(fillStart);
         if (options_.trace)
-            options_.trace->span("fill", PhaseKind::Static, fillStart, Clock::now(), -1, frame);
+            options_.trace->span("fill", PhaseKind::Static, SpanLevel::Phase, fillStart,
+                                 Clock::now(), -1, frame);
         for (const TileRequest& r : lacking) ++reports_[r.object].staticCosts.tilesFilled;
     }
     stats.staticSeconds += stats.fillSeconds;
@@ -382,6 +387,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     for (size_t i = 0; i < fillTiming.objectSeconds.size(); ++i) {
         frameStaticSeconds_[i] += fillTiming.objectSeconds[i];
         reports_[i].staticCosts.seconds += fillTiming.objectSeconds[i];
+        reports_[i].staticCosts.instructions += fillTiming.objectInstructions[i];
     }
     const DynamicFrameStats& d = dynamic_.stats();
     const std::vector<ObjectFrameCost>& objectCosts = dynamic_.objectCosts();
@@ -455,7 +461,7 @@ void MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
 Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
                                       const ProgressFn& progress) {
     const auto start = Clock::now();
-    const ScopedSpan span(options_.trace, "frame", PhaseKind::Frame, -1, frame);
+    const ScopedSpan span(options_.trace, "frame", PhaseKind::Frame, SpanLevel::Phase, -1, frame);
     render(frame, options, stats, progress);
     if (singlePhaseFrame_) {
         Image image;

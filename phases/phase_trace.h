@@ -12,12 +12,16 @@
 
 namespace mpshade {
 
+// Whether a span is a phase of a frame, reported by the thread rendering it, or one task of a
+// parallel loop, reported by whichever thread ran it.
+enum class SpanLevel : uint8_t { Phase, Task };
+
 // What a span is part of; a profile shows each on a track of its own.
 enum class PhaseKind : uint8_t {
-    Frame,    // a whole frame
-    Static,   // the static phase: dicing, tile fills
-    Dynamic,  // the dynamic phase: warp, rasterize, shade
-    Resolve,  // pixel reconstruction
+    Frame,      // a whole frame
+    Static,     // the static phase: dicing, tile fills
+    Dynamic,    // the dynamic phase: warp, rasterize, shade
+    Resolve,    // pixel reconstruction
     Reference,  // a frame rendered single-phase
 };
 
@@ -27,20 +31,21 @@ class PhaseTrace {
     virtual ~PhaseTrace() = default;
     // [begin, end) on the calling thread. `name` must outlive the sink (a string literal);
     // object: the scene object it worked for, or -1; frame: the frame, or -1.
-    virtual void span(const char* name, PhaseKind kind, Clock::time_point begin,
+    virtual void span(const char* name, PhaseKind kind, SpanLevel level, Clock::time_point begin,
                       Clock::time_point end, int64_t object, int64_t frame) = 0;
 };
 
 // Reports the span from its construction to its destruction; does nothing without a sink.
 class ScopedSpan {
   public:
-    ScopedSpan(PhaseTrace* trace, const char* name, PhaseKind kind, int64_t object = -1,
-               int64_t frame = -1)
-        : trace_(trace), name_(name), kind_(kind), object_(object), frame_(frame) {
+    ScopedSpan(PhaseTrace* trace, const char* name, PhaseKind kind, SpanLevel level,
+               int64_t object = -1, int64_t frame = -1)
+        : trace_(trace), name_(name), kind_(kind), level_(level), object_(object), frame_(frame) {
         if (trace_) begin_ = PhaseTrace::Clock::now();
     }
     ~ScopedSpan() {
-        if (trace_) trace_->span(name_, kind_, begin_, PhaseTrace::Clock::now(), object_, frame_);
+        if (trace_)
+            trace_->span(name_, kind_, level_, begin_, PhaseTrace::Clock::now(), object_, frame_);
     }
     ScopedSpan(const ScopedSpan&) = delete;
     ScopedSpan& operator=(const ScopedSpan&) = delete;
@@ -49,6 +54,7 @@ class ScopedSpan {
     PhaseTrace* trace_;
     const char* name_;
     PhaseKind kind_;
+    SpanLevel level_;
     int64_t object_, frame_;
     PhaseTrace::Clock::time_point begin_{};
 };

@@ -283,7 +283,10 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
 void StaticPhase::fill(std::span<const TileRequest> requests,
                        std::span<const ObjectRepresentation* const> representations,
                        StaticCosts& costs, FillTiming* timing) const {
-    if (timing) timing->objectSeconds.resize(objects_.size(), 0.0);
+    if (timing) {
+        timing->objectSeconds.resize(objects_.size(), 0.0);
+        timing->objectInstructions.resize(objects_.size(), 0);
+    }
     if (requests.empty()) return;
     const auto start = Clock::now();
     std::map<uint32_t, std::vector<TileKey>> perObject;
@@ -310,15 +313,17 @@ void StaticPhase::fill(std::span<const TileRequest> requests,
         const auto ended = Clock::now();
         work[w].seconds = std::chrono::duration<double>(ended - began).count();
         if (timing && timing->trace)
-            timing->trace->span("fill tiles", PhaseKind::Static, began, ended, work[w].object,
-                                timing->frame);
+            timing->trace->span("fill tiles", PhaseKind::Static, SpanLevel::Task, began, ended,
+                                work[w].object, timing->frame);
     });
     if (timing)
         for (const Work& w : work) timing->objectSeconds[w.object] += w.seconds;
     for (size_t w = 0; w < work.size(); ++w) {
         const FillStats& after = work[w].map->fillStats();
-        costs.instructions +=
+        const uint64_t instructions =
             (after.programRuns - before[w].programRuns) * work[w].instructionsPerRun;
+        costs.instructions += instructions;
+        if (timing) timing->objectInstructions[work[w].object] += instructions;
         costs.tilesFilled += after.tiles - before[w].tiles;
         costs.tilesFromChildren += after.tilesFromChildren - before[w].tilesFromChildren;
         costs.texelsFilled += after.texels - before[w].texels;

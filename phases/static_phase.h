@@ -50,12 +50,14 @@ struct StaticCosts {
     uint64_t tilesFilled = 0, tilesFromChildren = 0, texelsFilled = 0, programRuns = 0;
 };
 
-// Where a fill's time went: each map's fill reported as a span on the thread that ran it,
-// and added to its object's seconds (sized to the scene's objects by fill()).
+// Where a fill's work went: each map's fill reported as a span on the thread that ran it,
+// and added to its object's seconds and static shader instructions (both sized to the
+// scene's objects by fill()).
 struct FillTiming {
     PhaseTrace* trace = nullptr;  // not owned; null: no spans
     int64_t frame = -1;
     std::vector<double> objectSeconds;
+    std::vector<uint64_t> objectInstructions;
 };
 
 class StaticPhase {

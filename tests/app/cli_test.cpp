@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -499,6 +501,41 @@ TEST(Cli, ManyDistinctShapesAreRefusedBeforeTheirRayScenesAreBuilt) {
     const CliRun multi =
         mpshade("render " + dir + "/scene.json --memory-mb 2000 --quiet --out " + dir + "/mp");
     EXPECT_EQ(multi.exitCode, 0) << multi.output;
+}
+
+TEST(Cli, ProfileWritesTheCostsAndATraceThatOpens) {
+    const std::string out = tempDir("profile");
+    const CliRun run = mpshade("profile examples/vase/scene.json --frames 2:4 --size 96x54 --out " +
+                               out);
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("profile.md"), std::string::npos) << run.output;
+    std::ifstream md(out + "/profile.md");
+    const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+    for (const char* row : {"| vase | shadermap |", "| floor | shadermap |", "| 2 |", "| 3 |"})
+        EXPECT_NE(text.find(row), std::string::npos) << row << "\n" << text;
+    std::ifstream traceFile(out + "/trace.json");
+    const nlohmann::json trace = nlohmann::json::parse(traceFile);
+    ASSERT_TRUE(trace["traceEvents"].is_array());
+    std::map<std::string, int> phaseSpans;
+    std::set<int> threadTracks;
+    for (const nlohmann::json& e : trace["traceEvents"]) {
+        if (e["ph"] != "X") continue;
+        EXPECT_GE(e["dur"].get<double>(), 0.0);
+        if (e["pid"] == 1) ++phaseSpans[e["name"].get<std::string>()];
+        if (e["pid"] == 2) threadTracks.insert(e["tid"].get<int>());
+    }
+    EXPECT_EQ(phaseSpans["frame"], 2);
+    EXPECT_EQ(phaseSpans["static phase"], 1);  // the first frame builds both objects
+    EXPECT_EQ(phaseSpans["resolve"], 2);
+    EXPECT_GE(phaseSpans["shade"], 2);
+    EXPECT_FALSE(threadTracks.empty());
+
+    const CliRun bad = mpshade("profile examples/vase/scene.json --frames 40:50 --out " + out);
+    EXPECT_EQ(bad.exitCode, 2) << bad.output;
+    EXPECT_NE(bad.output.find("--frames"), std::string::npos) << bad.output;
+    const CliRun badSpp = mpshade("profile examples/vase/scene.json --spp 0 --out " + out);
+    EXPECT_EQ(badSpp.exitCode, 2) << badSpp.output;
+    EXPECT_NE(badSpp.output.find("--spp"), std::string::npos) << badSpp.output;
 }
 
 TEST(Cli, HelpAndVersion) {

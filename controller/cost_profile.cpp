@@ -1,0 +1,198 @@
+#include "controller/cost_profile.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdarg>
+#include <cstdio>
+
+namespace mpshade {
+namespace {
+
+std::string format(const char* f, ...) __attribute__((format(printf, 1, 2)));
+std::string format(const char* f, ...) {
+    char buffer[512];
+    va_list args;
+    va_start(args, f);
+    std::vsnprintf(buffer, sizeof buffer, f, args);
+    va_end(args);
+    return buffer;
+}
+
+double ms(double seconds) {
+    return 1e3 * seconds;
+}
+
+double mb(uint64_t bytes) {
+    return static_cast<double>(bytes) / (1024.0 * 1024.0);
+}
+
+// A frame's dynamic phase on the rendering thread: warp, rasterize, shade, resolve.
+double dynamicSeconds(const FrameStats& s) {
+    return s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
+}
+
+}  // namespace
+
+std::string representationName(const MultiphaseRenderer& renderer, size_t object) {
+    const ObjectReport& r = renderer.report(object);
+    if (r.kind == Representation::Auto) return "none (never seen)";
+    if (renderer.factored(object).staticPart.channelOutputs.empty()) return "geometry";
+    return r.kind == Representation::Facets ? "facets" : "shadermap";
+}
+
+CostProfile profileScene(const Scene& scene, const std::string& scenePath,
+                         const ProfileOptions& options, TraceRecorder& trace,
+                         const std::function<void(int)>& progress) {
+    const auto start = std::chrono::steady_clock::now();
+    MultiphaseOptions mo = options.multiphase;
+    mo.trace = &trace;
+    MultiphaseRenderer renderer(scene, mo);
+    renderer.plan(options.first, options.last, options.render);
+    CostProfile p;
+    p.scene = scenePath;
+    p.first = options.first;
+    p.last = options.last;
+    p.singlePhaseFrames = mo.singlePhaseFrames;
+    const size_t n = scene.objects.size();
+    p.objects.resize(n);
+    const int frames = std::max(0, options.last - options.first);
+    for (ObjectProfile& o : p.objects) {
+        o.staticSecondsPerFrame.assign(static_cast<size_t>(frames), 0.0);
+        o.shadeSecondsPerFrame.assign(static_cast<size_t>(frames), 0.0);
+    }
+    for (int frame = options.first; frame < options.last; ++frame) {
+        FrameStats stats;
+        renderer.renderFrame(frame, options.render, stats);
+        const size_t k = static_cast<size_t>(frame - options.first);
+        const std::vector<double>& staticSeconds = renderer.lastFrameStaticSeconds();
+        const std::vector<ObjectFrameCost>& dynamic = renderer.lastFrameDynamicCosts();
+        for (size_t i = 0; i < n; ++i) {
+            ObjectProfile& o = p.objects[i];
+            if (i < staticSeconds.size()) o.staticSecondsPerFrame[k] = staticSeconds[i];
+            if (i < dynamic.size()) {
+                o.shadeSecondsPerFrame[k] = dynamic[i].shadeSeconds;
+                o.shadingPoints += dynamic[i].shadingPoints;
+                o.dynamicInstructions += dynamic[i].instructions;
+            }
+        }
+        p.frames.push_back(stats);
+        if (progress) progress(frame);
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const ObjectReport& r = renderer.report(i);
+        ObjectProfile& o = p.objects[i];
+        o.name = r.name;
+        o.representation = representationName(renderer, i);
+        o.reason = r.reason;
+        o.staticRuns = r.staticRuns;
+        o.framesDrawn = r.framesDrawn;
+        for (double s : o.staticSecondsPerFrame) o.staticSeconds += s;
+        for (double s : o.shadeSecondsPerFrame) o.shadeSeconds += s;
+        o.staticInstructions = r.staticCosts.instructions;
+        o.tilesFilled = r.staticCosts.tilesFilled;
+        o.residentTiles = r.residentTiles;
+        o.facets = r.facets;
+        o.facetBytes = r.facetBytes;
+        o.mapBytes = r.mapBytes;
+    }
+    const RenderOptions& ro = options.render;
+    p.width = ro.width > 0 ? ro.width : scene.settings.width;
+    p.height = ro.height > 0 ? ro.height : scene.settings.height;
+    p.spp = ro.samplesPerPixel > 0 ? ro.samplesPerPixel : scene.settings.samplesPerPixel;
+    p.threads = trace.threads();
+    p.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return p;
+}
+
+std::string profileMarkdown(const CostProfile& p) {
+    std::string md;
+    md += "# mpshade profile: " + p.scene + "\n\n";
+    md += format(
+        "%dx%d, %d spp, frames %d:%d, multi-phase; %d threads reported work; %.3f s in "
+        "all.\n\n",
+        p.width, p.height, p.spp, p.first, p.last, p.threads, p.wallSeconds);
+    if (!p.singlePhaseFrames)
+        md +=
+            "Every frame multi-phase (as `mpshade render --no-single-phase`): `render` may "
+            "render a short request single-phase where its static work would not pay for "
+            "itself.\n\n";
+    md +=
+        "A frame's phases are wall-clock milliseconds on the rendering thread. An object's "
+        "static and shading milliseconds are summed over the threads that worked for it. "
+        "`trace.json` has every span (open it in https://ui.perfetto.dev or chrome://tracing): "
+        "a track per phase and one per thread.\n\n";
+
+    double staticTotal = 0.0, dynamicTotal = 0.0, wallTotal = 0.0;
+    int singlePhase = 0;
+    for (const FrameStats& s : p.frames) {
+        staticTotal += s.staticSeconds;
+        dynamicTotal += dynamicSeconds(s);
+        wallTotal += s.wallSeconds;
+        singlePhase += s.singlePhase ? 1 : 0;
+    }
+    md += "## Static against dynamic\n\n";
+    md += format("| | ms | share of the frames' time |\n| --- | --- | --- |\n");
+    const double share = wallTotal > 0.0 ? 100.0 / wallTotal : 0.0;
+    md += format(
+        "| static phase (choosing representations, building, filling tiles) | %.1f | "
+        "%.1f%% |\n",
+        ms(staticTotal), staticTotal * share);
+    md += format("| dynamic phase (warp, rasterize, shade, resolve) | %.1f | %.1f%% |\n",
+                 ms(dynamicTotal), dynamicTotal * share);
+    const double other = std::max(0.0, wallTotal - staticTotal - dynamicTotal);
+    md += format(
+        "| the rest (the sample layout at the first frame, buffers, bookkeeping) | %.1f | "
+        "%.1f%% |\n",
+        ms(other), other * share);
+    md += format("| frames in all | %.1f | 100%% |\n\n", ms(wallTotal));
+    if (singlePhase > 0)
+        md += format(
+            "%d frame(s) rendered single-phase (their static work would not have paid "
+            "for itself); their time is in the total only.\n\n",
+            singlePhase);
+
+    md += "## Per object\n\n";
+    md +=
+        "| object | representation | static runs | static ms | shading ms per frame drawn | "
+        "shading points per frame | tiles filled | resident tiles | facets | static "
+        "instructions | dynamic instructions per frame | memory MB |\n";
+    md += "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    for (const ObjectProfile& o : p.objects) {
+        const double drawn = std::max(1, o.framesDrawn);
+        md += format(
+            "| %s | %s | %d | %.1f | %.2f | %.0f | %llu | %llu | %llu | %.3g | %.3g | "
+            "%.2f |\n",
+            o.name.c_str(), o.representation.c_str(), o.staticRuns, ms(o.staticSeconds),
+            ms(o.shadeSeconds) / drawn, static_cast<double>(o.shadingPoints) / drawn,
+            static_cast<unsigned long long>(o.tilesFilled),
+            static_cast<unsigned long long>(o.residentTiles),
+            static_cast<unsigned long long>(o.facets), static_cast<double>(o.staticInstructions),
+            static_cast<double>(o.dynamicInstructions) / drawn, mb(o.facetBytes + o.mapBytes));
+    }
+    md += "\nWhy each representation:\n\n";
+    for (const ObjectProfile& o : p.objects)
+        if (!o.reason.empty()) md += "- " + o.name + ": " + o.reason + "\n";
+
+    md += "\n## Per frame\n\n";
+    md +=
+        "| frame | static ms | of it, fills | warp | rasterize | shade | resolve | frame ms | "
+        "static runs | tiles filled | shaded points | resident MB |\n";
+    md += "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    for (const FrameStats& s : p.frames) {
+        if (s.singlePhase) {
+            md += format("| %d | single-phase | | | | | | %.1f | | | %llu | |\n", s.index,
+                         ms(s.wallSeconds), static_cast<unsigned long long>(s.shadedPoints));
+            continue;
+        }
+        md += format(
+            "| %d | %.1f | %.1f | %.2f | %.2f | %.1f | %.2f | %.1f | %d | %llu | %llu | "
+            "%.1f |\n",
+            s.index, ms(s.staticSeconds), ms(s.fillSeconds), ms(s.warpSeconds), ms(s.rasterSeconds),
+            ms(s.shadeSeconds), ms(s.resolveSeconds), ms(s.wallSeconds), s.staticRuns,
+            static_cast<unsigned long long>(s.tilesFilled),
+            static_cast<unsigned long long>(s.shadedPoints), mb(s.residentBytes));
+    }
+    return md;
+}
+
+}  // namespace mpshade
