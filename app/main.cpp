@@ -8,6 +8,7 @@
 #include "app/eval_command.h"
 #include "app/factor_command.h"
 #include "app/output_files.h"
+#include "app/play_command.h"
 #include "app/profile_command.h"
 #include "app/render_command.h"
 
@@ -118,6 +119,26 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     profileCmd->add_flag("--quiet", profile.quiet, "No progress or summary on stderr");
 
+    mpshade::PlayCommandOptions play;
+    CLI::App* playCmd = app.add_subcommand(
+        "play", "Play a scene back at a locked frame rate: each frame gets 1/fps seconds");
+    playCmd->add_option("scene", play.scene, "Scene file (.json)")->required();
+    playCmd->add_option("--out", play.outDir, "Output folder (created if missing)")->required();
+    playCmd->add_option("--fps", play.fps, "Frames per second: each frame's budget is 1/fps")
+        ->capture_default_str();
+    playCmd->add_option("--frames", play.frames,
+                        "Frames A:B (half-open) or N; default every frame");
+    playCmd->add_option("--size", play.size, "Image size WxH (overrides the scene)");
+    playCmd->add_option("--spp", play.spp, "Samples per pixel (overrides the scene)");
+    playCmd->add_option("--seed", play.seed, "Seed of the sample positions")->capture_default_str();
+    playCmd
+        ->add_option("--cache-mb", play.cacheMb,
+                     "Memory budget of the shader maps' tiles, MB (least recently used out "
+                     "first; the coarsest levels stay)")
+        ->capture_default_str();
+    playCmd->add_flag("--no-write", play.noWrite, "Measure without the disk: stats.json only");
+    playCmd->add_flag("--quiet", play.quiet, "No progress or summary on stderr");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -136,6 +157,7 @@ int main(int argc, char** argv) {
         if (compareCmd->parsed()) return mpshade::runCompareCommand(compare);
         if (evalCmd->parsed()) return mpshade::runEvalCommand(eval);
         if (profileCmd->parsed()) return mpshade::runProfileCommand(profile);
+        if (playCmd->parsed()) return mpshade::runPlayCommand(play);
     } catch (const mpshade::OutputError& e) {
         std::fprintf(stderr, "mpshade: error: %s\n", e.what());
         return 1;

@@ -48,6 +48,15 @@ struct FrameStats {
     // needed was estimated to cost more than shading the frames it would serve from scratch
     // (multiphase_renderer.h). Every figure above is then the reference's.
     bool singlePhase = false;
+
+    // A frame budget (MultiphaseOptions::frameBudgetSeconds; `mpshade play`): the budget,
+    // whether the frame's work fit it, the tiles its probes lacked that were left for later
+    // frames, and the objects whose static phase was due but put off (they were drawn from
+    // their last representation).
+    double budgetSeconds = 0.0;
+    bool deadlineMet = true;
+    uint64_t tilesDeferred = 0;
+    int rebuildsDeferred = 0;
 };
 
 }  // namespace mpshade

@@ -51,6 +51,7 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
     framesSeen_.assign(n, {});
     reports_.resize(n);
     for (size_t i = 0; i < n; ++i) reports_[i].name = scene.objects[i].name;
+    lastBuildSeconds_.assign(n, 0.0);
 }
 
 MultiphaseRenderer::~MultiphaseRenderer() = default;
@@ -276,6 +277,27 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
             tooCoarse)
             stale.push_back(i);
     }
+    // A frame budget: what was never built is built; what is due again is rebuilt, cheapest
+    // first, only while its last run fits the time left after the dynamic phase (as long as
+    // the last frame's); the others are drawn from their last representation.
+    const bool budgeted = options_.frameBudgetSeconds > 0.0;
+    if (budgeted && !stale.empty()) {
+        std::vector<size_t> due, again;
+        for (size_t i : stale) (representations_[i] ? again : due).push_back(i);
+        std::sort(again.begin(), again.end(),
+                  [&](size_t a, size_t b) { return lastBuildSeconds_[a] < lastBuildSeconds_[b]; });
+        double left = options_.frameBudgetSeconds - secondsSince(start) - lastDynamicSeconds_;
+        for (size_t i : again) {
+            if (lastBuildSeconds_[i] <= left) {
+                due.push_back(i);
+                left -= lastBuildSeconds_[i];
+            } else {
+                ++stats.rebuildsDeferred;
+            }
+        }
+        std::sort(due.begin(), due.end());
+        stale = due;
+    }
     const auto staticStart = Clock::now();
     // First a check that needs no dicing survey: with every stale object at the least its
     // representations could cost, does single-phase still win? (A cut every frame then
@@ -283,7 +305,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     // and the check is made again with their estimates.
     std::vector<ObjectCostInputs> staleInputs(stale.size());
     singlePhaseFrame_ = false;
-    if (options_.singlePhaseFrames && !stale.empty()) {
+    if (options_.singlePhaseFrames && !budgeted && !stale.empty()) {
         for (size_t k = 0; k < stale.size(); ++k)
             staleInputs[k] =
                 costInputs(stale[k], frame, frame_.objects[stale[k]], camera, frame_.spp);
@@ -297,7 +319,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
             previousReasons[k] = reports_[i].reason;
             kinds_[i] = chooseKind(i, frame, frame_.objects[i], camera, frame_.spp, staleInputs[k]);
         }
-        singlePhaseFrame_ = options_.singlePhaseFrames && !stale.empty() &&
+        singlePhaseFrame_ = options_.singlePhaseFrames && !budgeted && !stale.empty() &&
                             singlePhasePays(stale, staleInputs, visible, frame, false);
         if (singlePhaseFrame_) {
             // Nothing is built: the objects stay as they were; the next frame decides again.
@@ -332,6 +354,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         r.staticCosts.runs += costs[k].runs;
         r.staticCosts.seconds += costs[k].seconds;
         frameStaticSeconds_[stale[k]] += costs[k].seconds;
+        lastBuildSeconds_[stale[k]] = costs[k].seconds;
         r.staticCosts.instructions += costs[k].instructions;
         r.staticCosts.programRuns += costs[k].programRuns;
         r.staticCosts.tilesFilled += costs[k].tilesFilled;
@@ -360,7 +383,15 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     FillTiming fillTiming;
     fillTiming.trace = options_.trace;
     fillTiming.frame = frame;
-    for (int pass = 0;; ++pass) {
+    lacking_.clear();
+    if (budgeted) {
+        // Once, with fallbacks; the tiles lacked are filled after the resolve, in the time
+        // left (fillWithinBudget).
+        lacking_ = dynamic_.shade(true);
+        stats.tilesRequested += lacking_.size();
+        drawn_ = drawn;
+    }
+    for (int pass = 0; !budgeted; ++pass) {
         const bool last = pass >= 6;  // a safety net: each pass fills what the last lacked
         const std::vector<TileRequest> lacking = dynamic_.shade(last);
         stats.tilesRequested += lacking.size();
@@ -472,15 +503,91 @@ Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, F
     Image image;
     dynamic_.resolve(image);
     stats.resolveSeconds = dynamic_.stats().resolveSeconds;
+    if (options_.frameBudgetSeconds > 0.0) {
+        const DynamicFrameStats& d = dynamic_.stats();
+        lastDynamicSeconds_ = d.warpSeconds + d.rasterSeconds + d.shadeSeconds + d.resolveSeconds;
+        fillWithinBudget(start, stats);
+    }
     stats.wallSeconds = secondsSince(start);
+    if (options_.frameBudgetSeconds > 0.0) {
+        stats.budgetSeconds = options_.frameBudgetSeconds;
+        stats.deadlineMet = stats.wallSeconds <= options_.frameBudgetSeconds;
+    }
     if (progress) progress(4, 4);
     return image;
 }
 
 SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& options,
                                                FrameStats& stats, const ProgressFn& progress) {
+    const auto start = Clock::now();
     render(frame, options, stats, progress);
+    if (options_.frameBudgetSeconds > 0.0 && !singlePhaseFrame_) {
+        fillWithinBudget(start, stats);
+        stats.budgetSeconds = options_.frameBudgetSeconds;
+        stats.deadlineMet = secondsSince(start) <= options_.frameBudgetSeconds;
+    }
     return singlePhaseFrame_ ? singlePhaseSamples_ : dynamic_.samples();
+}
+
+void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& stats) {
+    if (lacking_.empty()) return;
+    const int frame = stats.index;
+    // Coarser levels first: a tile there serves four times the surface of one a level
+    // finer, and (built from its children where they are resident) costs no more.
+    std::stable_sort(
+        lacking_.begin(), lacking_.end(),
+        [](const TileRequest& a, const TileRequest& b) { return a.key.level > b.key.level; });
+    StaticCosts fills;
+    FillTiming timing;
+    timing.trace = options_.trace;
+    timing.frame = frame;
+    const auto fillStart = Clock::now();
+    size_t next = 0, chunk = 8;
+    double perTile = 0.0;  // seconds a tile, as measured so far
+    // A twentieth of the budget is kept for what follows the fills; chunks are sized to
+    // 80% of the time left at the cost a tile has had so far, so one slow chunk does not
+    // overshoot.
+    const double deadline =
+        std::max(0.95 * options_.frameBudgetSeconds,
+                 secondsSince(start) + options_.minimumStaticShare * options_.frameBudgetSeconds);
+    while (next < lacking_.size()) {
+        const double left = deadline - secondsSince(start);
+        if (perTile > 0.0)
+            chunk = static_cast<size_t>(std::clamp(0.8 * left / perTile, 0.0, 4096.0));
+        if (left <= 0.0 || chunk == 0) break;
+        const size_t end = std::min(lacking_.size(), next + chunk);
+        const std::span<const TileRequest> batch(lacking_.data() + next, end - next);
+        size_t incoming = 0;
+        for (const TileRequest& r : batch) incoming += drawn_[r.object]->map->tileBytes();
+        keepMapsInBudget(incoming, stats);
+        const auto began = Clock::now();
+        static_.fill(batch, drawn_, fills, &timing);
+        const double took = secondsSince(began);
+        perTile = std::max(perTile * 0.5, took / static_cast<double>(batch.size()));
+        for (const TileRequest& r : batch) ++reports_[r.object].staticCosts.tilesFilled;
+        next = end;
+    }
+    stats.tilesDeferred = lacking_.size() - next;
+    stats.fillSeconds += secondsSince(fillStart);
+    stats.staticSeconds += secondsSince(fillStart);
+    if (options_.trace)
+        options_.trace->span("fill", PhaseKind::Static, SpanLevel::Phase, fillStart, Clock::now(),
+                             -1, frame);
+    stats.staticInstructions += fills.instructions;
+    stats.tilesFilled += fills.tilesFilled;
+    stats.tilesFromChildren += fills.tilesFromChildren;
+    stats.texelsFilled += fills.texelsFilled;
+    for (size_t i = 0; i < timing.objectSeconds.size(); ++i) {
+        frameStaticSeconds_[i] += timing.objectSeconds[i];
+        reports_[i].staticCosts.seconds += timing.objectSeconds[i];
+        reports_[i].staticCosts.instructions += timing.objectInstructions[i];
+    }
+    stats.residentTiles = stats.residentBytes = 0;
+    for (const auto& pool : static_.tilePools().all()) {
+        stats.residentTiles += pool->tilesHeld();
+        stats.residentBytes += pool->bytesHeld();
+    }
+    lacking_.clear();
 }
 
 }  // namespace mpshade

@@ -20,6 +20,7 @@
 //      does not depend on what earlier frames filled. Filled tiles are kept.
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -60,6 +61,16 @@ struct MultiphaseOptions {
     // Where every phase reports its spans (phase_trace.h; not owned, must outlive the
     // renderer). Null: nowhere, and nothing is measured for it.
     PhaseTrace* trace = nullptr;
+    // Above 0: the frame rate is locked (`mpshade play`). A frame shades once, probes
+    // lacking tiles falling back to the finest coarser level resident; then, in the time left
+    // of this many seconds, the tiles they lacked are filled (coarser levels first: each
+    // serves more of the screen, for less) and the rest left for later frames. An object
+    // whose static phase is due is drawn from its last representation unless its last
+    // static run fits the time left; one never built is always built. 0: constant quality.
+    double frameBudgetSeconds = 0.0;
+    // With a frame budget, the share of it static work gets even when the dynamic phase
+    // took the whole budget: frames late anyway still make progress towards full quality.
+    double minimumStaticShare = 0.1;
 };
 
 // Per object, for stats.json: what the static phase chose and did.
@@ -101,6 +112,11 @@ class MultiphaseRenderer {
     // The current representation of object i (null before a frame has seen it).
     const ObjectRepresentation* representation(size_t object) const;
     const FactoredShader& factored(size_t object) const;
+    // Sets MultiphaseOptions::frameBudgetSeconds for the frames that follow (0: constant
+    // quality), as playback does after rendering its first frame at constant quality.
+    void setFrameBudget(double seconds) { options_.frameBudgetSeconds = seconds; }
+    // Overrides the scene's shading rate for the frames that follow (unset: the scene's).
+    void setShadingRate(std::optional<ShadingRate> rate) { options_.shadingRate = rate; }
     const ObjectReport& report(size_t object) const { return reports_[object]; }
     size_t objectCount() const { return reports_.size(); }
     // Per object, what the last frame cost: its static work (building, filling tiles), in
@@ -112,6 +128,9 @@ class MultiphaseRenderer {
   private:
     void render(int frame, const RenderOptions& options, FrameStats& stats,
                 const ProgressFn& progress);
+    // With a frame budget: fills this frame's lacking tiles (lacking_) until the budget,
+    // counted from `start`, is spent.
+    void fillWithinBudget(std::chrono::steady_clock::time_point start, FrameStats& stats);
     // Drops the least recently used tiles until `incoming` more bytes of tiles fit the
     // budget (or nothing the frame has not used is left).
     void keepMapsInBudget(size_t incoming, FrameStats& stats);
@@ -152,6 +171,12 @@ class MultiphaseRenderer {
     SampleBuffer singlePhaseSamples_;
     std::vector<double> frameStaticSeconds_;
     std::vector<ObjectFrameCost> frameDynamic_;
+    // With a frame budget: per object its last static run's seconds; the frame's lacking
+    // tiles; the last frame's dynamic phase (warp to resolve), seconds.
+    std::vector<double> lastBuildSeconds_;
+    std::vector<TileRequest> lacking_;
+    std::vector<const ObjectRepresentation*> drawn_;
+    double lastDynamicSeconds_ = 0.0;
 };
 
 }  // namespace mpshade

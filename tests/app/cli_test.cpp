@@ -505,8 +505,8 @@ TEST(Cli, ManyDistinctShapesAreRefusedBeforeTheirRayScenesAreBuilt) {
 
 TEST(Cli, ProfileWritesTheCostsAndATraceThatOpens) {
     const std::string out = tempDir("profile");
-    const CliRun run = mpshade("profile examples/vase/scene.json --frames 2:4 --size 96x54 --out " +
-                               out);
+    const CliRun run =
+        mpshade("profile examples/vase/scene.json --frames 2:4 --size 96x54 --out " + out);
     ASSERT_EQ(run.exitCode, 0) << run.output;
     EXPECT_NE(run.output.find("profile.md"), std::string::npos) << run.output;
     std::ifstream md(out + "/profile.md");
@@ -536,6 +536,53 @@ TEST(Cli, ProfileWritesTheCostsAndATraceThatOpens) {
     const CliRun badSpp = mpshade("profile examples/vase/scene.json --spp 0 --out " + out);
     EXPECT_EQ(badSpp.exitCode, 2) << badSpp.output;
     EXPECT_NE(badSpp.output.find("--spp"), std::string::npos) << badSpp.output;
+}
+
+TEST(Cli, PlayReportsEveryFramesDeadlineAndWritesFramesUnlessAsked) {
+    const std::string out = tempDir("play");
+    const CliRun run = mpshade(
+        "play examples/teapot/scene.json --fps 24 --frames 0:3 --size "
+        "96x54 --cache-mb 8 --out " +
+        out);
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    EXPECT_NE(run.output.find("within 1/24 s"), std::string::npos) << run.output;
+    std::ifstream statsFile(out + "/stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(statsFile);
+    EXPECT_EQ(stats["mode"], "play");
+    EXPECT_EQ(stats["cache_mb"], 8);
+    ASSERT_EQ(stats["frames"].size(), 3u);
+    int met = 0;
+    for (const nlohmann::json& f : stats["frames"]) {
+        ASSERT_TRUE(f["deadline_met"].is_boolean());
+        met += f["deadline_met"].get<bool>() ? 1 : 0;
+        EXPECT_NEAR(f["budget_seconds"].get<double>(), 1.0 / 24.0, 1e-12);
+        EXPECT_EQ(f["deadline_met"].get<bool>(),
+                  f["wall_seconds"].get<double>() <= f["budget_seconds"].get<double>());
+        EXPECT_TRUE(f["quality"]["shading_rate"].is_string());
+        EXPECT_TRUE(f["deferred"]["tiles"].is_number());
+        EXPECT_LE(f["resident_bytes"].get<double>(), 8.0 * 1024 * 1024);
+    }
+    EXPECT_EQ(stats["deadlines_met"], met);
+    for (int k = 0; k < 3; ++k)
+        EXPECT_TRUE(std::filesystem::exists(out + fmt::format("/frame_{:04d}.exr", k)));
+
+    const std::string quiet = tempDir("play_no_write");
+    const CliRun noWrite = mpshade(
+        "play examples/teapot/scene.json --frames 0:2 --size 96x54 "
+        "--no-write --quiet --out " +
+        quiet);
+    ASSERT_EQ(noWrite.exitCode, 0) << noWrite.output;
+    EXPECT_EQ(noWrite.output, "");
+    EXPECT_TRUE(std::filesystem::exists(quiet + "/stats.json"));
+    EXPECT_FALSE(std::filesystem::exists(quiet + "/frame_0000.exr"));
+
+    for (const char* bad : {"--fps 0", "--fps -3", "--cache-mb 0", "--spp 0"}) {
+        const CliRun r =
+            mpshade(std::string("play examples/teapot/scene.json ") + bad + " --out " + quiet);
+        EXPECT_EQ(r.exitCode, 2) << bad << ": " << r.output;
+        const std::string option = std::string(bad).substr(0, std::string(bad).find(' '));
+        EXPECT_NE(r.output.find(option), std::string::npos) << r.output;
+    }
 }
 
 TEST(Cli, HelpAndVersion) {

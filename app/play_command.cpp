@@ -1,0 +1,131 @@
+#include "app/play_command.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include <unistd.h>
+#include <nlohmann/json.hpp>
+
+#include "app/command_line.h"
+#include "app/image_output.h"
+#include "app/memory_limit.h"
+#include "app/output_files.h"
+#include "controller/playback.h"
+#include "geometry/error.h"
+#include "scene/scene.h"
+
+namespace mpshade {
+
+int runPlayCommand(const PlayCommandOptions& options) {
+    try {
+        if (!(options.fps >= 0.1 && options.fps <= 1000.0))
+            throw InputError({"--fps", 0, 0, {}}, "expected 0.1..1000 frames per second, found " +
+                                                      std::to_string(options.fps));
+        if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
+            throw InputError({"--spp", 0, 0, {}},
+                             "expected 1..1024, found " + std::to_string(options.spp));
+        if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
+            throw InputError({"--cache-mb", 0, 0, {}},
+                             "expected 1..1048576 MB, found " + std::to_string(options.cacheMb));
+        const Scene scene = loadScene(options.scene);
+        PlaybackOptions po;
+        po.fps = options.fps;
+        po.render.seed = options.seed;
+        po.render.samplesPerPixel = options.spp > 0 ? options.spp : 0;
+        po.cacheBytes = static_cast<size_t>(options.cacheMb) << 20;
+        parseImageSize(options.size, po.render.width, po.render.height);
+        parseFrameRange(options.frames, scene.frameCount(), po.first, po.last);
+        const int width = po.render.width > 0 ? po.render.width : scene.settings.width;
+        const int height = po.render.height > 0 ? po.render.height : scene.settings.height;
+        const int spp = options.spp > 0 ? options.spp : scene.settings.samplesPerPixel;
+        FrameMemoryEstimate estimate = estimateFrameMemory(width, height, spp, true, false, -1);
+        estimate.bytes += estimateRaySceneBytes(scene, false);
+        checkMemory(estimate, defaultMemoryLimitBytes(),
+                    !options.size.empty() || options.spp > 0 ? "--size/--spp"
+                                                             : options.scene + ": settings");
+        prepareOutputFolder(options.outDir);
+        const std::filesystem::path dir(options.outDir);
+        const bool tty = !options.quiet && isatty(STDERR_FILENO);
+
+        nlohmann::json frames = nlohmann::json::array();
+        int met = 0;
+        const auto onFrame = [&](const FrameStats& s, const Image& image, ShadingRate rate) {
+            double writeSeconds = 0.0;
+            if (!options.noWrite) {
+                const auto began = std::chrono::steady_clock::now();
+                char name[32];
+                std::snprintf(name, sizeof name, "frame_%04d", s.index);
+                const std::string base = (dir / name).string();
+                writeExr(image, base + ".exr");
+                writePng(image, base + ".png");
+                writeSeconds =
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+            }
+            met += s.deadlineMet ? 1 : 0;
+            frames.push_back(
+                {{"index", s.index},
+                 {"time", s.time},
+                 {"wall_seconds", s.wallSeconds},
+                 {"budget_seconds", s.budgetSeconds},
+                 {"deadline_met", s.deadlineMet},
+                 {"static_seconds", s.staticSeconds},
+                 {"fill_seconds", s.fillSeconds},
+                 {"warp_seconds", s.warpSeconds},
+                 {"raster_seconds", s.rasterSeconds},
+                 {"shade_seconds", s.shadeSeconds},
+                 {"resolve_seconds", s.resolveSeconds},
+                 {"write_seconds", writeSeconds},
+                 {"static_runs", s.staticRuns},
+                 {"quality",
+                  {{"shading_rate", rate == ShadingRate::Pixel ? "pixel" : "sample"},
+                   {"probes", s.probes},
+                   {"probe_fallbacks", s.probeFallbacks},
+                   {"older_representations", s.rebuildsDeferred}}},
+                 {"deferred", {{"tiles", s.tilesDeferred}, {"rebuilds", s.rebuildsDeferred}}},
+                 {"tiles_requested", s.tilesRequested},
+                 {"tiles_filled", s.tilesFilled},
+                 {"tiles_evicted", s.tilesEvicted},
+                 {"resident_bytes", s.residentBytes},
+                 {"shaded_points", s.shadedPoints}});
+            if (tty)
+                std::fprintf(stderr, "\rframe %d: %.1f ms of %.1f, %d of %zu on time", s.index,
+                             1e3 * s.wallSeconds, 1e3 * s.budgetSeconds, met, frames.size());
+        };
+        const PlaybackSummary summary = playScene(scene, po, onFrame);
+        if (tty) std::fprintf(stderr, "\n");
+        const nlohmann::json doc = {
+            {"scene", options.scene},
+            {"mode", "play"},
+            {"fps", options.fps},
+            {"width", width},
+            {"height", height},
+            {"samples_per_pixel", spp},
+            {"seed", options.seed},
+            {"cache_mb", options.cacheMb},
+            {"preroll_seconds", summary.prerollSeconds},
+            {"frames_played", summary.frames},
+            {"deadlines_met", summary.deadlinesMet},
+            {"deadline_met_fraction",
+             summary.frames > 0 ? static_cast<double>(summary.deadlinesMet) / summary.frames : 1.0},
+            {"peak_resident_mb", peakResidentBytes() >> 20},
+            {"frames", frames}};
+        writeTextFile(dir / "stats.json", doc.dump(2) + "\n");
+        if (!options.quiet)
+            std::fprintf(stderr,
+                         "mpshade: %d of %d frame(s) within 1/%g s (%.1f%%), after a %.2f s "
+                         "pre-roll; stats in %s\n",
+                         summary.deadlinesMet, summary.frames, options.fps,
+                         summary.frames > 0 ? 100.0 * summary.deadlinesMet / summary.frames : 100.0,
+                         summary.prerollSeconds, (dir / "stats.json").string().c_str());
+        return 0;
+    } catch (const InputError& e) {
+        std::fprintf(stderr, "mpshade: %s\n", e.what());
+        return 2;
+    } catch (const OutputError& e) {
+        std::fprintf(stderr, "mpshade: error: %s\n", e.what());
+        return 1;
+    }
+}
+
+}  // namespace mpshade

@@ -1,0 +1,28 @@
+// play_command.h -- `mpshade play`: frame-rate-locked playback (controller/playback.h),
+// frames written as `render` writes them (or not, with --no-write) and per frame in
+// stats.json the time of each phase, whether it met its deadline, the quality it gave up
+// and the work it left for later.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace mpshade {
+
+struct PlayCommandOptions {
+    std::string scene;   // scene file
+    std::string outDir;  // created if missing
+    double fps = 30.0;   // 0.1 .. 1000
+    std::string frames;  // "A:B" half-open, or "N"; empty = every frame
+    std::string size;    // "WxH"; empty = the scene's
+    int spp = -1;        // -1 = the scene's; else 1..1024
+    uint32_t seed = 0;
+    int64_t cacheMb = 256;  // shader-map tiles' memory budget, MB; >= 1
+    bool noWrite = false;   // measure without the disk: stats.json only
+    bool quiet = false;
+};
+
+// Returns the process exit code: 0 success, 1 output failure, 2 bad input (message on stderr).
+int runPlayCommand(const PlayCommandOptions& options);
+
+}  // namespace mpshade

@@ -1,0 +1,52 @@
+#include "controller/playback.h"
+
+#include <chrono>
+
+#include "geometry/error.h"
+
+namespace mpshade {
+
+PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
+                          const PlaybackFrameFn& onFrame) {
+    MPSHADE_CHECK(options.fps > 0.0);
+    MultiphaseOptions mo;
+    // The always-resident levels are filled as each map is made: a missing tile always has
+    // a coarser level to fall back on.
+    mo.staticPhase.shaderMap.fillPinnedUpFront = true;
+    mo.singlePhaseFrames = false;  // the reference renderer cannot keep a frame rate
+    mo.mapMemoryBytes = options.cacheBytes;
+    mo.trace = options.trace;
+    MultiphaseRenderer renderer(scene, mo);
+    renderer.plan(options.first, options.last, options.render);
+    PlaybackSummary summary;
+    if (options.first >= options.last) return summary;
+    const auto start = std::chrono::steady_clock::now();
+    FrameStats preroll;
+    renderer.renderSamples(options.first, options.render, preroll);
+    summary.prerollSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double budget = 1.0 / options.fps;
+    renderer.setFrameBudget(budget);
+    // The shading-rate regulator: per pixel once the dynamic phase takes most of the
+    // budget, per sample again once it takes little of it (hysteresis between the two, so
+    // it does not flicker frame to frame).
+    ShadingRate rate = scene.settings.shadingRate;
+    for (int frame = options.first; frame < options.last; ++frame) {
+        renderer.setShadingRate(rate);
+        FrameStats stats;
+        const Image image = renderer.renderFrame(frame, options.render, stats);
+        ++summary.frames;
+        summary.deadlinesMet += stats.deadlineMet ? 1 : 0;
+        if (onFrame) onFrame(stats, image, rate);
+        const double dynamic =
+            stats.warpSeconds + stats.rasterSeconds + stats.shadeSeconds + stats.resolveSeconds;
+        if (rate == ShadingRate::Sample && dynamic > options.slowDownAt * budget)
+            rate = ShadingRate::Pixel;
+        else if (rate == ShadingRate::Pixel && scene.settings.shadingRate == ShadingRate::Sample &&
+                 dynamic < options.speedUpAt * budget)
+            rate = ShadingRate::Sample;
+    }
+    return summary;
+}
+
+}  // namespace mpshade

@@ -1,0 +1,45 @@
+// playback.h -- frame-rate-locked playback (`mpshade play`; patent FIG. 2, controller 240):
+// every frame gets 1 / fps seconds. The dynamic phase runs first and never waits: probes
+// whose tiles are missing read the finest coarser level resident (the six coarsest levels
+// of every map are filled with it, so there always is one). What is left of the frame's
+// time goes to static work, by benefit per cost: the tiles the frame lacked, coarser levels
+// first, then nothing more -- the rest is left for later frames (MultiphaseOptions::
+// frameBudgetSeconds). An object whose static phase is due again is drawn from its last
+// representation until its rebuild fits a frame's slack.
+//
+// Before the clock starts, the first frame is rendered at constant quality (a player
+// loading its scene): every object it sees is built and every tile it asks for filled.
+#pragma once
+
+#include <functional>
+
+#include "phases/multiphase_renderer.h"
+
+namespace mpshade {
+
+struct PlaybackOptions {
+    double fps = 30.0;        // frames per second; the budget of a frame is 1 / fps
+    RenderOptions render;     // image size, samples per pixel, seed (0: the scene's)
+    int first = 0, last = 0;  // frames [first, last)
+    // The shader maps' tiles stay under this many bytes (least recently used out first;
+    // the always-resident levels are never dropped).
+    size_t cacheBytes = size_t{256} << 20;
+    PhaseTrace* trace = nullptr;  // not owned; null: no spans
+    // The shading-rate regulator: a frame whose dynamic phase took more than slowDownAt of
+    // the budget makes the next ones shade per pixel; per pixel, one under speedUpAt (half
+    // what per sample would cost, about) makes them shade per sample again.
+    double slowDownAt = 0.7, speedUpAt = 0.3;
+};
+
+struct PlaybackSummary {
+    double prerollSeconds = 0.0;  // the first frame at constant quality, before the clock
+    int frames = 0, deadlinesMet = 0;
+};
+
+// Plays frames [first, last); after each, onFrame(stats, image, the shading rate it used)
+// (its time is not the frame's: writing to disk is the caller's).
+using PlaybackFrameFn = std::function<void(const FrameStats&, const Image&, ShadingRate)>;
+PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
+                          const PlaybackFrameFn& onFrame);
+
+}  // namespace mpshade
