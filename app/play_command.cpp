@@ -7,7 +7,7 @@
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 
-#include "app/command_line.h"
+#include "app/frame_request.h"
 #include "app/image_output.h"
 #include "app/memory_limit.h"
 #include "app/output_files.h"
@@ -22,28 +22,19 @@ int runPlayCommand(const PlayCommandOptions& options) {
         if (!(options.fps >= 0.1 && options.fps <= 1000.0))
             throw InputError({"--fps", 0, 0, {}}, "expected 0.1..1000 frames per second, found " +
                                                       std::to_string(options.fps));
-        if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
-            throw InputError({"--spp", 0, 0, {}},
-                             "expected 1..1024, found " + std::to_string(options.spp));
         if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
             throw InputError({"--cache-mb", 0, 0, {}},
                              "expected 1..1048576 MB, found " + std::to_string(options.cacheMb));
-        const Scene scene = loadScene(options.scene);
+        const FrameRequest request = loadFrameRequest(
+            {options.scene, options.frames, options.size, options.spp, options.seed});
+        const Scene& scene = request.scene;
+        const int width = request.width, height = request.height, spp = request.spp;
         PlaybackOptions po;
         po.fps = options.fps;
-        po.render.seed = options.seed;
-        po.render.samplesPerPixel = options.spp > 0 ? options.spp : 0;
+        po.render = request.render;
+        po.first = request.first;
+        po.last = request.last;
         po.cacheBytes = static_cast<size_t>(options.cacheMb) << 20;
-        parseImageSize(options.size, po.render.width, po.render.height);
-        parseFrameRange(options.frames, scene.frameCount(), po.first, po.last);
-        const int width = po.render.width > 0 ? po.render.width : scene.settings.width;
-        const int height = po.render.height > 0 ? po.render.height : scene.settings.height;
-        const int spp = options.spp > 0 ? options.spp : scene.settings.samplesPerPixel;
-        FrameMemoryEstimate estimate = estimateFrameMemory(width, height, spp, true, false, -1);
-        estimate.bytes += estimateRaySceneBytes(scene, false);
-        checkMemory(estimate, defaultMemoryLimitBytes(),
-                    !options.size.empty() || options.spp > 0 ? "--size/--spp"
-                                                             : options.scene + ": settings");
         prepareOutputFolder(options.outDir);
         const std::filesystem::path dir(options.outDir);
         const bool tty = !options.quiet && isatty(STDERR_FILENO);

@@ -5,8 +5,7 @@
 
 #include <unistd.h>
 
-#include "app/command_line.h"
-#include "app/memory_limit.h"
+#include "app/frame_request.h"
 #include "app/output_files.h"
 #include "controller/cost_profile.h"
 #include "geometry/error.h"
@@ -16,23 +15,13 @@ namespace mpshade {
 
 int runProfileCommand(const ProfileCommandOptions& options) {
     try {
-        if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
-            throw InputError({"--spp", 0, 0, {}},
-                             "expected 1..1024, found " + std::to_string(options.spp));
-        const Scene scene = loadScene(options.scene);
+        const FrameRequest request = loadFrameRequest(
+            {options.scene, options.frames, options.size, options.spp, options.seed});
+        const Scene& scene = request.scene;
         ProfileOptions po;
-        po.render.seed = options.seed;
-        po.render.samplesPerPixel = options.spp > 0 ? options.spp : 0;
-        parseImageSize(options.size, po.render.width, po.render.height);
-        parseFrameRange(options.frames, scene.frameCount(), po.first, po.last);
-        const int width = po.render.width > 0 ? po.render.width : scene.settings.width;
-        const int height = po.render.height > 0 ? po.render.height : scene.settings.height;
-        const int spp = options.spp > 0 ? options.spp : scene.settings.samplesPerPixel;
-        FrameMemoryEstimate estimate = estimateFrameMemory(width, height, spp, true, false, -1);
-        estimate.bytes += estimateRaySceneBytes(scene, false);
-        checkMemory(estimate, defaultMemoryLimitBytes(),
-                    !options.size.empty() || options.spp > 0 ? "--size/--spp"
-                                                             : options.scene + ": settings");
+        po.render = request.render;
+        po.first = request.first;
+        po.last = request.last;
         prepareOutputFolder(options.outDir);
 
         std::vector<std::string> names;
