@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/frame_request.h"
+#include "app/frame_stats_json.h"
 #include "app/image_output.h"
 #include "app/memory_limit.h"
 #include "app/output_files.h"
@@ -68,6 +69,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
                  {"resolve_seconds", s.resolveSeconds},
                  {"write_seconds", writeSeconds},
                  {"static_runs", s.staticRuns},
+                 {"static_runs_due", staticRunsDueJson(scene, s)},
                  {"quality",
                   {{"shading_rate", rate == ShadingRate::Pixel ? "pixel" : "sample"},
                    {"probes", s.probes},

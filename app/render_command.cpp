@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/command_line.h"
+#include "app/frame_stats_json.h"
 #include "app/image_output.h"
 #include "app/interrupt_watch.h"
 #include "app/memory_limit.h"
@@ -205,6 +206,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
                 for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
                 entry["single_phase"] = stats.singlePhase;
                 entry["static_runs"] = stats.staticRuns;
+                entry["static_runs_due"] = staticRunsDueJson(scene, stats);
                 entry["static_seconds"] = stats.staticSeconds;
                 entry["fill_seconds"] = stats.fillSeconds;
                 entry["warp_seconds"] = stats.warpSeconds;

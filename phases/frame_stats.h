@@ -2,8 +2,39 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 namespace mpshade {
+
+// Why an object's static phase was due this frame, with the fiducial that said so (Lengyel
+// and Snyder 1997, sec. 4): geometric (the view moved out of the range: degrees the view
+// direction turned or the eye moved around the object, or the ratio of view distances),
+// sampling (facets carrying the n-tuple measured longer than P/2 last frame, pixels; the
+// image height changed). `measured` beyond `threshold` is the trigger.
+struct StaticRunDue {
+    enum Cause { FirstSeen, ViewDirection, Distance, AngleAround, FacetsTooLong, ImageSize };
+    uint32_t object = 0;
+    Cause cause = FirstSeen;
+    float measured = 0.0f, threshold = 0.0f;
+    bool deferred = false;  // a frame budget put it off: drawn from its last representation
+};
+inline const char* staticRunCauseName(StaticRunDue::Cause cause) {
+    switch (cause) {
+        case StaticRunDue::FirstSeen:
+            return "first seen";
+        case StaticRunDue::ViewDirection:
+            return "view direction left the range";
+        case StaticRunDue::Distance:
+            return "view distance left the range";
+        case StaticRunDue::AngleAround:
+            return "view moved around the object beyond the range";
+        case StaticRunDue::FacetsTooLong:
+            return "facets longer than P/2";
+        case StaticRunDue::ImageSize:
+            return "image height changed";
+    }
+    return "unknown";
+}
 
 struct FrameStats {
     int index = 0;
@@ -57,6 +88,7 @@ struct FrameStats {
     bool deadlineMet = true;
     uint64_t tilesDeferred = 0;
     int rebuildsDeferred = 0;
+    std::vector<StaticRunDue> staticRunsDue;  // every object whose static phase was due
 };
 
 }  // namespace mpshade

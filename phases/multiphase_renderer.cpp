@@ -271,11 +271,35 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         const ObjectRepresentation* rep = representations_[i].get();
         const glm::vec3 forward =
             glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
-        const bool tooCoarse =
-            rep && rep->kind == Representation::Facets && longestEdge_[i] > rep->maxEdgePixels;
-        if (!rep || !rep->inRange(state.eye, forward) || rep->imageHeight != camera.height ||
-            tooCoarse)
+        StaticRunDue due;
+        due.object = static_cast<uint32_t>(i);
+        if (!rep) {
+            stats.staticRunsDue.push_back(due);
             stale.push_back(i);
+            continue;
+        }
+        const ObjectRepresentation::RangeCheck range = rep->checkRange(state.eye, forward);
+        if (range.fiducial != ObjectRepresentation::RangeCheck::None) {
+            due.cause = range.fiducial == ObjectRepresentation::RangeCheck::ViewDirection
+                            ? StaticRunDue::ViewDirection
+                        : range.fiducial == ObjectRepresentation::RangeCheck::Distance
+                            ? StaticRunDue::Distance
+                            : StaticRunDue::AngleAround;
+            due.measured = range.measured;
+            due.threshold = range.threshold;
+        } else if (rep->imageHeight != camera.height) {
+            due.cause = StaticRunDue::ImageSize;
+            due.measured = static_cast<float>(camera.height);
+            due.threshold = static_cast<float>(rep->imageHeight);
+        } else if (rep->kind == Representation::Facets && longestEdge_[i] > rep->maxEdgePixels) {
+            due.cause = StaticRunDue::FacetsTooLong;
+            due.measured = longestEdge_[i];
+            due.threshold = rep->maxEdgePixels;
+        } else {
+            continue;
+        }
+        stats.staticRunsDue.push_back(due);
+        stale.push_back(i);
     }
     // A frame budget: what was never built is built; what is due again is rebuilt, cheapest
     // first, only while its last run fits the time left after the dynamic phase (as long as
@@ -293,6 +317,8 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
                 left -= lastBuildSeconds_[i];
             } else {
                 ++stats.rebuildsDeferred;
+                for (StaticRunDue& d : stats.staticRunsDue)
+                    if (d.object == i) d.deferred = true;
             }
         }
         std::sort(due.begin(), due.end());

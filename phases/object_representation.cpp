@@ -9,16 +9,28 @@
 namespace mpshade {
 
 bool ObjectRepresentation::inRange(const glm::vec3& eye, const glm::vec3& forward) const {
-    if (frustumCulled &&
-        glm::dot(forward, representativeForward) < std::cos(glm::radians(range.angle)))
-        return false;
+    return checkRange(eye, forward).fiducial == RangeCheck::None;
+}
+
+ObjectRepresentation::RangeCheck ObjectRepresentation::checkRange(const glm::vec3& eye,
+                                                                  const glm::vec3& forward) const {
+    RangeCheck c;
+    auto degrees = [](float cosine) {
+        return glm::degrees(std::acos(std::clamp(cosine, -1.0f, 1.0f)));
+    };
+    const float turn = glm::dot(forward, representativeForward);
+    if (frustumCulled && turn < std::cos(glm::radians(range.angle)))
+        return {RangeCheck::ViewDirection, degrees(turn), range.angle};
     const glm::vec3 a = representativeEye - center, b = eye - center;
     const float da = glm::length(a), db = glm::length(b);
-    if (!(da > 0.0f) || !(db > 0.0f)) return false;
+    if (!(da > 0.0f) || !(db > 0.0f)) return {RangeCheck::Distance, 0.0f, range.distanceFactor};
     const float ratio = db / da;
-    if (ratio > range.distanceFactor || ratio < 1.0f / range.distanceFactor) return false;
+    if (ratio > range.distanceFactor || ratio < 1.0f / range.distanceFactor)
+        return {RangeCheck::Distance, ratio, range.distanceFactor};
     const float cosine = std::clamp(glm::dot(a, b) / (da * db), -1.0f, 1.0f);
-    return std::acos(cosine) <= glm::radians(range.angle);
+    if (std::acos(cosine) > glm::radians(range.angle))
+        return {RangeCheck::AngleAround, degrees(cosine), range.angle};
+    return c;
 }
 
 }  // namespace mpshade

@@ -57,6 +57,14 @@ struct ObjectRepresentation {
     // and direction around the centre within the angle, and, if patches were frustum
     // culled, the view direction within the angle too.
     bool inRange(const glm::vec3& eye, const glm::vec3& forward) const;
+    // The geometric fiducials of a view (Lengyel and Snyder 1997, sec. 4: how far the view
+    // moved from the representative one) against the range: the first that is beyond its
+    // threshold, or none.
+    struct RangeCheck {
+        enum Fiducial { None, ViewDirection, Distance, AngleAround } fiducial = None;
+        float measured = 0.0f, threshold = 0.0f;  // degrees, or the distance ratio
+    };
+    RangeCheck checkRange(const glm::vec3& eye, const glm::vec3& forward) const;
     // Bytes of the facets and their attributes (the map is counted apart: it is shared).
     size_t bytes() const { return mesh.bytes(); }
 };
