@@ -69,6 +69,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
                  {"resolve_seconds", s.resolveSeconds},
                  {"write_seconds", writeSeconds},
                  {"static_runs", s.staticRuns},
+                 {"built_ahead", s.builtAhead},
                  {"static_runs_due", staticRunsDueJson(scene, s)},
                  {"quality",
                   {{"shading_rate", rate == ShadingRate::Pixel ? "pixel" : "sample"},

@@ -1,6 +1,7 @@
 #include "controller/playback.h"
 
 #include <chrono>
+#include <cmath>
 
 #include "geometry/error.h"
 
@@ -35,6 +36,16 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         renderer.setShadingRate(rate);
         FrameStats stats;
         const Image image = renderer.renderFrame(frame, options.render, stats);
+        const double slack = budget - stats.wallSeconds;
+        if (options.lookAheadSeconds > 0.0 && slack > 0.0) {
+            const int frames =
+                static_cast<int>(std::ceil(options.lookAheadSeconds * scene.settings.fps));
+            const double spent =
+                renderer.buildAhead(frame, frames, options.render, slack, stats.builtAhead);
+            stats.staticSeconds += spent;
+            stats.wallSeconds += spent;
+            stats.deadlineMet = stats.wallSeconds <= budget;
+        }
         ++summary.frames;
         summary.deadlinesMet += stats.deadlineMet ? 1 : 0;
         if (onFrame) onFrame(stats, image, rate);

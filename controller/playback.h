@@ -29,6 +29,10 @@ struct PlaybackOptions {
     // the budget makes the next ones shade per pixel; per pixel, one under speedUpAt (half
     // what per sample would cost, about) makes them shade per sample again.
     double slowDownAt = 0.7, speedUpAt = 0.3;
+    // Looking ahead: objects the next frames up to this many seconds of scene time will see,
+    // not built yet, are built in a frame's slack (MultiphaseRenderer::buildAhead), so an
+    // object entering the view is ready before its first frame. 0: no look-ahead.
+    double lookAheadSeconds = 0.5;
 };
 
 struct PlaybackSummary {

@@ -88,6 +88,7 @@ struct FrameStats {
     bool deadlineMet = true;
     uint64_t tilesDeferred = 0;
     int rebuildsDeferred = 0;
+    int builtAhead = 0;  // objects built in this frame's slack for frames ahead that see them
     std::vector<StaticRunDue> staticRunsDue;  // every object whose static phase was due
 };
 

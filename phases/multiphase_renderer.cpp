@@ -555,6 +555,50 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
     return singlePhaseFrame_ ? singlePhaseSamples_ : dynamic_.samples();
 }
 
+double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions& options,
+                                      double seconds, int& built) {
+    const auto start = Clock::now();
+    built = 0;
+    const size_t n = scene_.objects.size();
+    const int last = std::min(scene_.frameCount() - 1, frame + frames);
+    std::vector<uint8_t> planned(n, 0);
+    for (int f = frame + 1; f <= last; ++f) {
+        const FrameState ahead =
+            frameStateAt(resources_, f, options.width, options.height, options.samplesPerPixel);
+        for (size_t i = 0; i < n; ++i) {
+            if (representations_[i] || planned[i] ||
+                !inView(*scene_.objects[i].surface, ahead.objects[i], ahead.camera))
+                continue;
+            planned[i] = 1;
+            ObjectCostInputs in;
+            const Representation kind =
+                chooseKind(i, f, ahead.objects[i], ahead.camera, ahead.spp, in);
+            const RepresentationChoice estimate = chooseRepresentation(in, options_.costModel);
+            const double cost = kind == Representation::Facets ? estimate.facetsStaticSeconds
+                                                               : estimate.mapStaticSeconds;
+            if (secondsSince(start) + cost > seconds) continue;
+            const ScopedSpan span(options_.trace, "build ahead", PhaseKind::Static,
+                                  SpanLevel::Phase, static_cast<int64_t>(i), frame);
+            StaticCosts costs;
+            kinds_[i] = kind;
+            representations_[i] = static_.build(i, kind, ahead.objects[i], ahead.camera,
+                                                ahead.uniforms[i], nullptr, costs);
+            longestEdge_[i] = 0.0f;
+            lastBuildSeconds_[i] = costs.seconds;
+            ObjectReport& r = reports_[i];
+            r.kind = kind;
+            ++r.staticRuns;
+            r.staticCosts.runs += costs.runs;
+            r.staticCosts.seconds += costs.seconds;
+            r.staticCosts.instructions += costs.instructions;
+            r.staticCosts.tilesFilled += costs.tilesFilled;
+            ++built;
+            if (secondsSince(start) >= seconds) return secondsSince(start);
+        }
+    }
+    return secondsSince(start);
+}
+
 void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& stats) {
     if (lacking_.empty()) return;
     const int frame = stats.index;

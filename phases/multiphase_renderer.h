@@ -115,6 +115,12 @@ class MultiphaseRenderer {
     // Sets MultiphaseOptions::frameBudgetSeconds for the frames that follow (0: constant
     // quality), as playback does after rendering its first frame at constant quality.
     void setFrameBudget(double seconds) { options_.frameBudgetSeconds = seconds; }
+    // Looks ahead (Fearing 1996's prediction, patent col. 11): objects not built yet that
+    // frames (frame, frame + frames] will see are built now, each for the view of the first
+    // of those frames that sees it, nearest first, while the estimated cost of the next
+    // fits in `seconds`. Returns the seconds spent; `built` counts the objects built.
+    double buildAhead(int frame, int frames, const RenderOptions& options, double seconds,
+                      int& built);
     // Overrides the scene's shading rate for the frames that follow (unset: the scene's).
     void setShadingRate(std::optional<ShadingRate> rate) { options_.shadingRate = rate; }
     const ObjectReport& report(size_t object) const { return reports_[object]; }
