@@ -43,6 +43,9 @@ int main(int argc, char** argv) {
                         "Multiphase: every frame multi-phase, even where its static work would "
                         "cost more than rendering the frames asked for single-phase");
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
+    renderCmd->add_option("--cache-mb", render.cacheMb,
+                          "Multiphase: memory budget of the shader maps' tiles, MB (default 96; "
+                          "a frame's own tiles are kept even beyond it)");
     renderCmd->add_option("--memory-mb", render.memoryMb,
                           "Refuse a render estimated to need more memory than this (MB; "
                           "default: 3/4 of physical memory)");

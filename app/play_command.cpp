@@ -81,6 +81,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
                  {"tiles_filled", s.tilesFilled},
                  {"tiles_evicted", s.tilesEvicted},
                  {"resident_bytes", s.residentBytes},
+                 {"resident_pinned_bytes", s.residentPinnedBytes},
                  {"shaded_points", s.shadedPoints}});
             if (tty)
                 std::fprintf(stderr, "\rframe %d: %.1f ms of %.1f, %d of %zu on time", s.index,

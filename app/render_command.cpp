@@ -131,6 +131,12 @@ int runRenderCommand(const RenderCommandOptions& options) {
                         "expected 0.05..8, found " + std::to_string(options.footprintScale));
                 mo.dynamic.footprintScale = options.footprintScale;
             }
+            if (options.cacheMb != 0) {
+                if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
+                    throw InputError({"--cache-mb", 0, 0, {}}, "expected 1..1048576 MB, found " +
+                                                                   std::to_string(options.cacheMb));
+                mo.mapMemoryBytes = static_cast<size_t>(options.cacheMb) << 20;
+            }
             // --compare measures the multi-phase engine against the reference: a frame the
             // reference rendered in its place would only be compared with itself.
             mo.singlePhaseFrames = !options.noSinglePhase && !options.compare;
@@ -232,6 +238,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
                 entry["texels_filled"] = stats.texelsFilled;
                 entry["resident_tiles"] = stats.residentTiles;
                 entry["resident_bytes"] = stats.residentBytes;
+                entry["resident_pinned_bytes"] = stats.residentPinnedBytes;
                 entry["tiles_evicted"] = stats.tilesEvicted;
             }
             if (options.compare) {

@@ -25,6 +25,9 @@ struct RenderCommandOptions {
     // Multiphase: never render a frame single-phase, even where the static work it needs
     // would not pay for itself over the frames asked for (MultiphaseOptions).
     bool noSinglePhase = false;
+    // Multiphase: the shader maps' tiles' memory budget, MB (MultiphaseOptions::
+    // mapMemoryBytes); 0: its default.
+    int64_t cacheMb = 0;
 };
 
 // Returns the process exit code: 0 success, 2 bad input (message already on stderr).

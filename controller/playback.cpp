@@ -22,6 +22,9 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
     PlaybackSummary summary;
     if (options.first >= options.last) return summary;
     const auto start = std::chrono::steady_clock::now();
+    // The pre-roll has all the time it needs, but not more memory than the cache: its fills
+    // go through the budgeted path, which stops when the cache is full.
+    renderer.setFrameBudget(1e9);
     FrameStats preroll;
     renderer.renderSamples(options.first, options.render, preroll);
     summary.prerollSeconds =

@@ -7,8 +7,9 @@
 // frameBudgetSeconds). An object whose static phase is due again is drawn from its last
 // representation until its rebuild fits a frame's slack.
 //
-// Before the clock starts, the first frame is rendered at constant quality (a player
-// loading its scene): every object it sees is built and every tile it asks for filled.
+// Before the clock starts, the first frame is rendered at full quality as far as the cache
+// allows (a player loading its scene): every object it sees is built and every tile it
+// asks for filled while the tiles fit `cacheBytes`.
 #pragma once
 
 #include <functional>

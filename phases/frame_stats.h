@@ -71,8 +71,9 @@ struct FrameStats {
     uint64_t texelsFilled = 0;
     uint64_t residentTiles = 0;
     uint64_t residentBytes = 0;
-    uint64_t tilesEvicted = 0;    // dropped to keep the maps under their memory budget
-    uint64_t probes = 0;          // bilinear probes
+    uint64_t residentPinnedBytes = 0;  // of residentBytes: the always-resident levels'
+    uint64_t tilesEvicted = 0;         // dropped to keep the maps under their memory budget
+    uint64_t probes = 0;               // bilinear probes
     uint64_t probeFallbacks = 0;  // answered from a coarser level (zero when render fills first)
     int shadePasses = 0;          // shading passes: 1, plus one per round of fills
     // The frame was rendered single-phase (by the reference renderer): the static work it

@@ -466,6 +466,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     for (const auto& pool : static_.tilePools().all()) {
         stats.residentTiles += pool->tilesHeld();
         stats.residentBytes += pool->bytesHeld();
+        stats.residentPinnedBytes += pool->pinnedBytesHeld();
     }
     stats.warpSeconds = d.warpSeconds;
     stats.rasterSeconds = d.rasterSeconds;
@@ -487,11 +488,11 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     stats.wallSeconds = secondsSince(start);
 }
 
-void MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
+bool MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
     const std::vector<std::shared_ptr<TilePool>> pools = static_.tilePools().all();
     size_t bytes = 0;
     for (const auto& pool : pools) bytes += pool->bytesHeld();
-    if (bytes + incoming <= options_.mapMemoryBytes) return;
+    if (bytes + incoming <= options_.mapMemoryBytes) return true;
     std::vector<TilePool::Held> candidates;
     std::vector<size_t> tileBytes;
     for (const auto& pool : pools) {
@@ -513,6 +514,7 @@ void MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
         bytes -= tileBytes[i];
         ++stats.tilesEvicted;
     }
+    return bytes + incoming <= options_.mapMemoryBytes;
 }
 
 Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
@@ -629,7 +631,9 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         const std::span<const TileRequest> batch(lacking_.data() + next, end - next);
         size_t incoming = 0;
         for (const TileRequest& r : batch) incoming += drawn_[r.object]->map->tileBytes();
-        keepMapsInBudget(incoming, stats);
+        // Locked frame rate: the cache's budget holds (what does not fit waits, the frame
+        // reads coarser levels); constant quality fills what its frame needs regardless.
+        if (!keepMapsInBudget(incoming, stats)) break;
         const auto began = Clock::now();
         static_.fill(batch, drawn_, fills, &timing);
         const double took = secondsSince(began);
@@ -652,10 +656,11 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         reports_[i].staticCosts.seconds += timing.objectSeconds[i];
         reports_[i].staticCosts.instructions += timing.objectInstructions[i];
     }
-    stats.residentTiles = stats.residentBytes = 0;
+    stats.residentTiles = stats.residentBytes = stats.residentPinnedBytes = 0;
     for (const auto& pool : static_.tilePools().all()) {
         stats.residentTiles += pool->tilesHeld();
         stats.residentBytes += pool->bytesHeld();
+        stats.residentPinnedBytes += pool->pinnedBytesHeld();
     }
     lacking_.clear();
 }

@@ -138,8 +138,8 @@ class MultiphaseRenderer {
     // counted from `start`, is spent.
     void fillWithinBudget(std::chrono::steady_clock::time_point start, FrameStats& stats);
     // Drops the least recently used tiles until `incoming` more bytes of tiles fit the
-    // budget (or nothing the frame has not used is left).
-    void keepMapsInBudget(size_t incoming, FrameStats& stats);
+    // budget (or nothing the frame has not used is left); returns whether they fit.
+    bool keepMapsInBudget(size_t incoming, FrameStats& stats);
     Representation chooseKind(size_t object, int frame, const ObjectState& state,
                               const CameraState& camera, int spp, ObjectCostInputs& in);
     // The cost estimate's inputs that need no dicing survey (combinedFacets is left 0).

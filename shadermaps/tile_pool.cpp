@@ -31,6 +31,7 @@ int TilePool::allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t sta
     pinned_[s] = pinned ? 1 : 0;
     lastUse_[s] = stamp;
     ++held_;
+    pinnedHeld_ += pinned ? 1 : 0;
     return slot;
 }
 
@@ -41,6 +42,7 @@ void TilePool::free(int slot) {
     owner_[s] = nullptr;
     free_.push_back(slot);
     --held_;
+    pinnedHeld_ -= pinned_[s];
 }
 
 void TilePool::evictable(uint32_t before, std::vector<Held>& out) const {

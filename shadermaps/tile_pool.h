@@ -36,6 +36,8 @@ class TilePool {
     size_t tileBytes() const { return tileBytes_; }
     size_t tilesHeld() const { return held_; }
     size_t bytesHeld() const { return held_ * tileBytes_; }
+    // Of them, the always-resident levels' (never dropped).
+    size_t pinnedBytesHeld() const { return pinnedHeld_ * tileBytes_; }
     size_t bytesAllocated() const { return blockCount_ * kTilesPerBlock * tileBytes_; }
 
     int allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t stamp);
@@ -69,7 +71,7 @@ class TilePool {
     static constexpr int kTilesPerBlock = 1 << kBlockShift;
 
     size_t tileBytes_;
-    size_t held_ = 0;
+    size_t held_ = 0, pinnedHeld_ = 0;
     std::mutex mutex_;
     // Block pointers in an array that never grows: data() reads it while other threads
     // allocate.
