@@ -2,20 +2,17 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdarg>
 #include <cstdio>
+
+#include <fmt/printf.h>
 
 namespace mpshade {
 namespace {
 
-std::string format(const char* f, ...) __attribute__((format(printf, 1, 2)));
-std::string format(const char* f, ...) {
-    char buffer[512];
-    va_list args;
-    va_start(args, f);
-    std::vsnprintf(buffer, sizeof buffer, f, args);
-    va_end(args);
-    return buffer;
+// printf-style into a string, checked against the arguments' types.
+template <typename... Args>
+std::string format(const char* f, const Args&... args) {
+    return fmt::sprintf(f, args...);
 }
 
 double ms(double seconds) {
