@@ -10,6 +10,7 @@
 #include "app/frame_request.h"
 #include "app/frame_stats_json.h"
 #include "app/image_output.h"
+#include "app/interrupt_watch.h"
 #include "app/memory_limit.h"
 #include "app/output_files.h"
 #include "controller/playback.h"
@@ -42,6 +43,30 @@ int runPlayCommand(const PlayCommandOptions& options) {
 
         nlohmann::json frames = nlohmann::json::array();
         int met = 0;
+        double preroll = 0.0;
+        // stats.json, rewritten (atomically) after every frame: what a stopped playback
+        // finished is always described.
+        const auto writeStats = [&](double prerollSeconds) {
+            const int played = static_cast<int>(frames.size());
+            const nlohmann::json doc = {
+                {"scene", options.scene},
+                {"mode", "play"},
+                {"fps", options.fps},
+                {"width", width},
+                {"height", height},
+                {"samples_per_pixel", spp},
+                {"seed", options.seed},
+                {"cache_mb", options.cacheMb},
+                {"preroll_seconds", prerollSeconds},
+                {"frames_requested", po.last - po.first},
+                {"frames_played", played},
+                {"deadlines_met", met},
+                {"deadline_met_fraction", played > 0 ? static_cast<double>(met) / played : 1.0},
+                {"peak_resident_mb", peakResidentBytes() >> 20},
+                {"frames", frames}};
+            writeTextFile(dir / "stats.json", doc.dump(2) + "\n");
+        };
+        const InterruptWatch watch;
         const auto onFrame = [&](const FrameStats& s, const Image& image, ShadingRate rate) {
             double writeSeconds = 0.0;
             if (!options.noWrite) {
@@ -86,26 +111,20 @@ int runPlayCommand(const PlayCommandOptions& options) {
             if (tty)
                 std::fprintf(stderr, "\rframe %d: %.1f ms of %.1f, %d of %zu on time", s.index,
                              1e3 * s.wallSeconds, 1e3 * s.budgetSeconds, met, frames.size());
+            writeStats(preroll);
+            return !interrupted();
         };
-        const PlaybackSummary summary = playScene(scene, po, onFrame);
+        const PlaybackSummary summary =
+            playScene(scene, po, onFrame, [&](double seconds) { preroll = seconds; });
         if (tty) std::fprintf(stderr, "\n");
-        const nlohmann::json doc = {
-            {"scene", options.scene},
-            {"mode", "play"},
-            {"fps", options.fps},
-            {"width", width},
-            {"height", height},
-            {"samples_per_pixel", spp},
-            {"seed", options.seed},
-            {"cache_mb", options.cacheMb},
-            {"preroll_seconds", summary.prerollSeconds},
-            {"frames_played", summary.frames},
-            {"deadlines_met", summary.deadlinesMet},
-            {"deadline_met_fraction",
-             summary.frames > 0 ? static_cast<double>(summary.deadlinesMet) / summary.frames : 1.0},
-            {"peak_resident_mb", peakResidentBytes() >> 20},
-            {"frames", frames}};
-        writeTextFile(dir / "stats.json", doc.dump(2) + "\n");
+        writeStats(summary.prerollSeconds);
+        if (interrupted()) {
+            std::fprintf(stderr,
+                         "mpshade: stopped by the user after %zu frame(s); stats.json "
+                         "describes them\n",
+                         frames.size());
+            return 130;
+        }
         if (!options.quiet)
             std::fprintf(stderr,
                          "mpshade: %d of %d frame(s) within 1/%g s (%.1f%%), after a %.2f s "

@@ -8,7 +8,8 @@
 namespace mpshade {
 
 PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
-                          const PlaybackFrameFn& onFrame) {
+                          const PlaybackFrameFn& onFrame,
+                          const std::function<void(double)>& onPreroll) {
     MPSHADE_CHECK(options.fps > 0.0);
     MultiphaseOptions mo;
     // The always-resident levels are filled as each map is made: a missing tile always has
@@ -29,6 +30,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
     renderer.renderSamples(options.first, options.render, preroll);
     summary.prerollSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (onPreroll) onPreroll(summary.prerollSeconds);
     const double budget = 1.0 / options.fps;
     renderer.setFrameBudget(budget);
     // The shading-rate regulator: per pixel once the dynamic phase takes most of the
@@ -51,7 +53,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         }
         ++summary.frames;
         summary.deadlinesMet += stats.deadlineMet ? 1 : 0;
-        if (onFrame) onFrame(stats, image, rate);
+        if (onFrame && !onFrame(stats, image, rate)) break;
         const double dynamic =
             stats.warpSeconds + stats.rasterSeconds + stats.shadeSeconds + stats.resolveSeconds;
         if (rate == ShadingRate::Sample && dynamic > options.slowDownAt * budget)

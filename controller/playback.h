@@ -42,9 +42,12 @@ struct PlaybackSummary {
 };
 
 // Plays frames [first, last); after each, onFrame(stats, image, the shading rate it used)
-// (its time is not the frame's: writing to disk is the caller's).
-using PlaybackFrameFn = std::function<void(const FrameStats&, const Image&, ShadingRate)>;
+// (its time is not the frame's: writing to disk is the caller's), which returns false to
+// stop playback there.
+using PlaybackFrameFn = std::function<bool(const FrameStats&, const Image&, ShadingRate)>;
+// onPreroll(seconds) once the pre-roll is done, before the first frame.
 PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
-                          const PlaybackFrameFn& onFrame);
+                          const PlaybackFrameFn& onFrame,
+                          const std::function<void(double)>& onPreroll = {});
 
 }  // namespace mpshade

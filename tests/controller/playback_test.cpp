@@ -102,6 +102,7 @@ TEST(Playback, PlaysEveryFrameAndRegulatesTheShadingRate) {
             EXPECT_EQ(image.width, 96);
             rates.push_back(r);
             ++frames;
+            return true;
         });
     EXPECT_EQ(summary.frames, 4);
     EXPECT_EQ(summary.deadlinesMet, 0);
@@ -155,14 +156,18 @@ TEST(Playback, AnObjectEnteringTheViewIsBuiltBeforeItsFirstFrame) {
     options.fps = 2.0;  // half a second a frame: slack for building ahead
     std::vector<FrameStats> without, with;
     options.lookAheadSeconds = 0.0;
-    playScene(scene, options,
-              [&](const FrameStats& s, const Image&, ShadingRate) { without.push_back(s); });
+    playScene(scene, options, [&](const FrameStats& s, const Image&, ShadingRate) {
+        without.push_back(s);
+        return true;
+    });
     // Without looking ahead, the ball ahead is first seen (and built) some frames in.
     const int enters = firstSeenFrame(without, 1);
     ASSERT_GT(enters, 1);
     options.lookAheadSeconds = 1.0;
-    playScene(scene, options,
-              [&](const FrameStats& s, const Image&, ShadingRate) { with.push_back(s); });
+    playScene(scene, options, [&](const FrameStats& s, const Image&, ShadingRate) {
+        with.push_back(s);
+        return true;
+    });
     EXPECT_EQ(firstSeenFrame(with, 1), -1);  // never due: it was ready
     int builtBefore = 0;
     for (const FrameStats& s : with)
@@ -204,11 +209,14 @@ TEST(Playback, AOneMegabyteCacheHoldsEveryFrameAndStillDrawsThem) {
         EXPECT_LE(s.residentPinnedBytes, s.residentBytes);
         deferred += s.tilesDeferred;
         double covered = 0.0;
+        size_t nonFinite = 0;
         for (size_t p = 3; p < image.rgba.size(); p += 4) {
-            ASSERT_TRUE(std::isfinite(image.rgba[p - 1]));
+            nonFinite += std::isfinite(image.rgba[p - 1]) ? 0 : 1;
             covered += image.rgba[p];
         }
+        EXPECT_EQ(nonFinite, 0u);
         EXPECT_GT(covered, 0.3 * image.width * image.height);
+        return true;
     });
     EXPECT_EQ(frames, 12);
     EXPECT_GT(deferred, 0u);  // the cache, not time, left tiles unfilled
