@@ -18,23 +18,6 @@ double secondsSince(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Whether any of the object's bounding sphere lies inside the view frustum.
-bool inView(const Surface& surface, const ObjectState& state, const CameraState& camera) {
-    const Bounds3 b = surfaceBounds(surface);
-    const glm::vec3 c = glm::vec3(state.objectToWorld * glm::vec4(b.center(), 1.0f)) - camera.eye;
-    const float r = 0.5f * b.diagonal() * state.scale;
-    const float depth = glm::dot(c, camera.forward);
-    if (depth < camera.zNear - r || depth > camera.zFar + r) return false;
-    const float tx = camera.tanHalfFovY * camera.aspect, ty = camera.tanHalfFovY;
-    const glm::vec3 planes[4] = {glm::normalize(camera.right - tx * camera.forward),
-                                 glm::normalize(-camera.right - tx * camera.forward),
-                                 glm::normalize(camera.up - ty * camera.forward),
-                                 glm::normalize(-camera.up - ty * camera.forward)};
-    for (const glm::vec3& n : planes)
-        if (glm::dot(c, n) > r) return false;
-    return true;
-}
-
 }  // namespace
 
 MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptions& options)
@@ -82,8 +65,8 @@ void MultiphaseRenderer::plan(int first, int last, const RenderOptions& options)
         const float t = scene_.frameTime(f);
         const CameraState camera = cameraAt(scene_, t, w, h);
         for (size_t i = 0; i < scene_.objects.size(); ++i) {
-            const bool seen =
-                inView(*scene_.objects[i].surface, objectAt(scene_.objects[i], t, camera), camera);
+            const bool seen = objectInView(*scene_.objects[i].surface,
+                                           objectAt(scene_.objects[i], t, camera), camera);
             framesSeen_[i][static_cast<size_t>(f - first)] =
                 (f > first ? framesSeen_[i][static_cast<size_t>(f - first - 1)] : 0) +
                 (seen ? 1 : 0);
@@ -266,7 +249,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     std::vector<size_t> stale;
     for (size_t i = 0; i < n; ++i) {
         const ObjectState& state = frame_.objects[i];
-        visible[i] = inView(*scene_.objects[i].surface, state, camera) ? 1 : 0;
+        visible[i] = objectInView(*scene_.objects[i].surface, state, camera) ? 1 : 0;
         if (!visible[i]) continue;
         const ObjectRepresentation* rep = representations_[i].get();
         const glm::vec3 forward =
@@ -555,114 +538,6 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
         stats.deadlineMet = secondsSince(start) <= options_.frameBudgetSeconds;
     }
     return singlePhaseFrame_ ? singlePhaseSamples_ : dynamic_.samples();
-}
-
-double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions& options,
-                                      double seconds, int& built) {
-    const auto start = Clock::now();
-    built = 0;
-    const size_t n = scene_.objects.size();
-    const int last = std::min(scene_.frameCount() - 1, frame + frames);
-    std::vector<uint8_t> planned(n, 0);
-    for (int f = frame + 1; f <= last; ++f) {
-        const FrameState ahead =
-            frameStateAt(resources_, f, options.width, options.height, options.samplesPerPixel);
-        for (size_t i = 0; i < n; ++i) {
-            if (representations_[i] || planned[i] ||
-                !inView(*scene_.objects[i].surface, ahead.objects[i], ahead.camera))
-                continue;
-            planned[i] = 1;
-            ObjectCostInputs in;
-            const Representation kind =
-                chooseKind(i, f, ahead.objects[i], ahead.camera, ahead.spp, in);
-            const RepresentationChoice estimate = chooseRepresentation(in, options_.costModel);
-            const double cost = kind == Representation::Facets ? estimate.facetsStaticSeconds
-                                                               : estimate.mapStaticSeconds;
-            if (secondsSince(start) + cost > seconds) continue;
-            const ScopedSpan span(options_.trace, "build ahead", PhaseKind::Static,
-                                  SpanLevel::Phase, static_cast<int64_t>(i), frame);
-            StaticCosts costs;
-            kinds_[i] = kind;
-            representations_[i] = static_.build(i, kind, ahead.objects[i], ahead.camera,
-                                                ahead.uniforms[i], nullptr, costs);
-            longestEdge_[i] = 0.0f;
-            lastBuildSeconds_[i] = costs.seconds;
-            ObjectReport& r = reports_[i];
-            r.kind = kind;
-            ++r.staticRuns;
-            r.staticCosts.runs += costs.runs;
-            r.staticCosts.seconds += costs.seconds;
-            r.staticCosts.instructions += costs.instructions;
-            r.staticCosts.tilesFilled += costs.tilesFilled;
-            ++built;
-            if (secondsSince(start) >= seconds) return secondsSince(start);
-        }
-    }
-    return secondsSince(start);
-}
-
-void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& stats) {
-    if (lacking_.empty()) return;
-    const int frame = stats.index;
-    // Coarser levels first: a tile there serves four times the surface of one a level
-    // finer, and (built from its children where they are resident) costs no more.
-    std::stable_sort(
-        lacking_.begin(), lacking_.end(),
-        [](const TileRequest& a, const TileRequest& b) { return a.key.level > b.key.level; });
-    StaticCosts fills;
-    FillTiming timing;
-    timing.trace = options_.trace;
-    timing.frame = frame;
-    const auto fillStart = Clock::now();
-    size_t next = 0, chunk = 8;
-    double perTile = 0.0;  // seconds a tile, as measured so far
-    // A twentieth of the budget is kept for what follows the fills; chunks are sized to
-    // 80% of the time left at the cost a tile has had so far, so one slow chunk does not
-    // overshoot.
-    const double deadline =
-        std::max(0.95 * options_.frameBudgetSeconds,
-                 secondsSince(start) + options_.minimumStaticShare * options_.frameBudgetSeconds);
-    while (next < lacking_.size()) {
-        const double left = deadline - secondsSince(start);
-        if (perTile > 0.0)
-            chunk = static_cast<size_t>(std::clamp(0.8 * left / perTile, 0.0, 4096.0));
-        if (left <= 0.0 || chunk == 0) break;
-        const size_t end = std::min(lacking_.size(), next + chunk);
-        const std::span<const TileRequest> batch(lacking_.data() + next, end - next);
-        size_t incoming = 0;
-        for (const TileRequest& r : batch) incoming += drawn_[r.object]->map->tileBytes();
-        // Locked frame rate: the cache's budget holds (what does not fit waits, the frame
-        // reads coarser levels); constant quality fills what its frame needs regardless.
-        if (!keepMapsInBudget(incoming, stats)) break;
-        const auto began = Clock::now();
-        static_.fill(batch, drawn_, fills, &timing);
-        const double took = secondsSince(began);
-        perTile = std::max(perTile * 0.5, took / static_cast<double>(batch.size()));
-        for (const TileRequest& r : batch) ++reports_[r.object].staticCosts.tilesFilled;
-        next = end;
-    }
-    stats.tilesDeferred = lacking_.size() - next;
-    stats.fillSeconds += secondsSince(fillStart);
-    stats.staticSeconds += secondsSince(fillStart);
-    if (options_.trace)
-        options_.trace->span("fill", PhaseKind::Static, SpanLevel::Phase, fillStart, Clock::now(),
-                             -1, frame);
-    stats.staticInstructions += fills.instructions;
-    stats.tilesFilled += fills.tilesFilled;
-    stats.tilesFromChildren += fills.tilesFromChildren;
-    stats.texelsFilled += fills.texelsFilled;
-    for (size_t i = 0; i < timing.objectSeconds.size(); ++i) {
-        frameStaticSeconds_[i] += timing.objectSeconds[i];
-        reports_[i].staticCosts.seconds += timing.objectSeconds[i];
-        reports_[i].staticCosts.instructions += timing.objectInstructions[i];
-    }
-    stats.residentTiles = stats.residentBytes = stats.residentPinnedBytes = 0;
-    for (const auto& pool : static_.tilePools().all()) {
-        stats.residentTiles += pool->tilesHeld();
-        stats.residentBytes += pool->bytesHeld();
-        stats.residentPinnedBytes += pool->pinnedBytesHeld();
-    }
-    lacking_.clear();
 }
 
 }  // namespace mpshade

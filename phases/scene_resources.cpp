@@ -1,5 +1,7 @@
 #include "phases/scene_resources.h"
 
+#include <glm/geometric.hpp>
+
 #include "scene/variability.h"
 #include "shading/shader_compiler.h"
 
@@ -21,6 +23,22 @@ SceneResources::SceneResources(const Scene& scene, RayScenes rayScenes) : scene_
         r.occlusionBias = 1e-4f * std::max(surfaceBounds(*obj.surface).diagonal(), 1e-6f);
         objects_.push_back(std::move(r));
     }
+}
+
+bool objectInView(const Surface& surface, const ObjectState& state, const CameraState& camera) {
+    const Bounds3 b = surfaceBounds(surface);
+    const glm::vec3 c = glm::vec3(state.objectToWorld * glm::vec4(b.center(), 1.0f)) - camera.eye;
+    const float r = 0.5f * b.diagonal() * state.scale;
+    const float depth = glm::dot(c, camera.forward);
+    if (depth < camera.zNear - r || depth > camera.zFar + r) return false;
+    const float tx = camera.tanHalfFovY * camera.aspect, ty = camera.tanHalfFovY;
+    const glm::vec3 planes[4] = {glm::normalize(camera.right - tx * camera.forward),
+                                 glm::normalize(-camera.right - tx * camera.forward),
+                                 glm::normalize(camera.up - ty * camera.forward),
+                                 glm::normalize(-camera.up - ty * camera.forward)};
+    for (const glm::vec3& n : planes)
+        if (glm::dot(c, n) > r) return false;
+    return true;
 }
 
 FrameState frameStateAt(const SceneResources& resources, int frame, int width, int height,

@@ -63,6 +63,10 @@ struct FrameState {
     std::vector<ShadingUniforms> uniforms;
 };
 
+// Whether any of the object's bounding sphere (its surface's bounds, placed by `state`) lies
+// inside the camera's view frustum, between its near and far planes.
+bool objectInView(const Surface& surface, const ObjectState& state, const CameraState& camera);
+
 // width, height, spp: 0 takes the scene's setting.
 FrameState frameStateAt(const SceneResources& resources, int frame, int width, int height, int spp);
 

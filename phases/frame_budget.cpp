@@ -1,0 +1,128 @@
+// frame_budget.cpp -- MultiphaseRenderer's mechanisms for a locked frame rate
+// (MultiphaseOptions::frameBudgetSeconds; the policy that drives them is
+// controller/playback.h): the lacking tiles filled in the time left of a frame, and
+// objects built ahead of the frames that will see them.
+#include <algorithm>
+#include <chrono>
+
+#include "phases/multiphase_renderer.h"
+
+namespace mpshade {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions& options,
+                                      double seconds, int& built) {
+    const auto start = Clock::now();
+    built = 0;
+    const size_t n = scene_.objects.size();
+    const int last = std::min(scene_.frameCount() - 1, frame + frames);
+    std::vector<uint8_t> planned(n, 0);
+    for (int f = frame + 1; f <= last; ++f) {
+        const FrameState ahead =
+            frameStateAt(resources_, f, options.width, options.height, options.samplesPerPixel);
+        for (size_t i = 0; i < n; ++i) {
+            if (representations_[i] || planned[i] ||
+                !objectInView(*scene_.objects[i].surface, ahead.objects[i], ahead.camera))
+                continue;
+            planned[i] = 1;
+            ObjectCostInputs in;
+            const Representation kind =
+                chooseKind(i, f, ahead.objects[i], ahead.camera, ahead.spp, in);
+            const RepresentationChoice estimate = chooseRepresentation(in, options_.costModel);
+            const double cost = kind == Representation::Facets ? estimate.facetsStaticSeconds
+                                                               : estimate.mapStaticSeconds;
+            if (secondsSince(start) + cost > seconds) continue;
+            const ScopedSpan span(options_.trace, "build ahead", PhaseKind::Static,
+                                  SpanLevel::Phase, static_cast<int64_t>(i), frame);
+            StaticCosts costs;
+            kinds_[i] = kind;
+            representations_[i] = static_.build(i, kind, ahead.objects[i], ahead.camera,
+                                                ahead.uniforms[i], nullptr, costs);
+            longestEdge_[i] = 0.0f;
+            lastBuildSeconds_[i] = costs.seconds;
+            ObjectReport& r = reports_[i];
+            r.kind = kind;
+            ++r.staticRuns;
+            r.staticCosts.runs += costs.runs;
+            r.staticCosts.seconds += costs.seconds;
+            r.staticCosts.instructions += costs.instructions;
+            r.staticCosts.tilesFilled += costs.tilesFilled;
+            ++built;
+            if (secondsSince(start) >= seconds) return secondsSince(start);
+        }
+    }
+    return secondsSince(start);
+}
+
+void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& stats) {
+    if (lacking_.empty()) return;
+    const int frame = stats.index;
+    // Coarser levels first: a tile there serves four times the surface of one a level
+    // finer, and (built from its children where they are resident) costs no more.
+    std::stable_sort(
+        lacking_.begin(), lacking_.end(),
+        [](const TileRequest& a, const TileRequest& b) { return a.key.level > b.key.level; });
+    StaticCosts fills;
+    FillTiming timing;
+    timing.trace = options_.trace;
+    timing.frame = frame;
+    const auto fillStart = Clock::now();
+    size_t next = 0, chunk = 8;
+    double perTile = 0.0;  // seconds a tile, as measured so far
+    // A twentieth of the budget is kept for what follows the fills; chunks are sized to
+    // 80% of the time left at the cost a tile has had so far, so one slow chunk does not
+    // overshoot.
+    const double deadline =
+        std::max(0.95 * options_.frameBudgetSeconds,
+                 secondsSince(start) + options_.minimumStaticShare * options_.frameBudgetSeconds);
+    while (next < lacking_.size()) {
+        const double left = deadline - secondsSince(start);
+        if (perTile > 0.0)
+            chunk = static_cast<size_t>(std::clamp(0.8 * left / perTile, 0.0, 4096.0));
+        if (left <= 0.0 || chunk == 0) break;
+        const size_t end = std::min(lacking_.size(), next + chunk);
+        const std::span<const TileRequest> batch(lacking_.data() + next, end - next);
+        size_t incoming = 0;
+        for (const TileRequest& r : batch) incoming += drawn_[r.object]->map->tileBytes();
+        // Locked frame rate: the cache's budget holds (what does not fit waits, the frame
+        // reads coarser levels); constant quality fills what its frame needs regardless.
+        if (!keepMapsInBudget(incoming, stats)) break;
+        const auto began = Clock::now();
+        static_.fill(batch, drawn_, fills, &timing);
+        const double took = secondsSince(began);
+        perTile = std::max(perTile * 0.5, took / static_cast<double>(batch.size()));
+        for (const TileRequest& r : batch) ++reports_[r.object].staticCosts.tilesFilled;
+        next = end;
+    }
+    stats.tilesDeferred = lacking_.size() - next;
+    stats.fillSeconds += secondsSince(fillStart);
+    stats.staticSeconds += secondsSince(fillStart);
+    if (options_.trace)
+        options_.trace->span("fill", PhaseKind::Static, SpanLevel::Phase, fillStart, Clock::now(),
+                             -1, frame);
+    stats.staticInstructions += fills.instructions;
+    stats.tilesFilled += fills.tilesFilled;
+    stats.tilesFromChildren += fills.tilesFromChildren;
+    stats.texelsFilled += fills.texelsFilled;
+    for (size_t i = 0; i < timing.objectSeconds.size(); ++i) {
+        frameStaticSeconds_[i] += timing.objectSeconds[i];
+        reports_[i].staticCosts.seconds += timing.objectSeconds[i];
+        reports_[i].staticCosts.instructions += timing.objectInstructions[i];
+    }
+    stats.residentTiles = stats.residentBytes = stats.residentPinnedBytes = 0;
+    for (const auto& pool : static_.tilePools().all()) {
+        stats.residentTiles += pool->tilesHeld();
+        stats.residentBytes += pool->bytesHeld();
+        stats.residentPinnedBytes += pool->pinnedBytesHeld();
+    }
+    lacking_.clear();
+}
+
+}  // namespace mpshade
