@@ -14,8 +14,8 @@ struct CompareCommandOptions {
 };
 
 // Prints PSNR, RMSE, largest error and coverage difference, and writes the difference
-// image if asked. Returns the exit code: 0, or 2 for images that cannot be read or differ in
-// size, or a difference image that cannot be written (message on stderr).
+// image if asked. Returns the exit code, 0. Images that cannot be read or differ in size, or
+// a difference image that cannot be written, throw InputError (the CLI exits 2).
 int runCompareCommand(const CompareCommandOptions& options);
 
 }  // namespace mpshade

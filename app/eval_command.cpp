@@ -121,138 +121,128 @@ std::string sceneName(const std::string& path, std::set<std::string>& taken) {
 }  // namespace
 
 int runEvalCommand(const EvalCommandOptions& options) {
-    try {
-        if (options.scenes.empty())
-            throw InputError({"scenes", 0, 0, {}}, "name at least one scene file");
-        if (options.truthSpp < 2 || options.truthSpp > 1024)
-            throw InputError({"--truth-spp", 0, 0, {}},
-                             "expected 2..1024, found " + std::to_string(options.truthSpp));
-        int width = 0, height = 0;
-        parseImageSize(options.size, width, height);
-        // Every scene is loaded (and so checked) before any work starts.
-        std::vector<Scene> loaded;
-        for (const std::string& path : options.scenes) loaded.push_back(loadScene(path));
-        std::vector<std::pair<int, int>> ranges;
-        for (size_t s = 0; s < loaded.size(); ++s) {
-            int first, last;
-            parseFrameRange(options.frames, loaded[s].frameCount(), first, last, options.scenes[s]);
-            ranges.emplace_back(first, last);
-        }
-        prepareOutputFolder(options.outDir);
-        const std::filesystem::path out(options.outDir);
-        const bool tty = !options.quiet && isatty(STDERR_FILENO);
-
-        std::vector<SceneEvaluation> evaluations;
-        std::vector<std::vector<std::string>> plots;
-        std::set<std::string> names;
-        nlohmann::json doc = {{"version", 1},
-                              {"truth_spp", options.truthSpp},
-                              {"quick", options.quick},
-                              {"scenes", nlohmann::json::array()}};
-        for (size_t s = 0; s < loaded.size(); ++s) {
-            const Scene& scene = loaded[s];
-            SceneEvaluation e;
-            e.scene = options.scenes[s];
-            e.name = sceneName(e.scene, names);
-            // --quick: half the width and height (a quarter of the samples), every frame: the
-            // static work is amortized as in the full render.
-            const int shrink = options.quick && !options.fullSize && width == 0 ? 2 : 1;
-            e.width = width > 0 ? width : std::max(1, scene.settings.width / shrink);
-            e.height = height > 0 ? height : std::max(1, scene.settings.height / shrink);
-            e.spp = scene.settings.samplesPerPixel;
-            e.first = ranges[s].first;
-            e.last = ranges[s].second;
-            e.truthSpp = options.truthSpp;
-            const int frames = e.last - e.first;
-            RenderOptions base;
-            base.width = e.width;
-            base.height = e.height;
-
-            const std::vector<EvalConfig> configs = ladders(e.spp, options.quick);
-            SweepProgress progress(tty, e.name, frames * static_cast<int>(configs.size() + 2));
-            if (!options.quiet && !tty)
-                std::fprintf(stderr, "mpshade eval: %s: %d configurations over %d frames\n",
-                             e.name.c_str(), static_cast<int>(configs.size()) + 1, frames);
-
-            // The truth, from the cache where it has it.
-            // The truth's samples are drawn with another seed than the ladders': a rung at
-            // the truth's own spp would otherwise be the truth itself, and the lower ones
-            // might share its first samples.
-            RenderOptions dense = base;
-            dense.samplesPerPixel = e.truthSpp;
-            dense.seed = base.seed ^ 0x9e3779b9u;
-            const TruthKey key{sceneContentHash(e.scene), e.width, e.height, e.truthSpp,
-                               dense.seed};
-            const std::filesystem::path truthDir = key.folder(out);
-            std::vector<Image> truth;
-            {
-                std::unique_ptr<ReferenceRenderer> reference;
-                const auto start = Clock::now();
-                for (int f = e.first; f < e.last; ++f) {
-                    std::optional<Image> cached = readTruthFrame(truthDir, f, e.width, e.height);
-                    if (cached) {
-                        truth.push_back(std::move(*cached));
-                        ++e.truthFramesCached;
-                    } else {
-                        if (!reference) reference = std::make_unique<ReferenceRenderer>(scene);
-                        FrameStats stats;
-                        truth.push_back(reference->renderFrame(f, dense, stats));
-                        writeTruthFrame(truthDir, f, truth.back());
-                        ++e.truthFramesRendered;
-                    }
-                    progress.step("truth");
-                }
-                e.truthSeconds = std::chrono::duration<double>(Clock::now() - start).count();
-                e.truthSelfPsnr = psnrOfMse(meanSquaredError(truth[0], truth[0]));
-            }
-
-            for (const EvalConfig& c : configs) {
-                e.runs.push_back(runEvalConfig(e.scene, c, e.first, e.last, base, truth,
-                                               [&] { progress.step(c.label); }));
-                if (c.multiphase && c.knob == "default") e.defaultRun = e.runs.size() - 1;
-                if (!c.multiphase && c.spp == e.spp) e.referenceAtSpp = e.runs.size() - 1;
-            }
-            EvalConfig cut = e.runs[e.defaultRun].config;
-            cut.knob = "cut_every_frame";
-            cut.label = "mp default, cut every frame";
-            cut.cutEveryFrame = true;
-            e.worstCase = runEvalConfig(e.scene, cut, e.first, e.last, base, truth,
-                                        [&] { progress.step(cut.label); });
-            progress.finish();
-            summarize(e);
-
-            // Images of the first frame for the report: truth, reference and multi-phase.
-            const std::filesystem::path folder = out / e.name;
-            std::filesystem::create_directories(folder);
-            writePng(truth[0], (folder / "truth_first_frame.png").string());
-            plots.push_back(writePlots(e, out));
-            doc["scenes"].push_back(toJson(e));
-            writeTextFile(out / "eval.json", doc.dump(2) + "\n");
-            evaluations.push_back(std::move(e));
-            writeTextFile(out / "report.md", reportMarkdown(evaluations, plots));
-            if (!options.quiet) {
-                const SceneEvaluation& done = evaluations.back();
-                std::fprintf(stderr,
-                             "mpshade eval: %s: speedup at equal PSNR %.2fx (whole sequence, "
-                             "defaults at %.2f dB), %.2fx at the reference's %.2f dB; a cut "
-                             "every frame %+.1f%%\n",
-                             done.name.c_str(), done.atDefault.sequence, done.atDefault.psnr,
-                             done.atReferencePsnr.sequence, done.atReferencePsnr.psnr,
-                             100.0 * done.worstCaseOverhead);
-            }
-        }
-        if (!options.quiet)
-            std::fprintf(stderr, "mpshade eval: wrote %s, %s and the plots\n",
-                         (out / "eval.json").string().c_str(),
-                         (out / "report.md").string().c_str());
-        return 0;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "mpshade: %s\n", e.what());
-        return 2;
-    } catch (const OutputError& e) {
-        std::fprintf(stderr, "mpshade: error: %s\n", e.what());
-        return 1;
+    if (options.scenes.empty())
+        throw InputError({"scenes", 0, 0, {}}, "name at least one scene file");
+    if (options.truthSpp < 2 || options.truthSpp > 1024)
+        throw InputError({"--truth-spp", 0, 0, {}},
+                         "expected 2..1024, found " + std::to_string(options.truthSpp));
+    int width = 0, height = 0;
+    parseImageSize(options.size, width, height);
+    // Every scene is loaded (and so checked) before any work starts.
+    std::vector<Scene> loaded;
+    for (const std::string& path : options.scenes) loaded.push_back(loadScene(path));
+    std::vector<std::pair<int, int>> ranges;
+    for (size_t s = 0; s < loaded.size(); ++s) {
+        int first, last;
+        parseFrameRange(options.frames, loaded[s].frameCount(), first, last, options.scenes[s]);
+        ranges.emplace_back(first, last);
     }
+    prepareOutputFolder(options.outDir);
+    const std::filesystem::path out(options.outDir);
+    const bool tty = !options.quiet && isatty(STDERR_FILENO);
+
+    std::vector<SceneEvaluation> evaluations;
+    std::vector<std::vector<std::string>> plots;
+    std::set<std::string> names;
+    nlohmann::json doc = {{"version", 1},
+                          {"truth_spp", options.truthSpp},
+                          {"quick", options.quick},
+                          {"scenes", nlohmann::json::array()}};
+    for (size_t s = 0; s < loaded.size(); ++s) {
+        const Scene& scene = loaded[s];
+        SceneEvaluation e;
+        e.scene = options.scenes[s];
+        e.name = sceneName(e.scene, names);
+        // --quick: half the width and height (a quarter of the samples), every frame: the
+        // static work is amortized as in the full render.
+        const int shrink = options.quick && !options.fullSize && width == 0 ? 2 : 1;
+        e.width = width > 0 ? width : std::max(1, scene.settings.width / shrink);
+        e.height = height > 0 ? height : std::max(1, scene.settings.height / shrink);
+        e.spp = scene.settings.samplesPerPixel;
+        e.first = ranges[s].first;
+        e.last = ranges[s].second;
+        e.truthSpp = options.truthSpp;
+        const int frames = e.last - e.first;
+        RenderOptions base;
+        base.width = e.width;
+        base.height = e.height;
+
+        const std::vector<EvalConfig> configs = ladders(e.spp, options.quick);
+        SweepProgress progress(tty, e.name, frames * static_cast<int>(configs.size() + 2));
+        if (!options.quiet && !tty)
+            std::fprintf(stderr, "mpshade eval: %s: %d configurations over %d frames\n",
+                         e.name.c_str(), static_cast<int>(configs.size()) + 1, frames);
+
+        // The truth, from the cache where it has it.
+        // The truth's samples are drawn with another seed than the ladders': a rung at
+        // the truth's own spp would otherwise be the truth itself, and the lower ones
+        // might share its first samples.
+        RenderOptions dense = base;
+        dense.samplesPerPixel = e.truthSpp;
+        dense.seed = base.seed ^ 0x9e3779b9u;
+        const TruthKey key{sceneContentHash(e.scene), e.width, e.height, e.truthSpp, dense.seed};
+        const std::filesystem::path truthDir = key.folder(out);
+        std::vector<Image> truth;
+        {
+            std::unique_ptr<ReferenceRenderer> reference;
+            const auto start = Clock::now();
+            for (int f = e.first; f < e.last; ++f) {
+                std::optional<Image> cached = readTruthFrame(truthDir, f, e.width, e.height);
+                if (cached) {
+                    truth.push_back(std::move(*cached));
+                    ++e.truthFramesCached;
+                } else {
+                    if (!reference) reference = std::make_unique<ReferenceRenderer>(scene);
+                    FrameStats stats;
+                    truth.push_back(reference->renderFrame(f, dense, stats));
+                    writeTruthFrame(truthDir, f, truth.back());
+                    ++e.truthFramesRendered;
+                }
+                progress.step("truth");
+            }
+            e.truthSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+            e.truthSelfPsnr = psnrOfMse(meanSquaredError(truth[0], truth[0]));
+        }
+
+        for (const EvalConfig& c : configs) {
+            e.runs.push_back(runEvalConfig(e.scene, c, e.first, e.last, base, truth,
+                                           [&] { progress.step(c.label); }));
+            if (c.multiphase && c.knob == "default") e.defaultRun = e.runs.size() - 1;
+            if (!c.multiphase && c.spp == e.spp) e.referenceAtSpp = e.runs.size() - 1;
+        }
+        EvalConfig cut = e.runs[e.defaultRun].config;
+        cut.knob = "cut_every_frame";
+        cut.label = "mp default, cut every frame";
+        cut.cutEveryFrame = true;
+        e.worstCase = runEvalConfig(e.scene, cut, e.first, e.last, base, truth,
+                                    [&] { progress.step(cut.label); });
+        progress.finish();
+        summarize(e);
+
+        // Images of the first frame for the report: truth, reference and multi-phase.
+        const std::filesystem::path folder = out / e.name;
+        std::filesystem::create_directories(folder);
+        writePng(truth[0], (folder / "truth_first_frame.png").string());
+        plots.push_back(writePlots(e, out));
+        doc["scenes"].push_back(toJson(e));
+        writeTextFile(out / "eval.json", doc.dump(2) + "\n");
+        evaluations.push_back(std::move(e));
+        writeTextFile(out / "report.md", reportMarkdown(evaluations, plots));
+        if (!options.quiet) {
+            const SceneEvaluation& done = evaluations.back();
+            std::fprintf(stderr,
+                         "mpshade eval: %s: speedup at equal PSNR %.2fx (whole sequence, "
+                         "defaults at %.2f dB), %.2fx at the reference's %.2f dB; a cut "
+                         "every frame %+.1f%%\n",
+                         done.name.c_str(), done.atDefault.sequence, done.atDefault.psnr,
+                         done.atReferencePsnr.sequence, done.atReferencePsnr.psnr,
+                         100.0 * done.worstCaseOverhead);
+        }
+    }
+    if (!options.quiet)
+        std::fprintf(stderr, "mpshade eval: wrote %s, %s and the plots\n",
+                     (out / "eval.json").string().c_str(), (out / "report.md").string().c_str());
+    return 0;
 }
 
 }  // namespace mpshade

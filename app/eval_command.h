@@ -21,8 +21,9 @@ struct EvalCommandOptions {
     bool quiet = false;
 };
 
-// Returns the exit code: 0, 2 for bad input (message on stderr), 1 if a file cannot be
-// written.
+// Returns the exit code, 0.
+// Bad input throws InputError naming its place (the CLI prints it and exits 2); a file
+// that cannot be written throws OutputError (exit 1).
 int runEvalCommand(const EvalCommandOptions& options);
 
 }  // namespace mpshade

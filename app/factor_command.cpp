@@ -55,133 +55,127 @@ ShaderBinding defaultBinding() {
 }  // namespace
 
 int runFactorCommand(const FactorCommandOptions& options) {
-    try {
-        auto ast = loadShaderFile(options.shader);
-        ShaderBinding binding = defaultBinding();
-        std::string bindingText =
-            "parameters at their defaults, a fixed ambient and a fixed distant light";
-        if (!options.scene.empty() || !options.object.empty()) {
-            if (options.scene.empty())
-                throw InputError({"--object", 0, 0, {}}, "--object needs --scene");
-            if (options.object.empty())
-                throw InputError({"--scene", 0, 0, {}}, "--scene needs --object NAME");
-            const Scene scene = loadScene(options.scene);
-            const SceneObject* object = nullptr;
-            std::string names;
-            for (const SceneObject& o : scene.objects) {
-                if (o.name == options.object) object = &o;
-                names += (names.empty() ? "" : ", ") + o.name;
-            }
-            if (!object)
-                throw InputError({"--object", 0, 0, {}}, "no object named '" + options.object +
-                                                             "' in " + options.scene +
-                                                             " (objects: " + names + ")");
-            for (const ParamValue& p : object->params) {
-                bool declared = false;
-                for (const ParamDecl& d : ast->params) declared = declared || d.name == p.name;
-                if (!declared)
-                    throw InputError({options.shader, 0, 0, {}},
-                                     "object '" + object->name + "' binds parameter '" + p.name +
-                                         "', which this shader does not declare");
-            }
-            binding = bindingOf(scene, *object);
-            bindingText = "object '" + object->name + "' in " + options.scene;
+    auto ast = loadShaderFile(options.shader);
+    ShaderBinding binding = defaultBinding();
+    std::string bindingText =
+        "parameters at their defaults, a fixed ambient and a fixed distant light";
+    if (!options.scene.empty() || !options.object.empty()) {
+        if (options.scene.empty())
+            throw InputError({"--object", 0, 0, {}}, "--object needs --scene");
+        if (options.object.empty())
+            throw InputError({"--scene", 0, 0, {}}, "--scene needs --object NAME");
+        const Scene scene = loadScene(options.scene);
+        const SceneObject* object = nullptr;
+        std::string names;
+        for (const SceneObject& o : scene.objects) {
+            if (o.name == options.object) object = &o;
+            names += (names.empty() ? "" : ", ") + o.name;
         }
-        FactorOptions factorOptions;
-        factorOptions.storeAboveCost = options.storeAboveCost;
-        const FactoredShader f = factorShader(*ast, binding, factorOptions);
-        const double ratio =
-            f.staticInstructions > 0 ? double(f.dynamicInstructions) / f.staticInstructions : 0.0;
-
-        if (options.json) {
-            nlohmann::json channels = nlohmann::json::array();
-            for (size_t k = 0; k < f.channels.size(); ++k) {
-                const ChannelInfo& c = f.channels[k];
-                channels.push_back({{"index", k},
-                                    {"name", c.name},
-                                    {"type", typeName(c.type)},
-                                    {"component", c.component},
-                                    {"line", c.line},
-                                    {"column", c.column},
-                                    {"op", opName(c.op)},
-                                    {"source", sourceLine(ast->source, c.line)}});
-            }
-            nlohmann::json lines = nlohmann::json::array();
-            for (const DynamicLine& l : f.dynamicLines)
-                lines.push_back({{"line", l.line},
-                                 {"source", sourceLine(ast->source, l.line)},
-                                 {"chain", l.chain}});
-            nlohmann::json doc = {{"shader", ast->name},
-                                  {"file", options.shader},
-                                  {"binding", bindingText},
-                                  {"naive_width", f.naiveWidth},
-                                  {"chosen_width", f.chosenWidth},
-                                  {"channels", channels},
-                                  {"instructions",
-                                   {{"unfactored", f.originalInstructions},
-                                    {"static", f.staticInstructions},
-                                    {"dynamic", f.dynamicInstructions}}},
-                                  {"cost",
-                                   {{"unfactored", f.originalCost},
-                                    {"static", f.staticCost},
-                                    {"dynamic", f.dynamicCost},
-                                    {"static_repeated", f.recomputedStaticCost}}},
-                                  {"dynamic_to_static_instructions", ratio},
-                                  {"dynamic_lines", lines}};
-            std::printf("%s\n", doc.dump(2).c_str());
-            return 0;
+        if (!object)
+            throw InputError({"--object", 0, 0, {}}, "no object named '" + options.object +
+                                                         "' in " + options.scene +
+                                                         " (objects: " + names + ")");
+        for (const ParamValue& p : object->params) {
+            bool declared = false;
+            for (const ParamDecl& d : ast->params) declared = declared || d.name == p.name;
+            if (!declared)
+                throw InputError({options.shader, 0, 0, {}},
+                                 "object '" + object->name + "' binds parameter '" + p.name +
+                                     "', which this shader does not declare");
         }
-
-        std::printf("%s (%s), factored for %s\n\n", ast->name.c_str(), options.shader.c_str(),
-                    bindingText.c_str());
-        std::printf(
-            "n-tuple: %d float%s (storing every static value a dynamic operation reads: %d)\n",
-            f.chosenWidth, f.chosenWidth == 1 ? "" : "s", f.naiveWidth);
-        if (f.recomputedStaticCost > 0)
-            std::printf(
-                "  %s: %d cost units of static work a point, cheaper to repeat than "
-                "to read back (--store-above-cost %d), run by the dynamic part\n",
-                f.chosenWidth == 0 ? "nothing stored" : "some not stored", f.recomputedStaticCost,
-                factorOptions.storeAboveCost);
-        if (!f.channels.empty())
-            std::printf("  %-9s %-7s %-18s %s\n", "channel", "type", "holds", "computed at");
-        for (size_t k = 0; k < f.channels.size();) {
-            const int group = groupSize(f.channels, k);
-            const ChannelInfo& c = f.channels[k];
-            const std::string index =
-                group == 3 ? std::to_string(k) + "-" + std::to_string(k + 2) : std::to_string(k);
-            const char* type = group == 3 ? typeName(c.type) : "float";
-            std::printf("  %-9s %-7s %-18s line %d:%d  %s\n", index.c_str(), type,
-                        channelLabel(c, group).c_str(), c.line, c.column,
-                        sourceLine(ast->source, c.line).c_str());
-            k += static_cast<size_t>(group);
-        }
-        std::printf("\nper sample         instructions   cost units\n");
-        std::printf("  unfactored       %12d %12d\n", f.originalInstructions, f.originalCost);
-        std::printf("  static part      %12d %12d\n", f.staticInstructions, f.staticCost);
-        std::printf("  dynamic part     %12d %12d\n", f.dynamicInstructions, f.dynamicCost);
-        if (f.staticInstructions > 0)
-            std::printf("  dynamic/static   %12.2f %12.2f\n", ratio,
-                        f.staticCost > 0 ? double(f.dynamicCost) / f.staticCost : 0.0);
-        std::printf("\ndynamic lines (and the input that reaches them):\n");
-        if (f.dynamicLines.empty())
-            std::printf("  none: the whole shader is static for this binding\n");
-        for (const DynamicLine& l : f.dynamicLines) {
-            std::printf("  %3d | %s\n", l.line, sourceLine(ast->source, l.line).c_str());
-            std::string chain;
-            for (const std::string& step : l.chain)
-                chain += (chain.empty() ? "" : "\n        <- ") + step;
-            std::printf("        <- %s\n", chain.c_str());
-        }
-        if (options.dump) {
-            std::printf("\nstatic part:\n%s\ndynamic part:\n%s", f.staticPart.dump().c_str(),
-                        f.dynamicPart.dump().c_str());
-        }
-        return 0;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "mpshade: %s\n", e.what());
-        return 2;
+        binding = bindingOf(scene, *object);
+        bindingText = "object '" + object->name + "' in " + options.scene;
     }
+    FactorOptions factorOptions;
+    factorOptions.storeAboveCost = options.storeAboveCost;
+    const FactoredShader f = factorShader(*ast, binding, factorOptions);
+    const double ratio =
+        f.staticInstructions > 0 ? double(f.dynamicInstructions) / f.staticInstructions : 0.0;
+
+    if (options.json) {
+        nlohmann::json channels = nlohmann::json::array();
+        for (size_t k = 0; k < f.channels.size(); ++k) {
+            const ChannelInfo& c = f.channels[k];
+            channels.push_back({{"index", k},
+                                {"name", c.name},
+                                {"type", typeName(c.type)},
+                                {"component", c.component},
+                                {"line", c.line},
+                                {"column", c.column},
+                                {"op", opName(c.op)},
+                                {"source", sourceLine(ast->source, c.line)}});
+        }
+        nlohmann::json lines = nlohmann::json::array();
+        for (const DynamicLine& l : f.dynamicLines)
+            lines.push_back({{"line", l.line},
+                             {"source", sourceLine(ast->source, l.line)},
+                             {"chain", l.chain}});
+        nlohmann::json doc = {{"shader", ast->name},
+                              {"file", options.shader},
+                              {"binding", bindingText},
+                              {"naive_width", f.naiveWidth},
+                              {"chosen_width", f.chosenWidth},
+                              {"channels", channels},
+                              {"instructions",
+                               {{"unfactored", f.originalInstructions},
+                                {"static", f.staticInstructions},
+                                {"dynamic", f.dynamicInstructions}}},
+                              {"cost",
+                               {{"unfactored", f.originalCost},
+                                {"static", f.staticCost},
+                                {"dynamic", f.dynamicCost},
+                                {"static_repeated", f.recomputedStaticCost}}},
+                              {"dynamic_to_static_instructions", ratio},
+                              {"dynamic_lines", lines}};
+        std::printf("%s\n", doc.dump(2).c_str());
+        return 0;
+    }
+
+    std::printf("%s (%s), factored for %s\n\n", ast->name.c_str(), options.shader.c_str(),
+                bindingText.c_str());
+    std::printf("n-tuple: %d float%s (storing every static value a dynamic operation reads: %d)\n",
+                f.chosenWidth, f.chosenWidth == 1 ? "" : "s", f.naiveWidth);
+    if (f.recomputedStaticCost > 0)
+        std::printf(
+            "  %s: %d cost units of static work a point, cheaper to repeat than "
+            "to read back (--store-above-cost %d), run by the dynamic part\n",
+            f.chosenWidth == 0 ? "nothing stored" : "some not stored", f.recomputedStaticCost,
+            factorOptions.storeAboveCost);
+    if (!f.channels.empty())
+        std::printf("  %-9s %-7s %-18s %s\n", "channel", "type", "holds", "computed at");
+    for (size_t k = 0; k < f.channels.size();) {
+        const int group = groupSize(f.channels, k);
+        const ChannelInfo& c = f.channels[k];
+        const std::string index =
+            group == 3 ? std::to_string(k) + "-" + std::to_string(k + 2) : std::to_string(k);
+        const char* type = group == 3 ? typeName(c.type) : "float";
+        std::printf("  %-9s %-7s %-18s line %d:%d  %s\n", index.c_str(), type,
+                    channelLabel(c, group).c_str(), c.line, c.column,
+                    sourceLine(ast->source, c.line).c_str());
+        k += static_cast<size_t>(group);
+    }
+    std::printf("\nper sample         instructions   cost units\n");
+    std::printf("  unfactored       %12d %12d\n", f.originalInstructions, f.originalCost);
+    std::printf("  static part      %12d %12d\n", f.staticInstructions, f.staticCost);
+    std::printf("  dynamic part     %12d %12d\n", f.dynamicInstructions, f.dynamicCost);
+    if (f.staticInstructions > 0)
+        std::printf("  dynamic/static   %12.2f %12.2f\n", ratio,
+                    f.staticCost > 0 ? double(f.dynamicCost) / f.staticCost : 0.0);
+    std::printf("\ndynamic lines (and the input that reaches them):\n");
+    if (f.dynamicLines.empty())
+        std::printf("  none: the whole shader is static for this binding\n");
+    for (const DynamicLine& l : f.dynamicLines) {
+        std::printf("  %3d | %s\n", l.line, sourceLine(ast->source, l.line).c_str());
+        std::string chain;
+        for (const std::string& step : l.chain)
+            chain += (chain.empty() ? "" : "\n        <- ") + step;
+        std::printf("        <- %s\n", chain.c_str());
+    }
+    if (options.dump) {
+        std::printf("\nstatic part:\n%s\ndynamic part:\n%s", f.staticPart.dump().c_str(),
+                    f.dynamicPart.dump().c_str());
+    }
+    return 0;
 }
 
 }  // namespace mpshade

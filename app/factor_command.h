@@ -19,7 +19,9 @@ struct FactorCommandOptions {
     int storeAboveCost = FactorOptions{}.storeAboveCost;
 };
 
-// Returns the exit code: 0 success, 2 bad input (message already on stderr).
+// Returns the exit code: 0 success.
+// Bad input throws InputError naming its place (the CLI prints it and exits 2); a file
+// that cannot be written throws OutputError (exit 1).
 int runFactorCommand(const FactorCommandOptions& options);
 
 }  // namespace mpshade

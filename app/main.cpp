@@ -11,6 +11,7 @@
 #include "app/play_command.h"
 #include "app/profile_command.h"
 #include "app/render_command.h"
+#include "geometry/error.h"
 
 int main(int argc, char** argv) {
     CLI::App app{"mpshade: multi-phase procedural shading"};
@@ -161,6 +162,10 @@ int main(int argc, char** argv) {
         if (evalCmd->parsed()) return mpshade::runEvalCommand(eval);
         if (profileCmd->parsed()) return mpshade::runProfileCommand(profile);
         if (playCmd->parsed()) return mpshade::runPlayCommand(play);
+    } catch (const mpshade::InputError& e) {
+        // Bad input, its place named in the message (file:line:col, JSON path, option).
+        std::fprintf(stderr, "mpshade: %s\n", e.what());
+        return 2;
     } catch (const mpshade::OutputError& e) {
         std::fprintf(stderr, "mpshade: error: %s\n", e.what());
         return 1;

@@ -20,126 +20,118 @@
 namespace mpshade {
 
 int runPlayCommand(const PlayCommandOptions& options) {
-    try {
-        if (!(options.fps >= 0.1 && options.fps <= 1000.0))
-            throw InputError({"--fps", 0, 0, {}}, "expected 0.1..1000 frames per second, found " +
-                                                      std::to_string(options.fps));
-        if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
-            throw InputError({"--cache-mb", 0, 0, {}},
-                             "expected 1..1048576 MB, found " + std::to_string(options.cacheMb));
-        const FrameRequest request = loadFrameRequest(
-            {options.scene, options.frames, options.size, options.spp, options.seed});
-        const Scene& scene = request.scene;
-        const int width = request.width, height = request.height, spp = request.spp;
-        PlaybackOptions po;
-        po.fps = options.fps;
-        po.render = request.render;
-        po.first = request.first;
-        po.last = request.last;
-        po.cacheBytes = static_cast<size_t>(options.cacheMb) << 20;
-        prepareOutputFolder(options.outDir);
-        const std::filesystem::path dir(options.outDir);
-        const bool tty = !options.quiet && isatty(STDERR_FILENO);
+    if (!(options.fps >= 0.1 && options.fps <= 1000.0))
+        throw InputError({"--fps", 0, 0, {}}, "expected 0.1..1000 frames per second, found " +
+                                                  std::to_string(options.fps));
+    if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
+        throw InputError({"--cache-mb", 0, 0, {}},
+                         "expected 1..1048576 MB, found " + std::to_string(options.cacheMb));
+    const FrameRequest request =
+        loadFrameRequest({options.scene, options.frames, options.size, options.spp, options.seed});
+    const Scene& scene = request.scene;
+    const int width = request.width, height = request.height, spp = request.spp;
+    PlaybackOptions po;
+    po.fps = options.fps;
+    po.render = request.render;
+    po.first = request.first;
+    po.last = request.last;
+    po.cacheBytes = static_cast<size_t>(options.cacheMb) << 20;
+    prepareOutputFolder(options.outDir);
+    const std::filesystem::path dir(options.outDir);
+    const bool tty = !options.quiet && isatty(STDERR_FILENO);
 
-        nlohmann::json frames = nlohmann::json::array();
-        int met = 0;
-        double preroll = 0.0;
-        // stats.json, rewritten (atomically) after every frame: what a stopped playback
-        // finished is always described.
-        const auto writeStats = [&](double prerollSeconds) {
-            const int played = static_cast<int>(frames.size());
-            const nlohmann::json doc = {
-                {"scene", options.scene},
-                {"mode", "play"},
-                {"fps", options.fps},
-                {"width", width},
-                {"height", height},
-                {"samples_per_pixel", spp},
-                {"seed", options.seed},
-                {"cache_mb", options.cacheMb},
-                {"preroll_seconds", prerollSeconds},
-                {"frames_requested", po.last - po.first},
-                {"frames_played", played},
-                {"deadlines_met", met},
-                {"deadline_met_fraction", played > 0 ? static_cast<double>(met) / played : 1.0},
-                {"peak_resident_mb", peakResidentBytes() >> 20},
-                {"frames", frames}};
-            writeTextFile(dir / "stats.json", doc.dump(2) + "\n");
-        };
-        const InterruptWatch watch;
-        const auto onFrame = [&](const FrameStats& s, const Image& image, ShadingRate rate) {
-            double writeSeconds = 0.0;
-            if (!options.noWrite) {
-                const auto began = std::chrono::steady_clock::now();
-                char name[32];
-                std::snprintf(name, sizeof name, "frame_%04d", s.index);
-                const std::string base = (dir / name).string();
-                writeExr(image, base + ".exr");
-                writePng(image, base + ".png");
-                writeSeconds =
-                    std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
-            }
-            met += s.deadlineMet ? 1 : 0;
-            frames.push_back(
-                {{"index", s.index},
-                 {"time", s.time},
-                 {"wall_seconds", s.wallSeconds},
-                 {"budget_seconds", s.budgetSeconds},
-                 {"deadline_met", s.deadlineMet},
-                 {"static_seconds", s.staticSeconds},
-                 {"fill_seconds", s.fillSeconds},
-                 {"warp_seconds", s.warpSeconds},
-                 {"raster_seconds", s.rasterSeconds},
-                 {"shade_seconds", s.shadeSeconds},
-                 {"resolve_seconds", s.resolveSeconds},
-                 {"write_seconds", writeSeconds},
-                 {"static_runs", s.staticRuns},
-                 {"built_ahead", s.builtAhead},
-                 {"static_runs_due", staticRunsDueJson(scene, s)},
-                 {"quality",
-                  {{"shading_rate", rate == ShadingRate::Pixel ? "pixel" : "sample"},
-                   {"probes", s.probes},
-                   {"probe_fallbacks", s.probeFallbacks},
-                   {"older_representations", s.rebuildsDeferred}}},
-                 {"deferred", {{"tiles", s.tilesDeferred}, {"rebuilds", s.rebuildsDeferred}}},
-                 {"tiles_requested", s.tilesRequested},
-                 {"tiles_filled", s.tilesFilled},
-                 {"tiles_evicted", s.tilesEvicted},
-                 {"resident_bytes", s.residentBytes},
-                 {"resident_pinned_bytes", s.residentPinnedBytes},
-                 {"shaded_points", s.shadedPoints}});
-            if (tty)
-                std::fprintf(stderr, "\rframe %d: %.1f ms of %.1f, %d of %zu on time", s.index,
-                             1e3 * s.wallSeconds, 1e3 * s.budgetSeconds, met, frames.size());
-            writeStats(preroll);
-            return !interrupted();
-        };
-        const PlaybackSummary summary =
-            playScene(scene, po, onFrame, [&](double seconds) { preroll = seconds; });
-        if (tty) std::fprintf(stderr, "\n");
-        writeStats(summary.prerollSeconds);
-        if (interrupted()) {
-            std::fprintf(stderr,
-                         "mpshade: stopped by the user after %zu frame(s); stats.json "
-                         "describes them\n",
-                         frames.size());
-            return 130;
+    nlohmann::json frames = nlohmann::json::array();
+    int met = 0;
+    double preroll = 0.0;
+    // stats.json, rewritten (atomically) after every frame: what a stopped playback
+    // finished is always described.
+    const auto writeStats = [&](double prerollSeconds) {
+        const int played = static_cast<int>(frames.size());
+        const nlohmann::json doc = {
+            {"scene", options.scene},
+            {"mode", "play"},
+            {"fps", options.fps},
+            {"width", width},
+            {"height", height},
+            {"samples_per_pixel", spp},
+            {"seed", options.seed},
+            {"cache_mb", options.cacheMb},
+            {"preroll_seconds", prerollSeconds},
+            {"frames_requested", po.last - po.first},
+            {"frames_played", played},
+            {"deadlines_met", met},
+            {"deadline_met_fraction", played > 0 ? static_cast<double>(met) / played : 1.0},
+            {"peak_resident_mb", peakResidentBytes() >> 20},
+            {"frames", frames}};
+        writeTextFile(dir / "stats.json", doc.dump(2) + "\n");
+    };
+    const InterruptWatch watch;
+    const auto onFrame = [&](const FrameStats& s, const Image& image, ShadingRate rate) {
+        double writeSeconds = 0.0;
+        if (!options.noWrite) {
+            const auto began = std::chrono::steady_clock::now();
+            char name[32];
+            std::snprintf(name, sizeof name, "frame_%04d", s.index);
+            const std::string base = (dir / name).string();
+            writeExr(image, base + ".exr");
+            writePng(image, base + ".png");
+            writeSeconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
         }
-        if (!options.quiet)
-            std::fprintf(stderr,
-                         "mpshade: %d of %d frame(s) within 1/%g s (%.1f%%), after a %.2f s "
-                         "pre-roll; stats in %s\n",
-                         summary.deadlinesMet, summary.frames, options.fps,
-                         summary.frames > 0 ? 100.0 * summary.deadlinesMet / summary.frames : 100.0,
-                         summary.prerollSeconds, (dir / "stats.json").string().c_str());
-        return 0;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "mpshade: %s\n", e.what());
-        return 2;
-    } catch (const OutputError& e) {
-        std::fprintf(stderr, "mpshade: error: %s\n", e.what());
-        return 1;
+        met += s.deadlineMet ? 1 : 0;
+        frames.push_back(
+            {{"index", s.index},
+             {"time", s.time},
+             {"wall_seconds", s.wallSeconds},
+             {"budget_seconds", s.budgetSeconds},
+             {"deadline_met", s.deadlineMet},
+             {"static_seconds", s.staticSeconds},
+             {"fill_seconds", s.fillSeconds},
+             {"warp_seconds", s.warpSeconds},
+             {"raster_seconds", s.rasterSeconds},
+             {"shade_seconds", s.shadeSeconds},
+             {"resolve_seconds", s.resolveSeconds},
+             {"write_seconds", writeSeconds},
+             {"static_runs", s.staticRuns},
+             {"built_ahead", s.builtAhead},
+             {"static_runs_due", staticRunsDueJson(scene, s)},
+             {"quality",
+              {{"shading_rate", rate == ShadingRate::Pixel ? "pixel" : "sample"},
+               {"probes", s.probes},
+               {"probe_fallbacks", s.probeFallbacks},
+               {"older_representations", s.rebuildsDeferred}}},
+             {"deferred", {{"tiles", s.tilesDeferred}, {"rebuilds", s.rebuildsDeferred}}},
+             {"tiles_requested", s.tilesRequested},
+             {"tiles_filled", s.tilesFilled},
+             {"tiles_evicted", s.tilesEvicted},
+             {"resident_bytes", s.residentBytes},
+             {"resident_pinned_bytes", s.residentPinnedBytes},
+             {"shaded_points", s.shadedPoints}});
+        if (tty)
+            std::fprintf(stderr, "\rframe %d: %.1f ms of %.1f, %d of %zu on time", s.index,
+                         1e3 * s.wallSeconds, 1e3 * s.budgetSeconds, met, frames.size());
+        writeStats(preroll);
+        return !interrupted();
+    };
+    const PlaybackSummary summary =
+        playScene(scene, po, onFrame, [&](double seconds) { preroll = seconds; });
+    if (tty) std::fprintf(stderr, "\n");
+    writeStats(summary.prerollSeconds);
+    if (interrupted()) {
+        std::fprintf(stderr,
+                     "mpshade: stopped by the user after %zu frame(s); stats.json "
+                     "describes them\n",
+                     frames.size());
+        return 130;
     }
+    if (!options.quiet)
+        std::fprintf(stderr,
+                     "mpshade: %d of %d frame(s) within 1/%g s (%.1f%%), after a %.2f s "
+                     "pre-roll; stats in %s\n",
+                     summary.deadlinesMet, summary.frames, options.fps,
+                     summary.frames > 0 ? 100.0 * summary.deadlinesMet / summary.frames : 100.0,
+                     summary.prerollSeconds, (dir / "stats.json").string().c_str());
+    return 0;
 }
 
 }  // namespace mpshade

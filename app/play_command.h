@@ -22,7 +22,9 @@ struct PlayCommandOptions {
     bool quiet = false;
 };
 
-// Returns the process exit code: 0 success, 1 output failure, 2 bad input (message on stderr).
+// Returns the exit code: 0, or 130 when stopped by Ctrl-C.
+// Bad input throws InputError naming its place (the CLI prints it and exits 2); a file
+// that cannot be written throws OutputError (exit 1).
 int runPlayCommand(const PlayCommandOptions& options);
 
 }  // namespace mpshade

@@ -14,50 +14,41 @@
 namespace mpshade {
 
 int runProfileCommand(const ProfileCommandOptions& options) {
-    try {
-        const FrameRequest request = loadFrameRequest(
-            {options.scene, options.frames, options.size, options.spp, options.seed});
-        const Scene& scene = request.scene;
-        ProfileOptions po;
-        po.render = request.render;
-        po.first = request.first;
-        po.last = request.last;
-        prepareOutputFolder(options.outDir);
+    const FrameRequest request =
+        loadFrameRequest({options.scene, options.frames, options.size, options.spp, options.seed});
+    const Scene& scene = request.scene;
+    ProfileOptions po;
+    po.render = request.render;
+    po.first = request.first;
+    po.last = request.last;
+    prepareOutputFolder(options.outDir);
 
-        std::vector<std::string> names;
-        for (const SceneObject& o : scene.objects) names.push_back(o.name);
-        TraceRecorder trace(names);
-        const bool tty = !options.quiet && isatty(STDERR_FILENO);
-        const CostProfile profile = profileScene(scene, options.scene, po, trace, [&](int frame) {
-            if (tty)
-                std::fprintf(stderr, "\rprofiling frame %d (%d of %d)", frame, frame - po.first + 1,
-                             po.last - po.first);
-        });
-        if (tty) std::fprintf(stderr, "\n");
-        const std::filesystem::path dir(options.outDir);
-        writeTextFile(dir / "profile.md", profileMarkdown(profile));
-        writeTextFile(dir / "trace.json", trace.chromeTraceJson());
-        if (!options.quiet) {
-            double staticSeconds = 0.0, wall = 0.0;
-            for (const FrameStats& s : profile.frames) {
-                staticSeconds += s.staticSeconds;
-                wall += s.wallSeconds;
-            }
-            std::fprintf(stderr,
-                         "mpshade: %d frame(s) in %.2f s, %.0f%% of it static work; wrote %s "
-                         "and %s (open it in https://ui.perfetto.dev)\n",
-                         po.last - po.first, wall, wall > 0 ? 100.0 * staticSeconds / wall : 0.0,
-                         (dir / "profile.md").string().c_str(),
-                         (dir / "trace.json").string().c_str());
+    std::vector<std::string> names;
+    for (const SceneObject& o : scene.objects) names.push_back(o.name);
+    TraceRecorder trace(names);
+    const bool tty = !options.quiet && isatty(STDERR_FILENO);
+    const CostProfile profile = profileScene(scene, options.scene, po, trace, [&](int frame) {
+        if (tty)
+            std::fprintf(stderr, "\rprofiling frame %d (%d of %d)", frame, frame - po.first + 1,
+                         po.last - po.first);
+    });
+    if (tty) std::fprintf(stderr, "\n");
+    const std::filesystem::path dir(options.outDir);
+    writeTextFile(dir / "profile.md", profileMarkdown(profile));
+    writeTextFile(dir / "trace.json", trace.chromeTraceJson());
+    if (!options.quiet) {
+        double staticSeconds = 0.0, wall = 0.0;
+        for (const FrameStats& s : profile.frames) {
+            staticSeconds += s.staticSeconds;
+            wall += s.wallSeconds;
         }
-        return 0;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "mpshade: %s\n", e.what());
-        return 2;
-    } catch (const OutputError& e) {
-        std::fprintf(stderr, "mpshade: error: %s\n", e.what());
-        return 1;
+        std::fprintf(stderr,
+                     "mpshade: %d frame(s) in %.2f s, %.0f%% of it static work; wrote %s "
+                     "and %s (open it in https://ui.perfetto.dev)\n",
+                     po.last - po.first, wall, wall > 0 ? 100.0 * staticSeconds / wall : 0.0,
+                     (dir / "profile.md").string().c_str(), (dir / "trace.json").string().c_str());
     }
+    return 0;
 }
 
 }  // namespace mpshade

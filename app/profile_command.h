@@ -17,7 +17,9 @@ struct ProfileCommandOptions {
     bool quiet = false;  // no progress or summary on stderr
 };
 
-// Returns the process exit code: 0 success, 1 output failure, 2 bad input (message on stderr).
+// Returns the exit code, 0.
+// Bad input throws InputError naming its place (the CLI prints it and exits 2); a file
+// that cannot be written throws OutputError (exit 1).
 int runProfileCommand(const ProfileCommandOptions& options);
 
 }  // namespace mpshade

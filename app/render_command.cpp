@@ -57,252 +57,243 @@ class ProgressBar {
 }  // namespace
 
 int runRenderCommand(const RenderCommandOptions& options) {
-    try {
-        if (options.mode != "reference" && options.mode != "multiphase")
-            throw InputError({"--mode", 0, 0, {}}, "unknown mode '" + options.mode +
-                                                       "' (available: reference, multiphase)");
-        if (options.compare && options.mode != "multiphase")
-            throw InputError({"--compare", 0, 0, {}},
-                             "--compare measures --mode multiphase against the reference");
-        if (options.truthSpp != -1 && !options.compare)
-            throw InputError({"--truth-spp", 0, 0, {}}, "--truth-spp goes with --compare");
-        if (options.truthSpp != -1 && (options.truthSpp < 1 || options.truthSpp > 1024))
-            throw InputError({"--truth-spp", 0, 0, {}},
-                             "expected 1..1024, found " + std::to_string(options.truthSpp));
-        if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
-            throw InputError({"--spp", 0, 0, {}},
-                             "expected 1..1024, found " + std::to_string(options.spp));
-        const Scene scene = loadScene(options.scene);
-        RenderOptions render;
-        render.seed = options.seed;
-        render.samplesPerPixel = options.spp > 0 ? options.spp : 0;
-        parseImageSize(options.size, render.width, render.height);
-        int first, last;
-        parseFrameRange(options.frames, scene.frameCount(), first, last);
-        const bool multiphase = options.mode == "multiphase";
-        if (options.memoryMb < 0)
-            throw InputError({"--memory-mb", 0, 0, {}}, "expected a positive number of MB");
-        const uint64_t memoryLimit = options.memoryMb > 0
-                                         ? static_cast<uint64_t>(options.memoryMb) << 20
-                                         : defaultMemoryLimitBytes();
-        // The frame as rendered: the options over the scene's settings.
-        const int width = render.width > 0 ? render.width : scene.settings.width;
-        const int height = render.height > 0 ? render.height : scene.settings.height;
-        const int spp =
-            render.samplesPerPixel > 0 ? render.samplesPerPixel : scene.settings.samplesPerPixel;
-        {
-            FrameMemoryEstimate estimate = estimateFrameMemory(
-                width, height, spp, multiphase, !multiphase || options.compare, options.truthSpp);
-            const uint64_t rays = estimateRaySceneBytes(scene, !multiphase || options.compare);
-            const bool raysDominate = rays > estimate.bytes;
-            estimate.bytes += rays;
-            if (raysDominate) {
-                estimate.what +=
-                    " and the ray queries of " + std::to_string(scene.objects.size()) + " objects";
-                estimate.hint = "fewer distinct shapes (equal ones share)";
-            }
-            checkMemory(estimate, memoryLimit,
-                        raysDominate                               ? options.scene + ": objects"
-                        : !options.size.empty() || options.spp > 0 ? "--size/--spp"
-                                                                   : options.scene + ": settings");
+    if (options.mode != "reference" && options.mode != "multiphase")
+        throw InputError({"--mode", 0, 0, {}},
+                         "unknown mode '" + options.mode + "' (available: reference, multiphase)");
+    if (options.compare && options.mode != "multiphase")
+        throw InputError({"--compare", 0, 0, {}},
+                         "--compare measures --mode multiphase against the reference");
+    if (options.truthSpp != -1 && !options.compare)
+        throw InputError({"--truth-spp", 0, 0, {}}, "--truth-spp goes with --compare");
+    if (options.truthSpp != -1 && (options.truthSpp < 1 || options.truthSpp > 1024))
+        throw InputError({"--truth-spp", 0, 0, {}},
+                         "expected 1..1024, found " + std::to_string(options.truthSpp));
+    if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
+        throw InputError({"--spp", 0, 0, {}},
+                         "expected 1..1024, found " + std::to_string(options.spp));
+    const Scene scene = loadScene(options.scene);
+    RenderOptions render;
+    render.seed = options.seed;
+    render.samplesPerPixel = options.spp > 0 ? options.spp : 0;
+    parseImageSize(options.size, render.width, render.height);
+    int first, last;
+    parseFrameRange(options.frames, scene.frameCount(), first, last);
+    const bool multiphase = options.mode == "multiphase";
+    if (options.memoryMb < 0)
+        throw InputError({"--memory-mb", 0, 0, {}}, "expected a positive number of MB");
+    const uint64_t memoryLimit = options.memoryMb > 0
+                                     ? static_cast<uint64_t>(options.memoryMb) << 20
+                                     : defaultMemoryLimitBytes();
+    // The frame as rendered: the options over the scene's settings.
+    const int width = render.width > 0 ? render.width : scene.settings.width;
+    const int height = render.height > 0 ? render.height : scene.settings.height;
+    const int spp =
+        render.samplesPerPixel > 0 ? render.samplesPerPixel : scene.settings.samplesPerPixel;
+    {
+        FrameMemoryEstimate estimate = estimateFrameMemory(
+            width, height, spp, multiphase, !multiphase || options.compare, options.truthSpp);
+        const uint64_t rays = estimateRaySceneBytes(scene, !multiphase || options.compare);
+        const bool raysDominate = rays > estimate.bytes;
+        estimate.bytes += rays;
+        if (raysDominate) {
+            estimate.what +=
+                " and the ray queries of " + std::to_string(scene.objects.size()) + " objects";
+            estimate.hint = "fewer distinct shapes (equal ones share)";
         }
-
-        prepareOutputFolder(options.outDir);
-
-        std::unique_ptr<ReferenceRenderer> reference;
-        if (!multiphase || options.compare) reference = std::make_unique<ReferenceRenderer>(scene);
-        std::unique_ptr<MultiphaseRenderer> multi;
-        if (multiphase) {
-            MultiphaseOptions mo;
-            if (!options.shadingRate.empty()) {
-                if (options.shadingRate == "sample")
-                    mo.shadingRate = ShadingRate::Sample;
-                else if (options.shadingRate == "pixel")
-                    mo.shadingRate = ShadingRate::Pixel;
-                else
-                    throw InputError(
-                        {"--shading-rate", 0, 0, {}},
-                        "expected sample or pixel, found '" + options.shadingRate + "'");
-            }
-            if (options.footprintScale != 0.0f) {
-                if (!(options.footprintScale >= 0.05f && options.footprintScale <= 8.0f))
-                    throw InputError(
-                        {"--footprint-scale", 0, 0, {}},
-                        "expected 0.05..8, found " + std::to_string(options.footprintScale));
-                mo.dynamic.footprintScale = options.footprintScale;
-            }
-            if (options.cacheMb != 0) {
-                if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
-                    throw InputError({"--cache-mb", 0, 0, {}}, "expected 1..1048576 MB, found " +
-                                                                   std::to_string(options.cacheMb));
-                mo.mapMemoryBytes = static_cast<size_t>(options.cacheMb) << 20;
-            }
-            // --compare measures the multi-phase engine against the reference: a frame the
-            // reference rendered in its place would only be compared with itself.
-            mo.singlePhaseFrames = !options.noSinglePhase && !options.compare;
-            multi = std::make_unique<MultiphaseRenderer>(scene, mo);
-            multi->plan(first, last, render);
-        }
-        ProgressBar bar(!options.quiet && isatty(STDERR_FILENO));
-        bar.setFirst(first);
-        nlohmann::json frames = nlohmann::json::array();
-        const auto start = std::chrono::steady_clock::now();
-        // stats.json, rewritten (atomically) after every frame: what a stopped render
-        // finished is always described.
-        const auto writeStats = [&] {
-            nlohmann::json doc = {
-                {"scene", options.scene},
-                {"mode", options.mode},
-                {"width", width},
-                {"height", height},
-                {"samples_per_pixel", spp},
-                {"seed", options.seed},
-                {"frames_requested", last - first},
-                {"memory_limit_mb", memoryLimit >> 20},
-                {"peak_resident_mb", peakResidentBytes() >> 20},
-                {"total_wall_seconds",
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
-                {"frames", frames}};
-            if (multi) {
-                doc["shading_rate"] =
-                    scene.settings.shadingRate == ShadingRate::Pixel ? "pixel" : "sample";
-                nlohmann::json objects = nlohmann::json::array();
-                for (size_t i = 0; i < multi->objectCount(); ++i) {
-                    const ObjectReport& r = multi->report(i);
-                    objects.push_back({{"name", r.name},
-                                       {"representation", representationName(*multi, i)},
-                                       {"reason", r.reason},
-                                       {"static_runs", r.staticRuns},
-                                       {"static_seconds", r.staticCosts.seconds},
-                                       {"frames_drawn", r.framesDrawn},
-                                       {"facets", r.facets},
-                                       {"longest_edge_pixels", r.longestEdgePixels},
-                                       {"facet_bytes", r.facetBytes},
-                                       {"resident_tiles", r.residentTiles},
-                                       {"map_bytes", r.mapBytes}});
-                }
-                doc["objects"] = objects;
-            }
-            writeTextFile(std::filesystem::path(options.outDir) / "stats.json", doc.dump(2) + "\n");
-        };
-        const InterruptWatch watch;
-        for (int frame = first; frame < last; ++frame) {
-            FrameStats stats;
-            const ProgressFn progress = [&](int done, int total) {
-                bar.update(frame, last - first, done, total);
-            };
-            const Image image = multiphase ? multi->renderFrame(frame, render, stats, progress)
-                                           : reference->renderFrame(frame, render, stats, progress);
-            char name[32];
-            std::snprintf(name, sizeof name, "frame_%04d", frame);
-            const std::string base = (std::filesystem::path(options.outDir) / name).string();
-            writeExr(image, base + ".exr");
-            writePng(image, base + ".png");
-            nlohmann::json entry = {{"index", stats.index},
-                                    {"time", stats.time},
-                                    {"wall_seconds", stats.wallSeconds},
-                                    {"samples", stats.samples},
-                                    {"rays", stats.rays},
-                                    {"occlusion_rays", stats.occlusionRays},
-                                    {"shaded_points", stats.shadedPoints},
-                                    {"shader_instructions", stats.shaderInstructions},
-                                    {"nonfinite_samples", stats.nonFiniteSamples}};
-            if (multiphase) {
-                double covered = 0.0;
-                for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
-                entry["single_phase"] = stats.singlePhase;
-                entry["static_runs"] = stats.staticRuns;
-                entry["static_runs_due"] = staticRunsDueJson(scene, stats);
-                entry["static_seconds"] = stats.staticSeconds;
-                entry["fill_seconds"] = stats.fillSeconds;
-                entry["warp_seconds"] = stats.warpSeconds;
-                entry["raster_seconds"] = stats.rasterSeconds;
-                entry["shade_seconds"] = stats.shadeSeconds;
-                entry["resolve_seconds"] = stats.resolveSeconds;
-                entry["static_instructions"] = stats.staticInstructions;
-                entry["objects_drawn"] = stats.objectsDrawn;
-                entry["facets"] = stats.facets;
-                entry["facet_bytes"] = stats.facetBytes;
-                entry["facets_rasterized"] = stats.facetsRasterized;
-                entry["covered_pixels"] = covered;
-                entry["facets_per_covered_pixel"] =
-                    covered > 0.0 ? static_cast<double>(stats.facetsRasterized) / covered : 0.0;
-                entry["fragments"] = stats.fragments;
-                entry["vertices_warped"] = stats.verticesWarped;
-                entry["shade_passes"] = stats.shadePasses;
-                entry["probes"] = stats.probes;
-                entry["probe_fallbacks"] = stats.probeFallbacks;
-                entry["tiles_requested"] = stats.tilesRequested;
-                entry["tiles_filled"] = stats.tilesFilled;
-                entry["tiles_from_children"] = stats.tilesFromChildren;
-                entry["texels_filled"] = stats.texelsFilled;
-                entry["resident_tiles"] = stats.residentTiles;
-                entry["resident_bytes"] = stats.residentBytes;
-                entry["resident_pinned_bytes"] = stats.residentPinnedBytes;
-                entry["tiles_evicted"] = stats.tilesEvicted;
-            }
-            if (options.compare) {
-                FrameStats refStats;
-                const Image ref = reference->renderFrame(frame, render, refStats);
-                const ImageError err = compareImages(image, ref);
-                entry["reference"] = {
-                    {"wall_seconds", refStats.wallSeconds},
-                    {"psnr_db", err.psnr},
-                    {"rmse", err.rmse},
-                    {"max_abs_error", err.maxAbs},
-                    {"coverage_difference", err.coverageDiff},
-                    {"speedup",
-                     stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0}};
-                if (options.truthSpp > 0) {
-                    // Both renderers against a reference with many more samples: the error
-                    // each makes, rather than how far apart they are.
-                    RenderOptions dense = render;
-                    dense.samplesPerPixel = options.truthSpp;
-                    FrameStats truthStats;
-                    const Image truth = reference->renderFrame(frame, dense, truthStats);
-                    const ImageError m = compareImages(image, truth);
-                    const ImageError r = compareImages(ref, truth);
-                    entry["truth"] = {{"samples_per_pixel", options.truthSpp},
-                                      {"multiphase_psnr_db", m.psnr},
-                                      {"multiphase_rmse", m.rmse},
-                                      {"reference_psnr_db", r.psnr},
-                                      {"reference_rmse", r.rmse}};
-                    if (!options.quiet)
-                        std::fprintf(stderr,
-                                     "%sframe %d: against %d spp: multiphase %.2f dB, reference "
-                                     "%.2f dB\n",
-                                     isatty(STDERR_FILENO) ? "\n" : "", frame, options.truthSpp,
-                                     m.psnr, r.psnr);
-                }
-                if (!options.quiet)
-                    std::fprintf(
-                        stderr,
-                        "%sframe %d: PSNR %.2f dB against the reference, %.3f s vs %.3f s "
-                        "(%.2fx)\n",
-                        isatty(STDERR_FILENO) ? "\n" : "", frame, err.psnr, stats.wallSeconds,
-                        refStats.wallSeconds,
-                        stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0);
-            }
-            frames.push_back(entry);
-            writeStats();
-            if (interrupted()) break;
-        }
-        bar.finish();
-        if (interrupted()) {
-            std::fprintf(stderr,
-                         "mpshade: stopped by the user after %zu frame(s); stats.json "
-                         "describes them\n",
-                         frames.size());
-            return 130;
-        }
-        return 0;
-    } catch (const InputError& e) {
-        std::fprintf(stderr, "mpshade: %s\n", e.what());
-        return 2;
-    } catch (const OutputError& e) {
-        std::fprintf(stderr, "mpshade: error: %s\n", e.what());
-        return 1;
+        checkMemory(estimate, memoryLimit,
+                    raysDominate                               ? options.scene + ": objects"
+                    : !options.size.empty() || options.spp > 0 ? "--size/--spp"
+                                                               : options.scene + ": settings");
     }
+
+    prepareOutputFolder(options.outDir);
+
+    std::unique_ptr<ReferenceRenderer> reference;
+    if (!multiphase || options.compare) reference = std::make_unique<ReferenceRenderer>(scene);
+    std::unique_ptr<MultiphaseRenderer> multi;
+    if (multiphase) {
+        MultiphaseOptions mo;
+        if (!options.shadingRate.empty()) {
+            if (options.shadingRate == "sample")
+                mo.shadingRate = ShadingRate::Sample;
+            else if (options.shadingRate == "pixel")
+                mo.shadingRate = ShadingRate::Pixel;
+            else
+                throw InputError({"--shading-rate", 0, 0, {}},
+                                 "expected sample or pixel, found '" + options.shadingRate + "'");
+        }
+        if (options.footprintScale != 0.0f) {
+            if (!(options.footprintScale >= 0.05f && options.footprintScale <= 8.0f))
+                throw InputError(
+                    {"--footprint-scale", 0, 0, {}},
+                    "expected 0.05..8, found " + std::to_string(options.footprintScale));
+            mo.dynamic.footprintScale = options.footprintScale;
+        }
+        if (options.cacheMb != 0) {
+            if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
+                throw InputError({"--cache-mb", 0, 0, {}}, "expected 1..1048576 MB, found " +
+                                                               std::to_string(options.cacheMb));
+            mo.mapMemoryBytes = static_cast<size_t>(options.cacheMb) << 20;
+        }
+        // --compare measures the multi-phase engine against the reference: a frame the
+        // reference rendered in its place would only be compared with itself.
+        mo.singlePhaseFrames = !options.noSinglePhase && !options.compare;
+        multi = std::make_unique<MultiphaseRenderer>(scene, mo);
+        multi->plan(first, last, render);
+    }
+    ProgressBar bar(!options.quiet && isatty(STDERR_FILENO));
+    bar.setFirst(first);
+    nlohmann::json frames = nlohmann::json::array();
+    const auto start = std::chrono::steady_clock::now();
+    // stats.json, rewritten (atomically) after every frame: what a stopped render
+    // finished is always described.
+    const auto writeStats = [&] {
+        nlohmann::json doc = {
+            {"scene", options.scene},
+            {"mode", options.mode},
+            {"width", width},
+            {"height", height},
+            {"samples_per_pixel", spp},
+            {"seed", options.seed},
+            {"frames_requested", last - first},
+            {"memory_limit_mb", memoryLimit >> 20},
+            {"peak_resident_mb", peakResidentBytes() >> 20},
+            {"total_wall_seconds",
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
+            {"frames", frames}};
+        if (multi) {
+            doc["shading_rate"] =
+                scene.settings.shadingRate == ShadingRate::Pixel ? "pixel" : "sample";
+            nlohmann::json objects = nlohmann::json::array();
+            for (size_t i = 0; i < multi->objectCount(); ++i) {
+                const ObjectReport& r = multi->report(i);
+                objects.push_back({{"name", r.name},
+                                   {"representation", representationName(*multi, i)},
+                                   {"reason", r.reason},
+                                   {"static_runs", r.staticRuns},
+                                   {"static_seconds", r.staticCosts.seconds},
+                                   {"frames_drawn", r.framesDrawn},
+                                   {"facets", r.facets},
+                                   {"longest_edge_pixels", r.longestEdgePixels},
+                                   {"facet_bytes", r.facetBytes},
+                                   {"resident_tiles", r.residentTiles},
+                                   {"map_bytes", r.mapBytes}});
+            }
+            doc["objects"] = objects;
+        }
+        writeTextFile(std::filesystem::path(options.outDir) / "stats.json", doc.dump(2) + "\n");
+    };
+    const InterruptWatch watch;
+    for (int frame = first; frame < last; ++frame) {
+        FrameStats stats;
+        const ProgressFn progress = [&](int done, int total) {
+            bar.update(frame, last - first, done, total);
+        };
+        const Image image = multiphase ? multi->renderFrame(frame, render, stats, progress)
+                                       : reference->renderFrame(frame, render, stats, progress);
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%04d", frame);
+        const std::string base = (std::filesystem::path(options.outDir) / name).string();
+        writeExr(image, base + ".exr");
+        writePng(image, base + ".png");
+        nlohmann::json entry = {{"index", stats.index},
+                                {"time", stats.time},
+                                {"wall_seconds", stats.wallSeconds},
+                                {"samples", stats.samples},
+                                {"rays", stats.rays},
+                                {"occlusion_rays", stats.occlusionRays},
+                                {"shaded_points", stats.shadedPoints},
+                                {"shader_instructions", stats.shaderInstructions},
+                                {"nonfinite_samples", stats.nonFiniteSamples}};
+        if (multiphase) {
+            double covered = 0.0;
+            for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
+            entry["single_phase"] = stats.singlePhase;
+            entry["static_runs"] = stats.staticRuns;
+            entry["static_runs_due"] = staticRunsDueJson(scene, stats);
+            entry["static_seconds"] = stats.staticSeconds;
+            entry["fill_seconds"] = stats.fillSeconds;
+            entry["warp_seconds"] = stats.warpSeconds;
+            entry["raster_seconds"] = stats.rasterSeconds;
+            entry["shade_seconds"] = stats.shadeSeconds;
+            entry["resolve_seconds"] = stats.resolveSeconds;
+            entry["static_instructions"] = stats.staticInstructions;
+            entry["objects_drawn"] = stats.objectsDrawn;
+            entry["facets"] = stats.facets;
+            entry["facet_bytes"] = stats.facetBytes;
+            entry["facets_rasterized"] = stats.facetsRasterized;
+            entry["covered_pixels"] = covered;
+            entry["facets_per_covered_pixel"] =
+                covered > 0.0 ? static_cast<double>(stats.facetsRasterized) / covered : 0.0;
+            entry["fragments"] = stats.fragments;
+            entry["vertices_warped"] = stats.verticesWarped;
+            entry["shade_passes"] = stats.shadePasses;
+            entry["probes"] = stats.probes;
+            entry["probe_fallbacks"] = stats.probeFallbacks;
+            entry["tiles_requested"] = stats.tilesRequested;
+            entry["tiles_filled"] = stats.tilesFilled;
+            entry["tiles_from_children"] = stats.tilesFromChildren;
+            entry["texels_filled"] = stats.texelsFilled;
+            entry["resident_tiles"] = stats.residentTiles;
+            entry["resident_bytes"] = stats.residentBytes;
+            entry["resident_pinned_bytes"] = stats.residentPinnedBytes;
+            entry["tiles_evicted"] = stats.tilesEvicted;
+        }
+        if (options.compare) {
+            FrameStats refStats;
+            const Image ref = reference->renderFrame(frame, render, refStats);
+            const ImageError err = compareImages(image, ref);
+            entry["reference"] = {
+                {"wall_seconds", refStats.wallSeconds},
+                {"psnr_db", err.psnr},
+                {"rmse", err.rmse},
+                {"max_abs_error", err.maxAbs},
+                {"coverage_difference", err.coverageDiff},
+                {"speedup",
+                 stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0}};
+            if (options.truthSpp > 0) {
+                // Both renderers against a reference with many more samples: the error
+                // each makes, rather than how far apart they are.
+                RenderOptions dense = render;
+                dense.samplesPerPixel = options.truthSpp;
+                FrameStats truthStats;
+                const Image truth = reference->renderFrame(frame, dense, truthStats);
+                const ImageError m = compareImages(image, truth);
+                const ImageError r = compareImages(ref, truth);
+                entry["truth"] = {{"samples_per_pixel", options.truthSpp},
+                                  {"multiphase_psnr_db", m.psnr},
+                                  {"multiphase_rmse", m.rmse},
+                                  {"reference_psnr_db", r.psnr},
+                                  {"reference_rmse", r.rmse}};
+                if (!options.quiet)
+                    std::fprintf(stderr,
+                                 "%sframe %d: against %d spp: multiphase %.2f dB, reference "
+                                 "%.2f dB\n",
+                                 isatty(STDERR_FILENO) ? "\n" : "", frame, options.truthSpp, m.psnr,
+                                 r.psnr);
+            }
+            if (!options.quiet)
+                std::fprintf(
+                    stderr,
+                    "%sframe %d: PSNR %.2f dB against the reference, %.3f s vs %.3f s "
+                    "(%.2fx)\n",
+                    isatty(STDERR_FILENO) ? "\n" : "", frame, err.psnr, stats.wallSeconds,
+                    refStats.wallSeconds,
+                    stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0);
+        }
+        frames.push_back(entry);
+        writeStats();
+        if (interrupted()) break;
+    }
+    bar.finish();
+    if (interrupted()) {
+        std::fprintf(stderr,
+                     "mpshade: stopped by the user after %zu frame(s); stats.json "
+                     "describes them\n",
+                     frames.size());
+        return 130;
+    }
+    return 0;
 }
 
 }  // namespace mpshade

@@ -30,7 +30,9 @@ struct RenderCommandOptions {
     int64_t cacheMb = 0;
 };
 
-// Returns the process exit code: 0 success, 2 bad input (message already on stderr).
+// Returns the exit code: 0, or 130 when stopped by Ctrl-C.
+// Bad input throws InputError naming its place (the CLI prints it and exits 2); a file
+// that cannot be written throws OutputError (exit 1).
 int runRenderCommand(const RenderCommandOptions& options);
 
 }  // namespace mpshade
