@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <glm/geometric.hpp>
 
@@ -67,150 +68,112 @@ glm::vec3 shadeLightOne(Op op, const LightSample& light, const glm::vec3& P, con
 
 namespace {
 
-// max(0, x) that is 0 for NaN, as std::fmax(0, x) is, without a library call.
-inline float positive(float x) {
-    return x > 0.0f ? x : 0.0f;
+// The lane operations the formulas need, for one lane (float) or four (Float4), so both
+// run the same operations in the same order and agree bitwise.
+inline float splat(float x, float) {
+    return x;
+}
+inline Float4 splat(float x, Float4) {
+    return splatFloat4(x);
+}
+inline float load(const float* p, float) {
+    return *p;
+}
+inline Float4 load(const float* p, Float4) {
+    return loadFloat4(p);
+}
+inline void store(float* p, float v) {
+    *p = v;
+}
+inline void store(float* p, Float4 v) {
+    storeFloat4(p, v);
+}
+inline float root(float x) {
+    return std::sqrt(x);
+}
+inline Float4 root(Float4 x) {
+    return sqrtFloat4(x);
 }
 
-// One light over m lanes, with the light's kind and the operation fixed, so the lane loop
-// has no branches on them (the formulas are shadeLightOne's).
+// Lanes [l, l + width of V) of one light, with the light's kind and the operation fixed:
+// branch-free (selects, and divisions by safe denominators). The formulas are
+// shadeLightOne's; max(0, x) is a select that is 0 for NaN, as std::fmax(0, x) is.
+template <Op kOp, bool kPoint, typename V>
+inline void shadeLightLanes(const LightSample& light, const float* const* args, float* const* rgb,
+                            int l) {
+    const V zero = splat(0.0f, V{}), one = splat(1.0f, V{});
+    auto positive = [&](V x) { return x > zero ? x : zero; };
+    V Lx, Ly, Lz, cr, cg, cb;
+    if constexpr (kPoint) {
+        const V dx = splat(light.position.x, V{}) - load(args[0] + l, V{});
+        const V dy = splat(light.position.y, V{}) - load(args[1] + l, V{});
+        const V dz = splat(light.position.z, V{}) - load(args[2] + l, V{});
+        const V d2 = dx * dx + dy * dy + dz * dz;
+        const auto ok = d2 > zero;
+        const V safe = ok ? d2 : one;
+        const V rootInv = one / root(safe), recip = one / safe;
+        const V inv = ok ? rootInv : zero, fall = ok ? recip : zero;
+        Lx = dx * inv, Ly = dy * inv, Lz = dz * inv;
+        cr = splat(light.color.x, V{}) * fall, cg = splat(light.color.y, V{}) * fall,
+        cb = splat(light.color.z, V{}) * fall;
+    } else {
+        Lx = splat(light.toLight.x, V{}), Ly = splat(light.toLight.y, V{}),
+        Lz = splat(light.toLight.z, V{});
+        cr = splat(light.color.x, V{}), cg = splat(light.color.y, V{}),
+        cb = splat(light.color.z, V{});
+    }
+    const V nx = load(args[3] + l, V{}), ny = load(args[4] + l, V{}), nz = load(args[5] + l, V{});
+    const V ndl = positive(nx * Lx + ny * Ly + nz * Lz);
+    V f;
+    if constexpr (kOp == Op::Diffuse) {
+        f = ndl;
+    } else if constexpr (kOp == Op::Specular) {
+        const V hx = Lx + load(args[6] + l, V{}), hy = Ly + load(args[7] + l, V{}),
+                hz = Lz + load(args[8] + l, V{});
+        const V hl = root(hx * hx + hy * hy + hz * hz);
+        const auto ok = (hl > zero) & (ndl > zero);
+        const V ndh = positive((nx * hx + ny * hy + nz * hz) / (ok ? hl : one));
+        const V param = load(args[9] + l, V{}), floor = splat(0.01f, V{});
+        const V clamped = param > floor ? param : floor;
+        const V r = one < clamped ? one : clamped;  // std::min(clamped, 1)
+        const V a2 = r * r * r * r;
+        // 1 - ndh^2 (1 - a2), with 1 - ndh^2 as (1 - ndh)(1 + ndh): exact near the peak
+        // (Sterbenz), where the plain form cancels to 0 for a2 below float epsilon and D
+        // became infinite at the roughness floor.
+        const V denom = (one - ndh) * (one + ndh) + ndh * ndh * a2;
+        const V D = a2 / (splat(kPi, V{}) * denom * denom);
+        f = ok ? D * ndl * splat(0.25f, V{}) : zero;
+    } else {
+        const V vx = load(args[6] + l, V{}), vy = load(args[7] + l, V{}),
+                vz = load(args[8] + l, V{});
+        const V nv2 = splat(2.0f, V{}) * (nx * vx + ny * vy + nz * vz);
+        const V rx = -vx + nv2 * nx, ry = -vy + nv2 * ny, rz = -vz + nv2 * nz;
+        if constexpr (std::is_same_v<V, float>) {
+            f = scalar::safePow(positive(rx * Lx + ry * Ly + rz * Lz), load(args[9] + l, V{}));
+        }
+    }
+    store(rgb[0] + l, cr * f);
+    store(rgb[1] + l, cg * f);
+    store(rgb[2] + l, cb * f);
+}
+
+// One light over m lanes: four at a time in vector registers (the compiler did not
+// vectorize the one-lane loop) for diffuse and specular, the rest one at a time. Phong's
+// power is a library call: one lane at a time.
 template <Op kOp, bool kPoint>
 void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
-    const float* __restrict px = args[0];
-    const float* __restrict py = args[1];
-    const float* __restrict pz = args[2];
-    const float* __restrict nx = args[3];
-    const float* __restrict ny = args[4];
-    const float* __restrict nz = args[5];
-    const float* __restrict vx0 = kOp == Op::Diffuse ? nullptr : args[6];
-    const float* __restrict vy0 = kOp == Op::Diffuse ? nullptr : args[7];
-    const float* __restrict vz0 = kOp == Op::Diffuse ? nullptr : args[8];
-    const float* __restrict pr = kOp == Op::Diffuse ? nullptr : args[9];
-    float* __restrict outR = rgb[0];
-    float* __restrict outG = rgb[1];
-    float* __restrict outB = rgb[2];
-    const float lpx = light.position.x, lpy = light.position.y, lpz = light.position.z;
-    const float tlx = light.toLight.x, tly = light.toLight.y, tlz = light.toLight.z;
-    const float ccr = light.color.x, ccg = light.color.y, ccb = light.color.z;
-    // Branch-free (selects, and divisions by safe denominators), so the loop vectorizes.
-    for (int l = 0; l < m; ++l) {
-        float Lx, Ly, Lz, cr, cg, cb;
-        if constexpr (kPoint) {
-            const float dx = lpx - px[l], dy = lpy - py[l], dz = lpz - pz[l];
-            const float d2 = dx * dx + dy * dy + dz * dz;
-            const bool ok = d2 > 0.0f;
-            const float safe = ok ? d2 : 1.0f;
-            const float root = 1.0f / std::sqrt(safe), recip = 1.0f / safe;
-            const float inv = ok ? root : 0.0f;
-            const float fall = ok ? recip : 0.0f;
-            Lx = dx * inv, Ly = dy * inv, Lz = dz * inv;
-            cr = ccr * fall, cg = ccg * fall, cb = ccb * fall;
-        } else {
-            Lx = tlx, Ly = tly, Lz = tlz;
-            cr = ccr, cg = ccg, cb = ccb;
-        }
-        const float ndl = positive(nx[l] * Lx + ny[l] * Ly + nz[l] * Lz);
-        float f;
-        if constexpr (kOp == Op::Diffuse) {
-            f = ndl;
-        } else if constexpr (kOp == Op::Specular) {
-            const float hx = Lx + vx0[l], hy = Ly + vy0[l], hz = Lz + vz0[l];
-            const float hl = std::sqrt(hx * hx + hy * hy + hz * hz);
-            const bool ok = hl > 0.0f && ndl > 0.0f;
-            const float ndh = positive((nx[l] * hx + ny[l] * hy + nz[l] * hz) / (ok ? hl : 1.0f));
-            const float param = pr[l];
-            const float r = std::min(param > 0.01f ? param : 0.01f, 1.0f);
-            const float a2 = r * r * r * r;
-            // 1 - ndh^2 (1 - a2), with 1 - ndh^2 as (1 - ndh)(1 + ndh): exact near the
-            // peak (Sterbenz), where the plain form cancels to 0 for a2 below float epsilon
-            // and D became infinite at the roughness floor.
-            const float denom = (1.0f - ndh) * (1.0f + ndh) + ndh * ndh * a2;
-            const float D = a2 / (kPi * denom * denom);
-            f = ok ? D * ndl * 0.25f : 0.0f;
-        } else {
-            const float vx = vx0[l], vy = vy0[l], vz = vz0[l];
-            const float nv2 = 2.0f * (nx[l] * vx + ny[l] * vy + nz[l] * vz);
-            const float rx = -vx + nv2 * nx[l], ry = -vy + nv2 * ny[l], rz = -vz + nv2 * nz[l];
-            f = scalar::safePow(positive(rx * Lx + ry * Ly + rz * Lz), pr[l]);
-        }
-        outR[l] = cr * f;
-        outG[l] = cg * f;
-        outB[l] = cb * f;
-    }
-}
-
-// shadeLanes for diffuse and specular, four lanes at a time in vector registers (the
-// compiler does not vectorize the loop above), with the same operations in the same order:
-// the results are bitwise those of the scalar loop, which takes the last m % 4 lanes.
-template <Op kOp, bool kPoint>
-int shadeFourLanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
-    static_assert(kOp == Op::Diffuse || kOp == Op::Specular);
-    const Float4 zero = splatFloat4(0.0f), one = splatFloat4(1.0f);
-    const Float4 lpx = splatFloat4(light.position.x), lpy = splatFloat4(light.position.y),
-                 lpz = splatFloat4(light.position.z);
-    const Float4 ccr = splatFloat4(light.color.x), ccg = splatFloat4(light.color.y),
-                 ccb = splatFloat4(light.color.z);
-    auto positive4 = [&](Float4 x) { return x > zero ? x : zero; };
-    const int whole = m & ~3;
-    for (int l = 0; l < whole; l += 4) {
-        Float4 Lx, Ly, Lz, cr, cg, cb;
-        if constexpr (kPoint) {
-            const Float4 dx = lpx - loadFloat4(args[0] + l), dy = lpy - loadFloat4(args[1] + l),
-                         dz = lpz - loadFloat4(args[2] + l);
-            const Float4 d2 = dx * dx + dy * dy + dz * dz;
-            const auto ok = d2 > zero;
-            const Float4 safe = ok ? d2 : one;
-            const Float4 root = one / sqrtFloat4(safe), recip = one / safe;
-            const Float4 inv = ok ? root : zero, fall = ok ? recip : zero;
-            Lx = dx * inv, Ly = dy * inv, Lz = dz * inv;
-            cr = ccr * fall, cg = ccg * fall, cb = ccb * fall;
-        } else {
-            Lx = splatFloat4(light.toLight.x), Ly = splatFloat4(light.toLight.y),
-            Lz = splatFloat4(light.toLight.z);
-            cr = ccr, cg = ccg, cb = ccb;
-        }
-        const Float4 nx = loadFloat4(args[3] + l), ny = loadFloat4(args[4] + l),
-                     nz = loadFloat4(args[5] + l);
-        const Float4 ndl = positive4(nx * Lx + ny * Ly + nz * Lz);
-        Float4 f;
-        if constexpr (kOp == Op::Diffuse) {
-            f = ndl;
-        } else {
-            const Float4 hx = Lx + loadFloat4(args[6] + l), hy = Ly + loadFloat4(args[7] + l),
-                         hz = Lz + loadFloat4(args[8] + l);
-            const Float4 hl = sqrtFloat4(hx * hx + hy * hy + hz * hz);
-            const auto ok = (hl > zero) & (ndl > zero);
-            const Float4 ndh = positive4((nx * hx + ny * hy + nz * hz) / (ok ? hl : one));
-            const Float4 param = loadFloat4(args[9] + l), floor = splatFloat4(0.01f);
-            const Float4 p = param > floor ? param : floor;
-            const Float4 r = one < p ? one : p;  // std::min(p, 1)
-            const Float4 a2 = r * r * r * r;
-            const Float4 denom = (one - ndh) * (one + ndh) + ndh * ndh * a2;
-            const Float4 D = a2 / (splatFloat4(kPi) * denom * denom);
-            f = ok ? D * ndl * splatFloat4(0.25f) : zero;
-        }
-        storeFloat4(rgb[0] + l, cr * f);
-        storeFloat4(rgb[1] + l, cg * f);
-        storeFloat4(rgb[2] + l, cb * f);
-    }
-    return whole;
+    int l = 0;
+    if constexpr (kOp != Op::Phong)
+        for (; l + 4 <= m; l += 4) shadeLightLanes<kOp, kPoint, Float4>(light, args, rgb, l);
+    for (; l < m; ++l) shadeLightLanes<kOp, kPoint, float>(light, args, rgb, l);
 }
 
 template <Op kOp>
 void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
-    const bool point = light.kind == LightKind::Point;
-    int done = 0;
-    if constexpr (kOp == Op::Diffuse || kOp == Op::Specular)
-        done = point ? shadeFourLanes<kOp, true>(light, args, rgb, m)
-                     : shadeFourLanes<kOp, false>(light, args, rgb, m);
-    if (done == m) return;
-    const float* rest[10] = {};
-    for (int k = 0; k < (kOp == Op::Diffuse ? 6 : 10); ++k) rest[k] = args[k] + done;
-    float* restRgb[3] = {rgb[0] + done, rgb[1] + done, rgb[2] + done};
-    if (point)
-        shadeLanes<kOp, true>(light, rest, restRgb, m - done);
+    if (light.kind == LightKind::Point)
+        shadeLanes<kOp, true>(light, args, rgb, m);
     else
-        shadeLanes<kOp, false>(light, rest, restRgb, m - done);
+        shadeLanes<kOp, false>(light, args, rgb, m);
 }
 
 }  // namespace
