@@ -62,7 +62,7 @@ nlohmann::json runJson(const EvalRun& r, const SceneEvaluation& e) {
     const EvalConfig& c = r.config;
     nlohmann::json settings = {{"samples_per_pixel", c.spp > 0 ? c.spp : e.spp}};
     if (c.multiphase) {
-        settings["shading_rate"] = c.shadingRate == ShadingRate::Pixel ? "pixel" : "sample";
+        settings["shading_rate"] = shadingRateName(c.shadingRate);
         settings["footprint_scale"] = c.footprintScale;
         settings["probe_filter"] = filterName(c.filter);
         settings["max_anisotropy"] = c.maxAnisotropy;

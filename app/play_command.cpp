@@ -66,7 +66,8 @@ int runPlayCommand(const PlayCommandOptions& options) {
         writeTextFile(dir / "stats.json", doc.dump(2) + "\n");
     };
     const InterruptWatch watch;
-    const auto onFrame = [&](const FrameStats& s, const Image& image, ShadingRate rate) {
+    const auto onFrame = [&](const FrameStats& s, const Image& image,
+                             const PlaybackQuality& quality) {
         double writeSeconds = 0.0;
         if (!options.noWrite) {
             const auto began = std::chrono::steady_clock::now();
@@ -96,7 +97,9 @@ int runPlayCommand(const PlayCommandOptions& options) {
              {"built_ahead", s.builtAhead},
              {"static_runs_due", staticRunsDueJson(scene, s)},
              {"quality",
-              {{"shading_rate", rate == ShadingRate::Pixel ? "pixel" : "sample"},
+              {{"level", quality.level},
+               {"shading_rate", shadingRateName(quality.step.rate)},
+               {"footprint_scale", quality.step.footprintScale},
                {"probes", s.probes},
                {"probe_fallbacks", s.probeFallbacks},
                {"older_representations", s.rebuildsDeferred}}},

@@ -111,6 +111,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
     std::unique_ptr<ReferenceRenderer> reference;
     if (!multiphase || options.compare) reference = std::make_unique<ReferenceRenderer>(scene);
     std::unique_ptr<MultiphaseRenderer> multi;
+    ShadingRate shadingRate = scene.settings.shadingRate;
     if (multiphase) {
         MultiphaseOptions mo;
         if (!options.shadingRate.empty()) {
@@ -118,9 +119,12 @@ int runRenderCommand(const RenderCommandOptions& options) {
                 mo.shadingRate = ShadingRate::Sample;
             else if (options.shadingRate == "pixel")
                 mo.shadingRate = ShadingRate::Pixel;
+            else if (options.shadingRate == "quad")
+                mo.shadingRate = ShadingRate::Quad;
             else
-                throw InputError({"--shading-rate", 0, 0, {}},
-                                 "expected sample or pixel, found '" + options.shadingRate + "'");
+                throw InputError(
+                    {"--shading-rate", 0, 0, {}},
+                    "expected sample, pixel or quad, found '" + options.shadingRate + "'");
         }
         if (options.footprintScale != 0.0f) {
             if (!(options.footprintScale >= 0.05f && options.footprintScale <= 8.0f))
@@ -138,6 +142,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         // --compare measures the multi-phase engine against the reference: a frame the
         // reference rendered in its place would only be compared with itself.
         mo.singlePhaseFrames = !options.noSinglePhase && !options.compare;
+        shadingRate = mo.shadingRate.value_or(shadingRate);
         multi = std::make_unique<MultiphaseRenderer>(scene, mo);
         multi->plan(first, last, render);
     }
@@ -162,8 +167,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
             {"frames", frames}};
         if (multi) {
-            doc["shading_rate"] =
-                scene.settings.shadingRate == ShadingRate::Pixel ? "pixel" : "sample";
+            doc["shading_rate"] = shadingRateName(shadingRate);
             nlohmann::json objects = nlohmann::json::array();
             for (size_t i = 0; i < multi->objectCount(); ++i) {
                 const ObjectReport& r = multi->report(i);
@@ -184,13 +188,16 @@ int runRenderCommand(const RenderCommandOptions& options) {
         writeTextFile(std::filesystem::path(options.outDir) / "stats.json", doc.dump(2) + "\n");
     };
     const InterruptWatch watch;
+    Image image;  // reused frame to frame
     for (int frame = first; frame < last; ++frame) {
         FrameStats stats;
         const ProgressFn progress = [&](int done, int total) {
             bar.update(frame, last - first, done, total);
         };
-        const Image image = multiphase ? multi->renderFrame(frame, render, stats, progress)
-                                       : reference->renderFrame(frame, render, stats, progress);
+        if (multiphase)
+            multi->renderFrame(frame, render, stats, image, progress);
+        else
+            image = reference->renderFrame(frame, render, stats, progress);
         char name[32];
         std::snprintf(name, sizeof name, "frame_%04d", frame);
         const std::string base = (std::filesystem::path(options.outDir) / name).string();

@@ -26,21 +26,36 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
     // The pre-roll has all the time it needs, but not more memory than the cache: its fills
     // go through the budgeted path, which stops when the cache is full.
     renderer.setFrameBudget(1e9);
+    const int spp = options.render.samplesPerPixel > 0 ? options.render.samplesPerPixel
+                                                       : scene.settings.samplesPerPixel;
+    renderer.setShadingRate(scene.settings.shadingRate);  // the regulator's top step
     FrameStats preroll;
-    renderer.renderSamples(options.first, options.render, preroll);
+    Image image;  // reused frame to frame
+    renderer.renderFrame(options.first, options.render, preroll, image);
+    // The regulator's ratios: the first frame again at every step, now warm (its objects
+    // built, its buffers allocated); each also fills what its own step reads.
+    QualityRegulator regulator(scene.settings.shadingRate, spp, options.regulator);
+    std::vector<double> stepSeconds(static_cast<size_t>(regulator.levels()));
+    for (int k = 0; k < regulator.levels(); ++k) {
+        renderer.setShadingRate(regulator.step(k).rate);
+        renderer.setFootprintScale(regulator.step(k).footprintScale);
+        FrameStats s;
+        renderer.renderFrame(options.first, options.render, s, image);
+        stepSeconds[static_cast<size_t>(k)] =
+            s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
+    }
     summary.prerollSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (onPreroll) onPreroll(summary.prerollSeconds);
     const double budget = 1.0 / options.fps;
     renderer.setFrameBudget(budget);
-    // The shading-rate regulator: per pixel once the dynamic phase takes most of the
-    // budget, per sample again once it takes little of it (hysteresis between the two, so
-    // it does not flicker frame to frame).
-    ShadingRate rate = scene.settings.shadingRate;
+    regulator.calibrate(stepSeconds, budget);
     for (int frame = options.first; frame < options.last; ++frame) {
-        renderer.setShadingRate(rate);
+        const PlaybackQuality quality{regulator.level(), regulator.step()};
+        renderer.setShadingRate(quality.step.rate);
+        renderer.setFootprintScale(quality.step.footprintScale);
         FrameStats stats;
-        const Image image = renderer.renderFrame(frame, options.render, stats);
+        renderer.renderFrame(frame, options.render, stats, image);
         const double slack = budget - stats.wallSeconds;
         if (options.lookAheadSeconds > 0.0 && slack > 0.0) {
             const int frames =
@@ -53,14 +68,8 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         }
         ++summary.frames;
         summary.deadlinesMet += stats.deadlineMet ? 1 : 0;
-        if (onFrame && !onFrame(stats, image, rate)) break;
-        const double dynamic =
-            stats.warpSeconds + stats.rasterSeconds + stats.shadeSeconds + stats.resolveSeconds;
-        if (rate == ShadingRate::Sample && dynamic > options.slowDownAt * budget)
-            rate = ShadingRate::Pixel;
-        else if (rate == ShadingRate::Pixel && scene.settings.shadingRate == ShadingRate::Sample &&
-                 dynamic < options.speedUpAt * budget)
-            rate = ShadingRate::Sample;
+        if (onFrame && !onFrame(stats, image, quality)) break;
+        regulator.update(stats, budget);
     }
     return summary;
 }

@@ -14,6 +14,7 @@
 
 #include <functional>
 
+#include "controller/quality_regulator.h"
 #include "phases/multiphase_renderer.h"
 
 namespace mpshade {
@@ -26,10 +27,9 @@ struct PlaybackOptions {
     // the always-resident levels are never dropped).
     size_t cacheBytes = size_t{256} << 20;
     PhaseTrace* trace = nullptr;  // not owned; null: no spans
-    // The shading-rate regulator: a frame whose dynamic phase took more than slowDownAt of
-    // the budget makes the next ones shade per pixel; per pixel, one under speedUpAt (half
-    // what per sample would cost, about) makes them shade per sample again.
-    double slowDownAt = 0.7, speedUpAt = 0.3;
+    // What frames give up when the dynamic phase alone takes most of the budget: shading
+    // rate, then probe footprint (quality_regulator.h).
+    QualityRegulatorOptions regulator;
     // Looking ahead: objects the next frames up to this many seconds of scene time will see,
     // not built yet, are built in a frame's slack (MultiphaseRenderer::buildAhead), so an
     // object entering the view is ready before its first frame. 0: no look-ahead.
@@ -41,10 +41,15 @@ struct PlaybackSummary {
     int frames = 0, deadlinesMet = 0;
 };
 
-// Plays frames [first, last); after each, onFrame(stats, image, the shading rate it used)
+// Plays frames [first, last); after each, onFrame(stats, image, the quality step it used)
 // (its time is not the frame's: writing to disk is the caller's), which returns false to
 // stop playback there.
-using PlaybackFrameFn = std::function<bool(const FrameStats&, const Image&, ShadingRate)>;
+struct PlaybackQuality {
+    int level = 0;  // QualityRegulator::level(): 0 is full quality
+    QualityStep step;
+};
+using PlaybackFrameFn =
+    std::function<bool(const FrameStats&, const Image&, const PlaybackQuality&)>;
 // onPreroll(seconds) once the pre-roll is done, before the first frame.
 PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
                           const PlaybackFrameFn& onFrame,

@@ -91,6 +91,7 @@ struct DynamicPhase::Band {
         std::vector<uint32_t> batchFacet;
         std::vector<float> batchX, batchY, batchColor, batchOpacity;
         std::vector<uint8_t> batchMissed;
+        std::vector<uint8_t> member;  // per fragment of a pixel block: its group
         SurfaceShadingScratch surface;
         SurfaceShadingCounters counters;
         std::vector<ObjectFrameCost> costs;  // per object
@@ -129,7 +130,7 @@ void DynamicPhase::begin(const FrameState& frame,
     const float footprint =
         options.footprintScale * (options.shadingRate == ShadingRate::Sample
                                       ? 1.0f / std::sqrt(static_cast<float>(layout_->spp()))
-                                      : 0.5f);
+                                      : (options.shadingRate == ShadingRate::Pixel ? 0.5f : 1.0f));
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
         const ObjectRepresentation* rep = objects_[i];
         if (!rep) return;
@@ -308,52 +309,66 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
                 int count;
             };
             Group groups[64];
-            uint8_t member[256];  // per (sample, layer) of the pixel: its group
-            for (int py = row0; py < row1; ++py)
-                for (int px = 0; px < width; ++px) {
-                    const size_t first = layout.index(px, py, 0);
+            // Per pixel, or per block of 2x2 pixels: the block's fragments grouped by
+            // surface. member: per (pixel of the block, sample, layer), its group.
+            const int block = options_.shadingRate == ShadingRate::Quad ? 2 : 1;
+            const size_t pixelSlots = static_cast<size_t>(spp) * layers;
+            s.member.resize(static_cast<size_t>(block * block) * pixelSlots);
+            for (int by = row0; by < row1; by += block)
+                for (int bx = 0; bx < width; bx += block) {
+                    const int y1 = std::min(row1, by + block), x1 = std::min(width, bx + block);
+                    // Calls f(sample, layer, member index) for every fragment of the block.
+                    auto forEachFragment = [&](auto&& f) {
+                        for (int py = by; py < y1; ++py)
+                            for (int px = bx; px < x1; ++px) {
+                                const size_t first = layout.index(px, py, 0);
+                                const size_t m0 =
+                                    static_cast<size_t>((py - by) * block + (px - bx)) * pixelSlots;
+                                for (int k = 0; k < spp; ++k)
+                                    for (int l = 0; l < vis.count[first + k]; ++l)
+                                        f(first + k, l, m0 + static_cast<size_t>(k * layers + l));
+                            }
+                    };
                     int groupCount = 0;
-                    for (int k = 0; k < spp && k * layers < 256; ++k)
-                        for (int l = 0; l < vis.count[first + k]; ++l) {
-                            const uint32_t o = vis.object[(first + k) * layers + l];
-                            int g = 0;
-                            while (g < groupCount &&
-                                   !(groups[g].object == o && groups[g].layer == l))
-                                ++g;
-                            if (g == groupCount) {
-                                if (groupCount == 64)
-                                    g = 0;  // more surfaces than that: merge
-                                else
-                                    groups[groupCount++] = {o, l, 0.0f, 0.0f, 0};
-                            }
-                            groups[g].sx += layout.x(first + k);
-                            groups[g].sy += layout.y(first + k);
-                            ++groups[g].count;
-                            member[k * layers + l] = static_cast<uint8_t>(g);
+                    forEachFragment([&](size_t smp, int l, size_t m) {
+                        const uint32_t o = vis.object[smp * layers + l];
+                        int g = 0;
+                        while (g < groupCount && !(groups[g].object == o && groups[g].layer == l))
+                            ++g;
+                        if (g == groupCount) {
+                            if (groupCount == 64)
+                                g = 0;  // more surfaces than that: merge
+                            else
+                                groups[groupCount++] = {o, l, 0.0f, 0.0f, 0};
                         }
-                    uint32_t pointOf[64];
+                        groups[g].sx += layout.x(smp);
+                        groups[g].sy += layout.y(smp);
+                        ++groups[g].count;
+                        s.member[m] = static_cast<uint8_t>(g);
+                    });
+                    // Each group's point: its centroid, on the facet of the member sample
+                    // nearest to it (the first such, in sample order).
+                    float cx[64], cy[64], best[64];
+                    uint32_t facet[64], pointOf[64];
                     for (int g = 0; g < groupCount; ++g) {
-                        const float cx = groups[g].sx / groups[g].count,
-                                    cy = groups[g].sy / groups[g].count;
-                        // The facet of the member sample nearest the centroid.
-                        uint32_t facet = 0;
-                        float best = 1e30f;
-                        for (int k = 0; k < spp && k * layers < 256; ++k)
-                            for (int l = 0; l < vis.count[first + k]; ++l) {
-                                if (member[k * layers + l] != g) continue;
-                                const float dx = layout.x(first + k) - cx,
-                                            dy = layout.y(first + k) - cy;
-                                if (dx * dx + dy * dy < best) {
-                                    best = dx * dx + dy * dy;
-                                    facet = vis.facet[(first + k) * layers + l];
-                                }
-                            }
-                        pointOf[g] = addPoint(groups[g].object, facet, cx, cy);
+                        cx[g] = groups[g].sx / groups[g].count;
+                        cy[g] = groups[g].sy / groups[g].count;
+                        best[g] = 1e30f;
+                        facet[g] = 0;
                     }
-                    for (int k = 0; k < spp && k * layers < 256; ++k)
-                        for (int l = 0; l < vis.count[first + k]; ++l)
-                            st.fragmentPoint[(first + k) * layers + l - firstSlot] =
-                                pointOf[member[k * layers + l]];
+                    forEachFragment([&](size_t smp, int l, size_t m) {
+                        const int g = s.member[m];
+                        const float dx = layout.x(smp) - cx[g], dy = layout.y(smp) - cy[g];
+                        if (dx * dx + dy * dy < best[g]) {
+                            best[g] = dx * dx + dy * dy;
+                            facet[g] = vis.facet[smp * layers + l];
+                        }
+                    });
+                    for (int g = 0; g < groupCount; ++g)
+                        pointOf[g] = addPoint(groups[g].object, facet[g], cx[g], cy[g]);
+                    forEachFragment([&](size_t smp, int l, size_t m) {
+                        st.fragmentPoint[smp * layers + l - firstSlot] = pointOf[s.member[m]];
+                    });
                 }
             // Grouped by object (a counting sort), the fragments following their points.
             const size_t points = s.unsortedObject.size();

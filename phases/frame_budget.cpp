@@ -47,6 +47,7 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
                                                 ahead.uniforms[i], nullptr, costs);
             longestEdge_[i] = 0.0f;
             lastBuildSeconds_[i] = costs.seconds;
+            staticInputs_[i].read(ahead.uniforms[i], builtInputs_[i]);
             ObjectReport& r = reports_[i];
             r.kind = kind;
             ++r.staticRuns;
@@ -78,10 +79,11 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     double perTile = 0.0;  // seconds a tile, as measured so far
     // A twentieth of the budget is kept for what follows the fills; chunks are sized to
     // 80% of the time left at the cost a tile has had so far, so one slow chunk does not
-    // overshoot.
+    // overshoot. A frame already late gets its minimum share; one that is not is never
+    // made late by fills.
+    const double budget = options_.frameBudgetSeconds, elapsed = secondsSince(start);
     const double deadline =
-        std::max(0.95 * options_.frameBudgetSeconds,
-                 secondsSince(start) + options_.minimumStaticShare * options_.frameBudgetSeconds);
+        elapsed < 0.95 * budget ? 0.95 * budget : elapsed + options_.minimumStaticShare * budget;
     while (next < lacking_.size()) {
         const double left = deadline - secondsSince(start);
         if (perTile > 0.0)

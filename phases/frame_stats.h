@@ -12,7 +12,15 @@ namespace mpshade {
 // sampling (facets carrying the n-tuple measured longer than P/2 last frame, pixels; the
 // image height changed). `measured` beyond `threshold` is the trigger.
 struct StaticRunDue {
-    enum Cause { FirstSeen, ViewDirection, Distance, AngleAround, FacetsTooLong, ImageSize };
+    enum Cause {
+        FirstSeen,
+        ViewDirection,
+        Distance,
+        AngleAround,
+        FacetsTooLong,
+        ImageSize,
+        StaticInput,  // measured: the largest move of an input over its span (static_inputs.h)
+    };
     uint32_t object = 0;
     Cause cause = FirstSeen;
     float measured = 0.0f, threshold = 0.0f;
@@ -32,6 +40,8 @@ inline const char* staticRunCauseName(StaticRunDue::Cause cause) {
             return "facets longer than P/2";
         case StaticRunDue::ImageSize:
             return "image height changed";
+        case StaticRunDue::StaticInput:
+            return "an animated input of its static part moved";
     }
     return "unknown";
 }

@@ -35,6 +35,10 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
     reports_.resize(n);
     for (size_t i = 0; i < n; ++i) reports_[i].name = scene.objects[i].name;
     lastBuildSeconds_.assign(n, 0.0);
+    staticInputs_.resize(n);
+    for (size_t i = 0; i < n; ++i) staticInputs_[i] = StaticInputs(factored(i).staticPart);
+    inputSpans_ = staticInputSpans(resources_, staticInputs_);
+    builtInputs_.assign(n, {});
 }
 
 MultiphaseRenderer::~MultiphaseRenderer() = default;
@@ -45,6 +49,12 @@ const ObjectRepresentation* MultiphaseRenderer::representation(size_t object) co
 
 const FactoredShader& MultiphaseRenderer::factored(size_t object) const {
     return static_.shading(object).factored;
+}
+
+float MultiphaseRenderer::inputsMoved(size_t object) {
+    if (staticInputs_[object].empty()) return 0.0f;
+    staticInputs_[object].read(frame_.uniforms[object], inputScratch_);
+    return staticInputChange(builtInputs_[object], inputScratch_, inputSpans_[object]);
 }
 
 void MultiphaseRenderer::discardStaticWork() {
@@ -270,6 +280,10 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
                             : StaticRunDue::AngleAround;
             due.measured = range.measured;
             due.threshold = range.threshold;
+        } else if (inputsMoved(i) > options_.staticInputTolerance) {
+            due.cause = StaticRunDue::StaticInput;
+            due.measured = inputsMoved(i);
+            due.threshold = options_.staticInputTolerance;
         } else if (rep->imageHeight != camera.height) {
             due.cause = StaticRunDue::ImageSize;
             due.measured = static_cast<float>(camera.height);
@@ -285,19 +299,22 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         stale.push_back(i);
     }
     // A frame budget: what was never built is built; what is due again is rebuilt, cheapest
-    // first, only while its last run fits the time left after the dynamic phase (as long as
-    // the last frame's); the others are drawn from their last representation.
+    // first, only while its last run, and half as much again (a re-dice of a nearer view
+    // makes more facets), fits the time left after the dynamic phase (as long as the last
+    // frame's) and the twentieth kept for the end of the frame; the others are drawn from
+    // their last representation.
     const bool budgeted = options_.frameBudgetSeconds > 0.0;
     if (budgeted && !stale.empty()) {
         std::vector<size_t> due, again;
         for (size_t i : stale) (representations_[i] ? again : due).push_back(i);
         std::sort(again.begin(), again.end(),
                   [&](size_t a, size_t b) { return lastBuildSeconds_[a] < lastBuildSeconds_[b]; });
-        double left = options_.frameBudgetSeconds - secondsSince(start) - lastDynamicSeconds_;
+        double left =
+            0.95 * options_.frameBudgetSeconds - secondsSince(start) - lastDynamicSeconds_;
         for (size_t i : again) {
-            if (lastBuildSeconds_[i] <= left) {
+            if (1.5 * lastBuildSeconds_[i] <= left) {
                 due.push_back(i);
-                left -= lastBuildSeconds_[i];
+                left -= 1.5 * lastBuildSeconds_[i];
             } else {
                 ++stats.rebuildsDeferred;
                 for (StaticRunDue& d : stats.staticRunsDue)
@@ -364,6 +381,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         r.staticCosts.seconds += costs[k].seconds;
         frameStaticSeconds_[stale[k]] += costs[k].seconds;
         lastBuildSeconds_[stale[k]] = costs[k].seconds;
+        staticInputs_[stale[k]].read(frame_.uniforms[stale[k]], builtInputs_[stale[k]]);
         r.staticCosts.instructions += costs[k].instructions;
         r.staticCosts.programRuns += costs[k].programRuns;
         r.staticCosts.tilesFilled += costs[k].tilesFilled;
@@ -502,16 +520,21 @@ bool MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
 
 Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
                                       const ProgressFn& progress) {
+    Image image;
+    renderFrame(frame, options, stats, image, progress);
+    return image;
+}
+
+void MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
+                                     Image& image, const ProgressFn& progress) {
     const auto start = Clock::now();
     const ScopedSpan span(options_.trace, "frame", PhaseKind::Frame, SpanLevel::Phase, -1, frame);
     render(frame, options, stats, progress);
     if (singlePhaseFrame_) {
-        Image image;
         singlePhaseSamples_.layout->resolve(singlePhaseSamples_.rgba.data(), nullptr, image);
         stats.wallSeconds = secondsSince(start);
-        return image;
+        return;
     }
-    Image image;
     dynamic_.resolve(image);
     stats.resolveSeconds = dynamic_.stats().resolveSeconds;
     if (options_.frameBudgetSeconds > 0.0) {
@@ -525,7 +548,6 @@ Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, F
         stats.deadlineMet = stats.wallSeconds <= options_.frameBudgetSeconds;
     }
     if (progress) progress(4, 4);
-    return image;
 }
 
 SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& options,

@@ -9,16 +9,18 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                                           const RepresentationCostModel& model) {
     const double frames = std::max(1, in.frames);
     const double staticPointNs = in.staticCostUnits * model.nsPerCostUnit + model.geometryPointNs;
-    const double points =
-        in.coveredPixels *
-        (in.shadingRate == ShadingRate::Pixel ? 1.0 : static_cast<double>(in.samplesPerPixel));
+    const double pointsPerPixel = in.shadingRate == ShadingRate::Sample
+                                      ? static_cast<double>(in.samplesPerPixel)
+                                      : (in.shadingRate == ShadingRate::Pixel ? 1.0 : 0.25);
+    const double points = in.coveredPixels * pointsPerPixel;
     // Combined: a vertex per two facets, shaded again at every run.
     const double facetsStatic =
         0.5 * in.combinedFacets * staticPointNs * std::max(1, in.combinedRuns);
     const double facetsFrame = in.combinedFacets * model.facetNs + points * model.vertexPointNs;
     // Separate: the texels frames ask for and the always-resident levels, unless built.
-    const double samplesScale =
-        in.shadingRate == ShadingRate::Pixel ? 1.0 : in.samplesPerPixel / 4.0;
+    const double samplesScale = in.shadingRate == ShadingRate::Sample  ? in.samplesPerPixel / 4.0
+                                : in.shadingRate == ShadingRate::Pixel ? 1.0
+                                                                       : 0.25;
     const double footprint = 0.6 / std::max(0.05f, in.footprintScale);
     const double texelsPerPixel =
         model.texelsPerCoveredPixel * samplesScale * footprint * footprint;

@@ -56,7 +56,8 @@ class SampleLayout {
     // Pixels from per-sample RGBA (4 floats per sample, index order): each pixel is the
     // filter-weighted mean of the samples within the filter's radius of its centre.
     // `uniform` (per pixel, may be null): 1 where every sample of the pixel holds the same
-    // RGBA as its first, which is then read once.
+    // RGBA as its first, which is then read once. `out` keeps its storage when its size is
+    // the layout's.
     void resolve(const float* rgba, const uint8_t* uniform, Image& out) const;
 
   private:

@@ -18,9 +18,15 @@
 namespace mpshade {
 
 // How often the dynamic shader runs: once per sub-pixel sample, or once per pixel and
-// visible surface with coverage still per sample (docs/multiphase.md has the figures that
-// chose the default).
-enum class ShadingRate { Sample, Pixel };
+// visible surface, or once per block of 2x2 pixels and visible surface, with coverage
+// still per sample (docs/multiphase.md has the figures that chose the default; `play`
+// lowers the rate when frames run late).
+enum class ShadingRate { Sample, Pixel, Quad };
+
+// The scene file's spelling: "sample", "pixel", "quad".
+inline const char* shadingRateName(ShadingRate rate) {
+    return rate == ShadingRate::Sample ? "sample" : rate == ShadingRate::Pixel ? "pixel" : "quad";
+}
 
 struct RenderSettings {
     int width = 640;             // pixels, 1..16384

@@ -180,8 +180,10 @@ class SceneLoader {
                 r.shadingRate = ShadingRate::Sample;
             else if (rate == "pixel")
                 r.shadingRate = ShadingRate::Pixel;
+            else if (rate == "quad")
+                r.shadingRate = ShadingRate::Quad;
             else
-                n->fail("unknown shading_rate '" + rate + "' (expected sample or pixel)");
+                n->fail("unknown shading_rate '" + rate + "' (expected sample, pixel or quad)");
         }
         if (r.fps > 1000.0f) s["fps"].fail("fps must be at most 1000");
         if (r.duration * r.fps > 1.0e6f)

@@ -85,31 +85,34 @@ TEST(Playback, NoTimeLeftDefersTilesAndRebuildsButDrawsEveryFrame) {
     }
 }
 
-TEST(Playback, PlaysEveryFrameAndRegulatesTheShadingRate) {
+TEST(Playback, PlaysEveryFrameAndRegulatesItsQuality) {
     const Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
     PlaybackOptions options;
     options.render = small();
     options.first = 0;
     options.last = 4;
-    // A rate no frame can meet: the regulator must move to per-pixel shading at once.
+    // A rate no frame can meet: the pre-roll's frame sets the regulator on its last step.
     options.fps = 1e6;
-    std::vector<ShadingRate> rates;
+    std::vector<PlaybackQuality> steps;
     int frames = 0;
-    const PlaybackSummary summary =
-        playScene(scene, options, [&](const FrameStats& s, const Image& image, ShadingRate r) {
+    const PlaybackSummary summary = playScene(
+        scene, options, [&](const FrameStats& s, const Image& image, const PlaybackQuality& q) {
             EXPECT_EQ(s.index, options.first + frames);
             EXPECT_DOUBLE_EQ(s.budgetSeconds, 1e-6);
             EXPECT_EQ(image.width, 96);
-            rates.push_back(r);
+            steps.push_back(q);
             ++frames;
             return true;
         });
     EXPECT_EQ(summary.frames, 4);
     EXPECT_EQ(summary.deadlinesMet, 0);
     EXPECT_GT(summary.prerollSeconds, 0.0);
-    ASSERT_EQ(rates.size(), 4u);
-    EXPECT_EQ(rates[0], ShadingRate::Sample);  // the scene's
-    for (size_t k = 1; k < rates.size(); ++k) EXPECT_EQ(rates[k], ShadingRate::Pixel);
+    ASSERT_EQ(steps.size(), 4u);
+    for (const PlaybackQuality& q : steps) {
+        EXPECT_EQ(q.level, 4);  // the scene shades per sample: five steps
+        EXPECT_EQ(q.step.rate, ShadingRate::Quad);
+        EXPECT_EQ(q.step.footprintScale, 2.0f);
+    }
 }
 
 }  // namespace
@@ -156,7 +159,7 @@ TEST(Playback, AnObjectEnteringTheViewIsBuiltBeforeItsFirstFrame) {
     options.fps = 2.0;  // half a second a frame: slack for building ahead
     std::vector<FrameStats> without, with;
     options.lookAheadSeconds = 0.0;
-    playScene(scene, options, [&](const FrameStats& s, const Image&, ShadingRate) {
+    playScene(scene, options, [&](const FrameStats& s, const Image&, const PlaybackQuality&) {
         without.push_back(s);
         return true;
     });
@@ -164,7 +167,7 @@ TEST(Playback, AnObjectEnteringTheViewIsBuiltBeforeItsFirstFrame) {
     const int enters = firstSeenFrame(without, 1);
     ASSERT_GT(enters, 1);
     options.lookAheadSeconds = 1.0;
-    playScene(scene, options, [&](const FrameStats& s, const Image&, ShadingRate) {
+    playScene(scene, options, [&](const FrameStats& s, const Image&, const PlaybackQuality&) {
         with.push_back(s);
         return true;
     });
@@ -203,7 +206,7 @@ TEST(Playback, AOneMegabyteCacheHoldsEveryFrameAndStillDrawsThem) {
     options.cacheBytes = size_t{1} << 20;
     int frames = 0;
     uint64_t deferred = 0;
-    playScene(scene, options, [&](const FrameStats& s, const Image& image, ShadingRate) {
+    playScene(scene, options, [&](const FrameStats& s, const Image& image, const PlaybackQuality&) {
         ++frames;
         EXPECT_LE(s.residentBytes - s.residentPinnedBytes, options.cacheBytes) << s.index;
         EXPECT_LE(s.residentPinnedBytes, s.residentBytes);

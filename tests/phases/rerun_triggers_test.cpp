@@ -1,6 +1,7 @@
 // When an object goes back through the static phase, and why: the fiducial that crossed
 // its threshold, measured here independently from the scene's camera.
 #include <cmath>
+#include <fstream>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
@@ -83,6 +84,99 @@ TEST(RerunTriggers, ANewImageHeightIsDueWithBothHeights) {
         EXPECT_EQ(d.measured, 48.0f);
         EXPECT_EQ(d.threshold, 36.0f);
     }
+}
+
+}  // namespace
+}  // namespace mpshade
+
+namespace mpshade {
+namespace {
+
+// A ball whose baked colour follows an animated parameter (k: 0 at t = 0 to 1 at t = 1),
+// and one whose animated parameter stays dynamic (not baked); the camera stands still.
+std::string writeBakedInputScene() {
+    const std::string dir = ::testing::TempDir();
+    {
+        std::ofstream sl(dir + "mpshade_baked_k.sl");
+        sl << "surface baked_k(float k = 0.0) {\n"
+              "    Ci = bake(color(k) * (0.5 + 0.5 * noise(P * 3.0)));\n"
+              "    Oi = 1.0;\n"
+              "}\n";
+        std::ofstream dyn(dir + "mpshade_dynamic_k.sl");
+        dyn << "surface dynamic_k(float k = 0.0) {\n"
+               "    Ci = color(k) * (0.5 + 0.5 * noise(P * 3.0));\n"
+               "    Oi = 1.0;\n"
+               "}\n";
+    }
+    const std::string path = dir + "mpshade_baked_input_scene.json";
+    std::ofstream f(path);
+    f << R"({
+  "settings": {"width": 64, "height": 36, "fps": 10, "duration": 1.0, "samples_per_pixel": 1},
+  "camera": {"fov_y": 40, "near": 0.1, "far": 100, "keys": [
+    {"t": 0, "eye": [0, 0, 6], "target": [0, 0, 0]}]},
+  "shaders": {"baked": ")"
+      << dir << R"(mpshade_baked_k.sl", "dynamic": ")" << dir << R"(mpshade_dynamic_k.sl"},
+  "objects": [
+    {"name": "baked", "geometry": {"type": "sphere", "radius": 1.0}, "shader": "baked",
+     "transform": {"translate": [-1.2, 0, 0]},
+     "params": {"k": {"keys": [{"t": 0, "value": 0.0}, {"t": 1, "value": 1.0}]}}},
+    {"name": "dynamic", "geometry": {"type": "sphere", "radius": 1.0}, "shader": "dynamic",
+     "transform": {"translate": [1.2, 0, 0]},
+     "params": {"k": {"keys": [{"t": 0, "value": 0.0}, {"t": 1, "value": 1.0}]}}}]
+})";
+    return path;
+}
+
+double meanRed(const Image& image, int x0, int x1) {
+    double sum = 0.0;
+    for (int y = 0; y < image.height; ++y)
+        for (int x = x0; x < x1; ++x)
+            sum += image.rgba[4 * (static_cast<size_t>(y) * image.width + x)];
+    return sum / ((x1 - x0) * image.height);
+}
+
+TEST(RerunTriggers, ABakedAnimatedInputThatMovesRunsTheStaticPhaseAgain) {
+    const Scene scene = loadScene(writeBakedInputScene());
+    ASSERT_EQ(scene.frameCount(), 10);
+    MultiphaseRenderer renderer(scene, everyFrame());
+    FrameStats stats;
+    renderer.renderFrame(0, tiny(), stats);
+    ASSERT_EQ(stats.staticRunsDue.size(), 2u);  // both first seen
+    renderer.renderFrame(1, tiny(), stats);
+    // k moved 0.1 of its span over the frames (t = 0 .. 0.9: 0.9): 0.111 > 0.02.
+    ASSERT_EQ(stats.staticRunsDue.size(), 1u);
+    const StaticRunDue& d = stats.staticRunsDue[0];
+    EXPECT_EQ(d.object, 0u);
+    EXPECT_EQ(d.cause, StaticRunDue::StaticInput);
+    EXPECT_NEAR(d.measured, 0.1f / 0.9f, 1e-4f);
+    EXPECT_EQ(d.threshold, 0.02f);
+    EXPECT_EQ(stats.staticRuns, 1);
+    // The baked ball follows k: at frame 7 it is as bright as the reference renderer's.
+    const Image image = renderer.renderFrame(7, tiny(), stats);
+    ReferenceRenderer reference(scene);
+    FrameStats refStats;
+    const Image truth = reference.renderFrame(7, tiny(), refStats);
+    const double got = meanRed(image, 0, 32), want = meanRed(truth, 0, 32);
+    ASSERT_GT(want, 0.05);
+    EXPECT_NEAR(got / want, 1.0, 0.02);
+}
+
+TEST(RerunTriggers, AnInputMovingWithinTheToleranceRunsNothing) {
+    const Scene scene = loadScene(writeBakedInputScene());
+    MultiphaseOptions o = everyFrame();
+    o.staticInputTolerance = 0.5f;  // half of k's span: 4.5 frames
+    MultiphaseRenderer renderer(scene, o);
+    FrameStats stats;
+    for (int frame = 0; frame <= 4; ++frame) {
+        renderer.renderFrame(frame, tiny(), stats);
+        if (frame > 0) {
+            EXPECT_TRUE(stats.staticRunsDue.empty()) << frame;
+        }
+    }
+    renderer.renderFrame(5, tiny(), stats);  // 0.5 / 0.9 = 0.56 of the span
+    ASSERT_EQ(stats.staticRunsDue.size(), 1u);
+    EXPECT_EQ(stats.staticRunsDue[0].cause, StaticRunDue::StaticInput);
+    EXPECT_NEAR(stats.staticRunsDue[0].measured, 0.5f / 0.9f, 1e-4f);
 }
 
 }  // namespace

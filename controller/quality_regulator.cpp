@@ -1,0 +1,92 @@
+#include "controller/quality_regulator.h"
+
+#include <algorithm>
+
+#include "geometry/error.h"
+
+namespace mpshade {
+namespace {
+
+double pointsPerPixel(ShadingRate rate, int spp) {
+    switch (rate) {
+        case ShadingRate::Sample:
+            return static_cast<double>(spp);
+        case ShadingRate::Pixel:
+            return 1.0;
+        case ShadingRate::Quad:
+            return 0.25;
+    }
+    return 1.0;
+}
+
+double dynamicSeconds(const FrameStats& s) {
+    return s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
+}
+
+}  // namespace
+
+QualityRegulator::QualityRegulator(ShadingRate sceneRate, int spp,
+                                   const QualityRegulatorOptions& options)
+    : options_(options) {
+    if (sceneRate == ShadingRate::Sample) steps_.push_back({ShadingRate::Sample, 1.0f});
+    if (sceneRate != ShadingRate::Quad) {
+        steps_.push_back({ShadingRate::Pixel, 1.0f});
+        steps_.push_back({ShadingRate::Pixel, 2.0f});
+    }
+    steps_.push_back({ShadingRate::Quad, 1.0f});
+    steps_.push_back({ShadingRate::Quad, 2.0f});
+    // Until measured: as if the whole dynamic phase scaled with the shading points (an
+    // overestimate: rasterization and resolve do not).
+    ratioAbove_.assign(steps_.size(), 1.0);
+    for (size_t k = 1; k < steps_.size(); ++k)
+        ratioAbove_[k] = pointsPerPixel(steps_[k - 1].rate, std::max(1, spp)) /
+                         pointsPerPixel(steps_[k].rate, std::max(1, spp));
+}
+
+void QualityRegulator::calibrate(std::span<const double> seconds, double budget) {
+    MPSHADE_CHECK(seconds.size() == steps_.size());
+    // A lower step never costs more than the one above it in the model; a measurement
+    // that says so is noise, so ratios stay at least 1.
+    for (size_t k = 1; k < steps_.size(); ++k)
+        ratioAbove_[k] = seconds[k] > 0.0 ? std::max(1.0, seconds[k - 1] / seconds[k]) : 1.0;
+    const double target = 0.5 * (options_.slowDownAt + options_.speedUpAt) * budget;
+    current_ = levels() - 1;
+    for (int k = 0; k < levels(); ++k)
+        if (seconds[static_cast<size_t>(k)] <= target) {
+            current_ = k;
+            break;
+        }
+    calm_ = 0;
+    lastLevel_ = -1;
+}
+
+void QualityRegulator::update(const FrameStats& stats, double budget) {
+    const double dynamic = dynamicSeconds(stats);
+    // Neighbouring steps on consecutive frames: their ratio, measured on nearly one view.
+    if (lastLevel_ >= 0 && dynamic > 0.0 && lastDynamic_ > 0.0) {
+        const int below = std::max(lastLevel_, current_);
+        if (std::abs(lastLevel_ - current_) == 1) {
+            const double upper = lastLevel_ < current_ ? lastDynamic_ : dynamic;
+            const double lower = lastLevel_ < current_ ? dynamic : lastDynamic_;
+            ratioAbove_[static_cast<size_t>(below)] = std::max(1.0, upper / lower);
+        }
+    }
+    lastLevel_ = current_;
+    lastDynamic_ = dynamic;
+    if (dynamic > options_.slowDownAt * budget) {
+        current_ = std::min(current_ + 1, levels() - 1);
+        calm_ = 0;
+        return;
+    }
+    if (current_ == 0) return;
+    if (dynamic * ratioAbove_[static_cast<size_t>(current_)] >= options_.speedUpAt * budget) {
+        calm_ = 0;
+        return;
+    }
+    if (++calm_ >= options_.calmFrames) {
+        --current_;
+        calm_ = 0;
+    }
+}
+
+}  // namespace mpshade

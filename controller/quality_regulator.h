@@ -1,0 +1,72 @@
+// quality_regulator.h -- what `play` gives up when the dynamic phase alone would take the
+// frame's time (the patent's Applications: quality "reduced occasionally to meet the
+// frame rate"; Lengyel & Snyder 1997, sec. 6: a regulator trades quality parameters for
+// fixed rendering resources, measuring what each change costs).
+//
+// A ladder of steps, best first, each cheaper than the one above:
+//   the scene's shading rate at footprint 1; per pixel; per pixel reading one mip level
+//   coarser (footprint x2: a quarter of the tiles to fill); per 2x2 pixels (a quarter of the
+//   shading points, and the same level as the step above); per 2x2 pixels one level coarser.
+// Coverage stays per sample on every step: edges keep their antialiasing.
+//
+// After each frame the regulator steps down at once when the dynamic phase (warp to
+// resolve) took more than `slowDownAt` of the budget, and steps up after `calmFrames`
+// frames in a row whose dynamic phase, times the step above's cost ratio, would take less
+// than `speedUpAt`. The ratios are measured: all of them before the first frame
+// (calibrate: one view rendered at every step), then each again whenever two consecutive
+// frames ran on neighbouring steps. The gap between the two shares and the wait keep it
+// from flickering between steps.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "phases/frame_stats.h"
+#include "scene/scene.h"
+
+namespace mpshade {
+
+struct QualityStep {
+    ShadingRate rate = ShadingRate::Sample;
+    float footprintScale = 1.0f;  // DynamicOptions::footprintScale
+};
+
+struct QualityRegulatorOptions {
+    double slowDownAt = 0.7;  // of the budget: a dynamic phase above it steps down
+    double speedUpAt = 0.6;   // of the budget: the step above, predicted below it, steps up
+    int calmFrames = 8;       // frames in a row that must predict so before stepping up
+};
+
+class QualityRegulator {
+  public:
+    // sceneRate: the top step's rate (the scene's); spp: samples per pixel (the shading
+    // point ratio between per-sample and per-pixel shading, before anything is measured).
+    QualityRegulator(ShadingRate sceneRate, int spp, const QualityRegulatorOptions& options = {});
+
+    const QualityStep& step() const { return steps_[current_]; }
+    const QualityStep& step(int level) const { return steps_[level]; }
+    int level() const { return current_; }  // 0: full quality
+    int levels() const { return static_cast<int>(steps_.size()); }
+
+    // Before the first frame: `dynamicSeconds[k]`, one view's dynamic phase at step k (every
+    // step, warm: its tiles resident). Takes the ratios between neighbouring steps from them
+    // and starts at the best step within the middle of the two shares.
+    void calibrate(std::span<const double> dynamicSeconds, double budget);
+
+    // After a frame rendered at step(), with `budget` seconds: moves the step for the next.
+    void update(const FrameStats& stats, double budget);
+
+    // The dynamic phase at step level - 1 over that at `level` (>= 1), as last measured.
+    double costRatioAbove(int level) const { return ratioAbove_[level]; }
+
+  private:
+    std::vector<QualityStep> steps_;
+    std::vector<double> ratioAbove_;  // per level >= 1
+    QualityRegulatorOptions options_;
+    int current_ = 0;
+    int calm_ = 0;
+    int lastLevel_ = -1;  // the previous frame's, and its dynamic seconds
+    double lastDynamic_ = 0.0;
+};
+
+}  // namespace mpshade

@@ -1,0 +1,113 @@
+#include "controller/quality_regulator.h"
+
+#include <gtest/gtest.h>
+
+namespace mpshade {
+namespace {
+
+// A frame whose dynamic phase took `rest` seconds outside shading and `shade` shading.
+FrameStats frame(double rest, double shade = 0.0) {
+    FrameStats s;
+    s.warpSeconds = 0.25 * rest;
+    s.rasterSeconds = 0.5 * rest;
+    s.resolveSeconds = 0.25 * rest;
+    s.shadeSeconds = shade;
+    return s;
+}
+
+// Shares exact in binary, so the tests can sit on their boundaries: a step down above 3/4
+// of the budget, a step up predicted below 1/2, a start within 5/8.
+QualityRegulatorOptions exactShares() {
+    QualityRegulatorOptions o;
+    o.slowDownAt = 0.75;
+    o.speedUpAt = 0.5;
+    return o;
+}
+
+TEST(QualityRegulator, TheLadderStartsAtTheScenesRate) {
+    const QualityRegulator fromSample(ShadingRate::Sample, 4);
+    ASSERT_EQ(fromSample.levels(), 5);
+    EXPECT_EQ(fromSample.step().rate, ShadingRate::Sample);
+    EXPECT_EQ(fromSample.step().footprintScale, 1.0f);
+    EXPECT_EQ(fromSample.step(2).rate, ShadingRate::Pixel);
+    EXPECT_EQ(fromSample.step(2).footprintScale, 2.0f);
+    EXPECT_EQ(fromSample.step(4).rate, ShadingRate::Quad);
+    EXPECT_EQ(fromSample.step(4).footprintScale, 2.0f);
+    const QualityRegulator fromPixel(ShadingRate::Pixel, 4);
+    EXPECT_EQ(fromPixel.levels(), 4);
+    EXPECT_EQ(fromPixel.step().rate, ShadingRate::Pixel);
+    const QualityRegulator fromQuad(ShadingRate::Quad, 4);
+    EXPECT_EQ(fromQuad.levels(), 2);
+    EXPECT_EQ(fromQuad.step().rate, ShadingRate::Quad);
+}
+
+TEST(QualityRegulator, BeforeMeasuringTheRatiosAreTheShadingPoints) {
+    const QualityRegulator r(ShadingRate::Sample, 8);
+    EXPECT_EQ(r.costRatioAbove(1), 8.0);  // per sample over per pixel
+    EXPECT_EQ(r.costRatioAbove(2), 1.0);  // the footprint alone differs
+    EXPECT_EQ(r.costRatioAbove(3), 4.0);  // per pixel over per 2x2 pixels
+    EXPECT_EQ(r.costRatioAbove(4), 1.0);
+}
+
+TEST(QualityRegulator, StepsDownOnlyAboveItsShareAndStopsAtTheBottom) {
+    QualityRegulator r(ShadingRate::Sample, 4, exactShares());
+    r.update(frame(0.5, 0.25), 1.0);  // exactly at the share is not above it
+    EXPECT_EQ(r.level(), 0);
+    r.update(frame(0.5, 0.2501), 1.0);
+    EXPECT_EQ(r.level(), 1);
+    EXPECT_EQ(r.step().rate, ShadingRate::Pixel);
+    for (int k = 0; k < 10; ++k) r.update(frame(2.0, 2.0), 1.0);
+    EXPECT_EQ(r.level(), 4);
+}
+
+TEST(QualityRegulator, StartsAtTheBestStepItsCalibrationFits) {
+    QualityRegulator fits(ShadingRate::Sample, 4, exactShares());
+    const double atTarget[] = {0.625, 0.5, 0.25, 0.125, 0.0625};
+    fits.calibrate(atTarget, 1.0);
+    EXPECT_EQ(fits.level(), 0);
+    EXPECT_EQ(fits.costRatioAbove(1), 1.25);
+    EXPECT_EQ(fits.costRatioAbove(2), 2.0);
+    QualityRegulator perPixel(ShadingRate::Sample, 4, exactShares());
+    const double justAbove[] = {0.626, 0.625, 0.5, 0.25, 0.5};  // the last: noise
+    perPixel.calibrate(justAbove, 1.0);
+    EXPECT_EQ(perPixel.level(), 1);
+    EXPECT_EQ(perPixel.costRatioAbove(4), 1.0);  // a lower step costing more counts as equal
+    QualityRegulator none(ShadingRate::Sample, 4, exactShares());
+    const double late[] = {4.0, 2.0, 1.0, 0.75, 0.7};
+    none.calibrate(late, 1.0);
+    EXPECT_EQ(none.level(), 4);
+}
+
+TEST(QualityRegulator, StepsUpAfterCalmFramesPredictingTheStepAboveFits) {
+    QualityRegulator r(ShadingRate::Sample, 4, exactShares());  // calmFrames 8
+    const double seconds[] = {1.0, 0.5, 0.375, 0.25, 0.125};
+    r.calibrate(seconds, 1.0);
+    ASSERT_EQ(r.level(), 1);
+    ASSERT_EQ(r.costRatioAbove(1), 2.0);
+    // 0.25 x 2 is exactly the share: does not fit.
+    for (int k = 0; k < 20; ++k) r.update(frame(0.25), 1.0);
+    EXPECT_EQ(r.level(), 1);
+    for (int k = 0; k < 7; ++k) r.update(frame(0.24), 1.0);
+    EXPECT_EQ(r.level(), 1);
+    r.update(frame(0.25), 1.0);  // one that does not fit starts the count again
+    for (int k = 0; k < 7; ++k) r.update(frame(0.24), 1.0);
+    EXPECT_EQ(r.level(), 1);
+    r.update(frame(0.24), 1.0);
+    EXPECT_EQ(r.level(), 0);
+    // The first frame on the step above measures the ratio again: 0.6 / 0.24.
+    r.update(frame(0.6), 1.0);
+    EXPECT_EQ(r.level(), 0);
+    EXPECT_DOUBLE_EQ(r.costRatioAbove(1), 2.5);
+}
+
+TEST(QualityRegulator, AStepDownMeasuresTheRatioOfTheTwoSteps) {
+    QualityRegulator r(ShadingRate::Pixel, 4, exactShares());
+    r.update(frame(0.8), 1.0);  // to level 1
+    ASSERT_EQ(r.level(), 1);
+    r.update(frame(0.2), 1.0);
+    EXPECT_DOUBLE_EQ(r.costRatioAbove(1), 4.0);
+    EXPECT_EQ(r.costRatioAbove(2), 4.0);  // not measured: the points' ratio
+}
+
+}  // namespace
+}  // namespace mpshade
