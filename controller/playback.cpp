@@ -44,6 +44,10 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         stepSeconds[static_cast<size_t>(k)] =
             s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
     }
+    // And one prediction, so the first frames know what one costs.
+    double predictCost = 0.0;  // the last prediction's seconds
+    if (options.prefetch)
+        renderer.predictTiles(options.first, options.render, options.predictDivisor, predictCost);
     summary.prerollSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (onPreroll) onPreroll(summary.prerollSeconds);
@@ -62,6 +66,27 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
                 static_cast<int>(std::ceil(options.lookAheadSeconds * scene.settings.fps));
             const double spent =
                 renderer.buildAhead(frame, frames, options.render, slack, stats.builtAhead);
+            stats.staticSeconds += spent;
+            stats.wallSeconds += spent;
+            stats.deadlineMet = stats.wallSeconds <= budget;
+        }
+        // Only once the frame's own tiles are all in, within the twentieth of the budget
+        // kept for the end of the frame.
+        if (options.prefetch && stats.tilesDeferred == 0 &&
+            0.95 * budget - stats.wallSeconds > predictCost) {
+            const double left = 0.95 * budget - stats.wallSeconds;
+            const int ahead = std::min(
+                options.last - 1,
+                frame + std::max(1, static_cast<int>(std::lround(options.predictSeconds *
+                                                                 scene.settings.fps))));
+            std::vector<TileRequest> tiles =
+                renderer.predictTiles(ahead, options.render, options.predictDivisor, predictCost);
+            stats.tilesPredicted = tiles.size();
+            const std::vector<TileRequest> adjacent = renderer.adjacentTiles();
+            stats.tilesAdjacent = adjacent.size();
+            tiles.insert(tiles.end(), adjacent.begin(), adjacent.end());
+            const double spent = predictCost + renderer.prefetch(tiles, left - predictCost, stats);
+            stats.prefetchSeconds = spent;
             stats.staticSeconds += spent;
             stats.wallSeconds += spent;
             stats.deadlineMet = stats.wallSeconds <= budget;

@@ -34,6 +34,12 @@ struct PlaybackOptions {
     // not built yet, are built in a frame's slack (MultiphaseRenderer::buildAhead), so an
     // object entering the view is ready before its first frame. 0: no look-ahead.
     double lookAheadSeconds = 0.5;
+    // Prefetching in what is left of a frame after that: the tiles of the frame this many
+    // seconds of scene time ahead, predicted at 1/predictDivisor of the image each way
+    // (claim 11), then those next to the tiles this frame lacked (claim 10). Off: none.
+    bool prefetch = true;
+    double predictSeconds = 0.1;
+    int predictDivisor = 4;
 };
 
 struct PlaybackSummary {

@@ -63,7 +63,10 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
 }
 
 void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& stats) {
-    if (lacking_.empty()) return;
+    if (lacking_.empty()) {
+        lastLacking_.clear();
+        return;
+    }
     const int frame = stats.index;
     // Coarser levels first: a tile there serves four times the surface of one a level
     // finer, and (built from its children where they are resident) costs no more.
@@ -75,10 +78,10 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     timing.trace = options_.trace;
     timing.frame = frame;
     const auto fillStart = Clock::now();
-    size_t next = 0, chunk = 8;
-    double perTile = 0.0;  // seconds a tile, as measured so far
+    size_t next = 0, chunk = 2;
+    double perTile = tileSeconds_;  // seconds a tile, as measured so far
     // A twentieth of the budget is kept for what follows the fills; chunks are sized to
-    // 80% of the time left at the cost a tile has had so far, so one slow chunk does not
+    // half the time left at the cost a tile has had lately, so one slow chunk does not
     // overshoot. A frame already late gets its minimum share; one that is not is never
     // made late by fills.
     const double budget = options_.frameBudgetSeconds, elapsed = secondsSince(start);
@@ -87,7 +90,7 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     while (next < lacking_.size()) {
         const double left = deadline - secondsSince(start);
         if (perTile > 0.0)
-            chunk = static_cast<size_t>(std::clamp(0.8 * left / perTile, 0.0, 4096.0));
+            chunk = static_cast<size_t>(std::clamp(0.5 * left / perTile, 0.0, 4096.0));
         if (left <= 0.0 || chunk == 0) break;
         const size_t end = std::min(lacking_.size(), next + chunk);
         const std::span<const TileRequest> batch(lacking_.data() + next, end - next);
@@ -100,6 +103,7 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         static_.fill(batch, drawn_, fills, &timing);
         const double took = secondsSince(began);
         perTile = std::max(perTile * 0.5, took / static_cast<double>(batch.size()));
+        tileSeconds_ = perTile;
         for (const TileRequest& r : batch) ++reports_[r.object].staticCosts.tilesFilled;
         next = end;
     }
@@ -124,6 +128,7 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         stats.residentBytes += pool->bytesHeld();
         stats.residentPinnedBytes += pool->pinnedBytesHeld();
     }
+    lastLacking_.swap(lacking_);
     lacking_.clear();
 }
 

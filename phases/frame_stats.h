@@ -100,6 +100,14 @@ struct FrameStats {
     uint64_t tilesDeferred = 0;
     int rebuildsDeferred = 0;
     int builtAhead = 0;  // objects built in this frame's slack for frames ahead that see them
+    // Prefetching in the frame's slack (MultiphaseRenderer::prefetch): tiles predicted by a
+    // low-resolution look at a frame ahead (claim 11) and next to tiles lacked (claim 10),
+    // those filled; and of the tiles prefetched before, those this frame's probes read
+    // first (used) and those dropped, or left unread for
+    // MultiphaseOptions::prefetchPatienceFrames, unread (wasted).
+    uint64_t tilesPredicted = 0, tilesAdjacent = 0, tilesPrefetched = 0;
+    uint64_t prefetchUsed = 0, prefetchWasted = 0;
+    double prefetchSeconds = 0.0;  // of staticSeconds: predicting and prefetching
     std::vector<StaticRunDue> staticRunsDue;  // every object whose static phase was due
 };
 

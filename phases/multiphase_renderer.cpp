@@ -418,6 +418,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         stats.tilesRequested += lacking_.size();
         drawn_ = drawn;
     }
+    if (!prefetched_.empty()) settlePrefetched(stats);
     for (int pass = 0; !budgeted; ++pass) {
         const bool last = pass >= 6;  // a safety net: each pass fills what the last lacked
         const std::vector<TileRequest> lacking = dynamic_.shade(last);

@@ -76,6 +76,9 @@ struct MultiphaseOptions {
     // animated inputs (through bake()) runs its static phase again once one of them moved
     // by more than this share of its span over the scene since the last run.
     float staticInputTolerance = 0.02f;
+    // A prefetched tile no frame read within this many frames counts as wasted (it stays
+    // resident, an ordinary tile for the cache).
+    int prefetchPatienceFrames = 30;
 };
 
 // Per object, for stats.json: what the static phase chose and did.
@@ -131,6 +134,19 @@ class MultiphaseRenderer {
     // fits in `seconds`. Returns the seconds spent; `built` counts the objects built.
     double buildAhead(int frame, int frames, const RenderOptions& options, double seconds,
                       int& built);
+    // Prefetching, for a caller with time left in a frame (patent claims 10 and 11):
+    // The tiles frame `frame` will lack, predicted by a low-resolution dynamic phase (the
+    // image 1/divisor each way, one sample a pixel, shading per pixel with footprints
+    // scaled to the full image's at the current rate) over the objects built; its probes
+    // fall back, never wait. `seconds` receives its cost.
+    std::vector<TileRequest> predictTiles(int frame, const RenderOptions& options, int divisor,
+                                          double& seconds);
+    // The tiles next to those the last frame lacked (the 8 around, same level), not resident.
+    std::vector<TileRequest> adjacentTiles() const;
+    // Fills those of `tiles` not resident, in order, while the time spent stays within
+    // `seconds` and the cache has room; counts them in stats.tilesPrefetched. Returns the
+    // seconds spent.
+    double prefetch(std::span<const TileRequest> tiles, double seconds, FrameStats& stats);
     // Overrides the scene's shading rate for the frames that follow (unset: the scene's).
     void setShadingRate(std::optional<ShadingRate> rate) { options_.shadingRate = rate; }
     // Sets DynamicOptions::footprintScale for the frames that follow (2: probes read one mip
@@ -153,6 +169,9 @@ class MultiphaseRenderer {
     // Drops the least recently used tiles until `incoming` more bytes of tiles fit the
     // budget (or nothing the frame has not used is left); returns whether they fit.
     bool keepMapsInBudget(size_t incoming, FrameStats& stats);
+    // Of the tiles prefetched, those this frame's probes read (used) and those dropped or
+    // left unread too long (wasted), counted in stats and forgotten.
+    void settlePrefetched(FrameStats& stats);
     Representation chooseKind(size_t object, int frame, const ObjectState& state,
                               const CameraState& camera, int spp, ObjectCostInputs& in);
     // The cost estimate's inputs that need no dicing survey (combinedFacets is left 0).
@@ -202,6 +221,21 @@ class MultiphaseRenderer {
     std::vector<StaticInputs> staticInputs_;
     std::vector<std::vector<float>> inputSpans_, builtInputs_;
     std::vector<float> inputScratch_;
+    // Prefetching: the last frame's lacking tiles; the tiles prefetched and not yet read
+    // (with the use stamp they were filled at); the low-resolution predictor.
+    std::vector<TileRequest> lastLacking_;
+    double tileSeconds_ = 0.0;  // what a tile's fill took lately (0: not measured yet)
+    struct Prefetched {
+        uint32_t object;
+        const ShaderMap* map;
+        TileKey key;
+        int slot;
+        uint32_t stamp;
+    };
+    std::vector<Prefetched> prefetched_;
+    std::unique_ptr<DynamicPhase> predictor_;
+    std::shared_ptr<const SampleLayout> predictLayout_;
+    FrameState predictState_;
     std::vector<TileRequest> lacking_;
     std::vector<const ObjectRepresentation*> drawn_;
     double lastDynamicSeconds_ = 0.0;

@@ -55,6 +55,9 @@ class TilePool {
     void markUsed(int slot, uint32_t stamp) const {
         __atomic_store_n(&lastUse_[static_cast<size_t>(slot)], stamp, __ATOMIC_RELAXED);
     }
+    uint32_t lastUse(int slot) const {
+        return __atomic_load_n(&lastUse_[static_cast<size_t>(slot)], __ATOMIC_RELAXED);
+    }
 
     struct Held {
         uint32_t lastUse;

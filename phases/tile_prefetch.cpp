@@ -1,0 +1,162 @@
+// tile_prefetch.cpp -- MultiphaseRenderer's prefetching mechanisms (the policy that calls
+// them is controller/playback.h): tiles predicted for a frame ahead by a low-resolution
+// dynamic phase (patent claim 11: "a low resolution version of the ... frames" tells which
+// tiles will be needed), tiles next to those recently lacked (claim 10: adjacency), filled
+// in a frame's slack; and whether what was prefetched was read.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "phases/multiphase_renderer.h"
+
+namespace mpshade {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// A shading point's probe footprint in pixels at `rate` (dynamic_phase.h), before
+// DynamicOptions::footprintScale.
+float footprintPixels(ShadingRate rate, int spp) {
+    switch (rate) {
+        case ShadingRate::Sample: return 1.0f / std::sqrt(static_cast<float>(spp));
+        case ShadingRate::Pixel: return 0.5f;
+        case ShadingRate::Quad: return 1.0f;
+    }
+    return 0.5f;
+}
+
+}  // namespace
+
+std::vector<TileRequest> MultiphaseRenderer::predictTiles(int frame, const RenderOptions& options,
+                                                          int divisor, double& seconds) {
+    const auto start = Clock::now();
+    const ScopedSpan span(options_.trace, "predict tiles", PhaseKind::Static, SpanLevel::Phase,
+                          -1, frame);
+    divisor = std::max(1, divisor);
+    const int width = std::max(1, (options.width > 0 ? options.width : scene_.settings.width) /
+                                      divisor);
+    const int height = std::max(
+        1, (options.height > 0 ? options.height : scene_.settings.height) / divisor);
+    const int spp = options.samplesPerPixel > 0 ? options.samplesPerPixel
+                                                : scene_.settings.samplesPerPixel;
+    predictState_ = frameStateAt(resources_, frame, width, height, 1);
+    if (!predictLayout_ ||
+        !predictLayout_->matches(width, height, 1, options.seed, options.filter))
+        predictLayout_ =
+            std::make_shared<const SampleLayout>(width, height, 1, options.seed, options.filter);
+    if (!predictor_) predictor_ = std::make_unique<DynamicPhase>(scene_);
+    const size_t n = scene_.objects.size();
+    std::vector<const ObjectRepresentation*> drawn(n, nullptr);
+    for (size_t i = 0; i < n; ++i)
+        if (representations_[i] && objectInView(*scene_.objects[i].surface,
+                                                 predictState_.objects[i], predictState_.camera))
+            drawn[i] = representations_[i].get();
+    DynamicOptions o = options_.dynamic;
+    o.trace = nullptr;
+    // The same world footprint as the full image's points: a low-resolution pixel is
+    // `divisor` full ones, and a per-pixel point's footprint is half a pixel.
+    const ShadingRate rate = options_.shadingRate.value_or(scene_.settings.shadingRate);
+    o.footprintScale = options_.dynamic.footprintScale * footprintPixels(rate, spp) /
+                       (0.5f * static_cast<float>(divisor));
+    o.shadingRate = ShadingRate::Pixel;
+    predictor_->begin(predictState_, drawn, predictLayout_, o);
+    std::vector<TileRequest> lacking = predictor_->shade(true);
+    seconds = secondsSince(start);
+    return lacking;
+}
+
+std::vector<TileRequest> MultiphaseRenderer::adjacentTiles() const {
+    std::vector<TileRequest> out;
+    for (const TileRequest& r : lastLacking_) {
+        const ObjectRepresentation* rep = representations_[r.object].get();
+        if (!rep || !rep->map) continue;
+        const ShaderMap& map = *rep->map;
+        const int side = map.tilesPerSide(r.key.level);
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int tx = r.key.tx + dx, ty = r.key.ty + dy;
+                if ((dx == 0 && dy == 0) || tx < 0 || ty < 0 || tx >= side || ty >= side)
+                    continue;
+                const TileKey key{r.key.chart, r.key.level, static_cast<uint16_t>(tx),
+                                  static_cast<uint16_t>(ty)};
+                if (!map.resident(key)) out.push_back({r.object, key});
+            }
+    }
+    std::sort(out.begin(), out.end(), [](const TileRequest& a, const TileRequest& b) {
+        return a.object != b.object ? a.object < b.object : a.key.packed() < b.key.packed();
+    });
+    out.erase(std::unique(out.begin(), out.end(),
+                          [](const TileRequest& a, const TileRequest& b) {
+                              return a.object == b.object && a.key == b.key;
+                          }),
+              out.end());
+    return out;
+}
+
+double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double seconds,
+                                    FrameStats& stats) {
+    const auto start = Clock::now();
+    const ScopedSpan span(options_.trace, "prefetch", PhaseKind::Static, SpanLevel::Phase, -1,
+                          stats.index);
+    std::vector<const ObjectRepresentation*> maps(representations_.size(), nullptr);
+    for (size_t i = 0; i < representations_.size(); ++i) maps[i] = representations_[i].get();
+    std::vector<TileRequest> batch;
+    StaticCosts costs;
+    size_t next = 0, chunk = 2;
+    double perTile = tileSeconds_;
+    while (next < tiles.size()) {
+        const double left = seconds - secondsSince(start);
+        if (perTile > 0.0)
+            chunk = static_cast<size_t>(std::clamp(0.5 * left / perTile, 0.0, 4096.0));
+        if (left <= 0.0 || chunk == 0) break;
+        batch.clear();
+        size_t incoming = 0;
+        for (; next < tiles.size() && batch.size() < chunk; ++next) {
+            const TileRequest& r = tiles[next];
+            const ObjectRepresentation* rep = maps[r.object];
+            if (!rep || !rep->map || rep->map->resident(r.key)) continue;
+            batch.push_back(r);
+            incoming += rep->map->tileBytes();
+        }
+        if (batch.empty()) continue;
+        if (!keepMapsInBudget(incoming, stats)) break;
+        const auto began = Clock::now();
+        static_.fill(batch, maps, costs, nullptr);
+        perTile = std::max(perTile * 0.5, secondsSince(began) / static_cast<double>(batch.size()));
+        tileSeconds_ = perTile;
+        for (const TileRequest& r : batch) {
+            const ShaderMap* map = maps[r.object]->map.get();
+            const int slot = map->slotOf(r.key);
+            if (slot >= 0) prefetched_.push_back({r.object, map, r.key, slot, useStamp_});
+        }
+    }
+    stats.tilesPrefetched += costs.tilesFilled;
+    return secondsSince(start);
+}
+
+void MultiphaseRenderer::settlePrefetched(FrameStats& stats) {
+    size_t kept = 0;
+    for (const Prefetched& p : prefetched_) {
+        const ObjectRepresentation* rep = representations_[p.object].get();
+        // Dropped, or its map replaced by a new static run, before any probe read it.
+        const bool gone =
+            !rep || rep->map.get() != p.map || p.map->slotOf(p.key) != p.slot;
+        if (gone) {
+            ++stats.prefetchWasted;
+        } else if (p.map->pool()->lastUse(p.slot) == useStamp_) {
+            // This frame's probes read it (a prediction's probes, run later in a frame,
+            // leave an older stamp by the next frame's settling).
+            ++stats.prefetchUsed;
+        } else if (useStamp_ - p.stamp >= static_cast<uint32_t>(options_.prefetchPatienceFrames)) {
+            ++stats.prefetchWasted;
+        } else {
+            prefetched_[kept++] = p;
+        }
+    }
+    prefetched_.resize(kept);
+}
+
+}  // namespace mpshade
