@@ -75,10 +75,10 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         if (options.prefetch && stats.tilesDeferred == 0 &&
             0.95 * budget - stats.wallSeconds > predictCost) {
             const double left = 0.95 * budget - stats.wallSeconds;
-            const int ahead = std::min(
-                options.last - 1,
-                frame + std::max(1, static_cast<int>(std::lround(options.predictSeconds *
-                                                                 scene.settings.fps))));
+            const int ahead =
+                std::min(options.last - 1,
+                         frame + std::max(1, static_cast<int>(std::lround(options.predictSeconds *
+                                                                          scene.settings.fps))));
             std::vector<TileRequest> tiles =
                 renderer.predictTiles(ahead, options.render, options.predictDivisor, predictCost);
             stats.tilesPredicted = tiles.size();

@@ -21,9 +21,12 @@ double secondsSince(Clock::time_point start) {
 // DynamicOptions::footprintScale.
 float footprintPixels(ShadingRate rate, int spp) {
     switch (rate) {
-        case ShadingRate::Sample: return 1.0f / std::sqrt(static_cast<float>(spp));
-        case ShadingRate::Pixel: return 0.5f;
-        case ShadingRate::Quad: return 1.0f;
+        case ShadingRate::Sample:
+            return 1.0f / std::sqrt(static_cast<float>(spp));
+        case ShadingRate::Pixel:
+            return 0.5f;
+        case ShadingRate::Quad:
+            return 1.0f;
     }
     return 0.5f;
 }
@@ -33,18 +36,17 @@ float footprintPixels(ShadingRate rate, int spp) {
 std::vector<TileRequest> MultiphaseRenderer::predictTiles(int frame, const RenderOptions& options,
                                                           int divisor, double& seconds) {
     const auto start = Clock::now();
-    const ScopedSpan span(options_.trace, "predict tiles", PhaseKind::Static, SpanLevel::Phase,
-                          -1, frame);
+    const ScopedSpan span(options_.trace, "predict tiles", PhaseKind::Static, SpanLevel::Phase, -1,
+                          frame);
     divisor = std::max(1, divisor);
-    const int width = std::max(1, (options.width > 0 ? options.width : scene_.settings.width) /
-                                      divisor);
-    const int height = std::max(
-        1, (options.height > 0 ? options.height : scene_.settings.height) / divisor);
-    const int spp = options.samplesPerPixel > 0 ? options.samplesPerPixel
-                                                : scene_.settings.samplesPerPixel;
+    const int width =
+        std::max(1, (options.width > 0 ? options.width : scene_.settings.width) / divisor);
+    const int height =
+        std::max(1, (options.height > 0 ? options.height : scene_.settings.height) / divisor);
+    const int spp =
+        options.samplesPerPixel > 0 ? options.samplesPerPixel : scene_.settings.samplesPerPixel;
     predictState_ = frameStateAt(resources_, frame, width, height, 1);
-    if (!predictLayout_ ||
-        !predictLayout_->matches(width, height, 1, options.seed, options.filter))
+    if (!predictLayout_ || !predictLayout_->matches(width, height, 1, options.seed, options.filter))
         predictLayout_ =
             std::make_shared<const SampleLayout>(width, height, 1, options.seed, options.filter);
     if (!predictor_) predictor_ = std::make_unique<DynamicPhase>(scene_);
@@ -52,7 +54,7 @@ std::vector<TileRequest> MultiphaseRenderer::predictTiles(int frame, const Rende
     std::vector<const ObjectRepresentation*> drawn(n, nullptr);
     for (size_t i = 0; i < n; ++i)
         if (representations_[i] && objectInView(*scene_.objects[i].surface,
-                                                 predictState_.objects[i], predictState_.camera))
+                                                predictState_.objects[i], predictState_.camera))
             drawn[i] = representations_[i].get();
     DynamicOptions o = options_.dynamic;
     o.trace = nullptr;
@@ -78,8 +80,7 @@ std::vector<TileRequest> MultiphaseRenderer::adjacentTiles() const {
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
                 const int tx = r.key.tx + dx, ty = r.key.ty + dy;
-                if ((dx == 0 && dy == 0) || tx < 0 || ty < 0 || tx >= side || ty >= side)
-                    continue;
+                if ((dx == 0 && dy == 0) || tx < 0 || ty < 0 || tx >= side || ty >= side) continue;
                 const TileKey key{r.key.chart, r.key.level, static_cast<uint16_t>(tx),
                                   static_cast<uint16_t>(ty)};
                 if (!map.resident(key)) out.push_back({r.object, key});
@@ -142,8 +143,7 @@ void MultiphaseRenderer::settlePrefetched(FrameStats& stats) {
     for (const Prefetched& p : prefetched_) {
         const ObjectRepresentation* rep = representations_[p.object].get();
         // Dropped, or its map replaced by a new static run, before any probe read it.
-        const bool gone =
-            !rep || rep->map.get() != p.map || p.map->slotOf(p.key) != p.slot;
+        const bool gone = !rep || rep->map.get() != p.map || p.map->slotOf(p.key) != p.slot;
         if (gone) {
             ++stats.prefetchWasted;
         } else if (p.map->pool()->lastUse(p.slot) == useStamp_) {

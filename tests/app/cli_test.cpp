@@ -559,7 +559,15 @@ TEST(Cli, PlayReportsEveryFramesDeadlineAndWritesFramesUnlessAsked) {
         EXPECT_EQ(f["deadline_met"].get<bool>(),
                   f["wall_seconds"].get<double>() <= f["budget_seconds"].get<double>());
         EXPECT_TRUE(f["quality"]["shading_rate"].is_string());
+        EXPECT_GE(f["quality"]["level"].get<int>(), 0);
+        EXPECT_GT(f["quality"]["footprint_scale"].get<double>(), 0.0);
         EXPECT_TRUE(f["deferred"]["tiles"].is_number());
+        const nlohmann::json& p = f["prefetch"];
+        EXPECT_LE(p["filled"].get<uint64_t>(),
+                  p["predicted"].get<uint64_t>() + p["adjacent"].get<uint64_t>());
+        EXPECT_GE(p["seconds"].get<double>(), 0.0);
+        EXPECT_EQ(f["probe_hits"].get<uint64_t>() + f["quality"]["probe_fallbacks"].get<uint64_t>(),
+                  f["quality"]["probes"].get<uint64_t>());
         EXPECT_LE(f["resident_bytes"].get<double>(), 8.0 * 1024 * 1024);
     }
     EXPECT_EQ(stats["deadlines_met"], met);

@@ -1,0 +1,121 @@
+// Prefetching (patent claims 10 and 11): a tile prefetched before the frame that reads it
+// is not lacked there and counts as used; one no frame reads counts as wasted; the
+// low-resolution prediction names the tiles the full frame will lack.
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "phases/multiphase_renderer.h"
+#include "test_support.h"
+
+namespace mpshade {
+namespace {
+
+MultiphaseOptions budgeted() {
+    MultiphaseOptions o;
+    o.staticPhase.shaderMap.fillPinnedUpFront = true;
+    o.singlePhaseFrames = false;
+    o.frameBudgetSeconds = 60.0;  // time for everything: no test here depends on a clock
+    return o;
+}
+
+RenderOptions small() {
+    RenderOptions r;
+    r.width = 96;
+    r.height = 54;
+    return r;
+}
+
+// How many tiles frame `frame` lacks after frame 0, nothing prefetched.
+uint64_t tilesLacked(const Scene& scene, int frame) {
+    MultiphaseRenderer renderer(scene, budgeted());
+    FrameStats stats;
+    renderer.renderFrame(0, small(), stats);
+    renderer.renderFrame(frame, small(), stats);
+    return stats.tilesRequested;
+}
+
+TEST(TilePrefetch, PrefetchedTilesAreNotLackedAndCountAsUsed) {
+    const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    // Frame 16 after frame 0: the camera has orbited 30 degrees.
+    const uint64_t lackedWithout = tilesLacked(scene, 16);
+    ASSERT_GT(lackedWithout, 20u);
+    // Predicted at the full size, and at half of it (footprints scaled to match the full
+    // image's: a planted "no scaling" reads a level too coarse and fails here).
+    for (int divisor : {1, 2}) {
+        MultiphaseRenderer renderer(scene, budgeted());
+        FrameStats stats;
+        renderer.renderFrame(0, small(), stats);
+        double seconds = 0.0;
+        const std::vector<TileRequest> predicted =
+            renderer.predictTiles(16, small(), divisor, seconds);
+        ASSERT_FALSE(predicted.empty());
+        for (const TileRequest& r : predicted)
+            ASSERT_FALSE(renderer.representation(r.object)->map->resident(r.key));
+        FrameStats slack;
+        renderer.prefetch(predicted, 60.0, slack);
+        EXPECT_EQ(slack.tilesPrefetched, predicted.size());
+        FrameStats ahead;
+        renderer.renderFrame(16, small(), ahead);
+        RecordProperty(
+            "lacked_after_prediction_" + std::to_string(divisor),
+            std::to_string(ahead.tilesRequested) + " of " + std::to_string(lackedWithout));
+        // The frame shades per sample at 4 samples: the same footprint as the prediction's
+        // per-pixel points (half a pixel), so it lacks little of what was predicted.
+        EXPECT_LT(ahead.tilesRequested * (divisor == 1 ? 4 : 2), lackedWithout) << divisor;
+        EXPECT_GT(ahead.prefetchUsed, slack.tilesPrefetched / 2) << divisor;
+        EXPECT_LE(ahead.prefetchUsed, slack.tilesPrefetched);
+        EXPECT_EQ(ahead.prefetchWasted, 0u);
+    }
+}
+
+TEST(TilePrefetch, ATileNoFrameReadsIsWastedAfterThePatience) {
+    const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    MultiphaseOptions o = budgeted();
+    o.prefetchPatienceFrames = 3;
+    MultiphaseRenderer renderer(scene, o);
+    FrameStats stats;
+    renderer.renderFrame(0, small(), stats);
+    // The finest level's corner tile of the vase's first chart: no 96x54 frame reads it.
+    const size_t vase = scene.objects[0].name == "vase" ? 0 : 1;
+    const ShaderMap& map = *renderer.representation(vase)->map;
+    const TileKey corner{0, 0, static_cast<uint16_t>(map.tilesPerSide(0) - 1),
+                         static_cast<uint16_t>(map.tilesPerSide(0) - 1)};
+    const TileRequest unread{static_cast<uint32_t>(vase), corner};
+    FrameStats slack;
+    renderer.prefetch(std::span<const TileRequest>(&unread, 1), 60.0, slack);
+    ASSERT_EQ(slack.tilesPrefetched, 1u);
+    uint64_t wasted = 0, used = 0;
+    for (int f = 1; f <= 3; ++f) {
+        renderer.renderFrame(f, small(), stats);
+        wasted += stats.prefetchWasted;
+        used += stats.prefetchUsed;
+        EXPECT_EQ(stats.prefetchWasted, f == 3 ? 1u : 0u) << f;
+    }
+    EXPECT_EQ(used, 0u);
+    EXPECT_EQ(wasted, 1u);
+    EXPECT_TRUE(map.resident(corner));  // still an ordinary tile of the cache
+}
+
+TEST(TilePrefetch, NeighboursOfLackedTilesAreAdjacentAndNotResident) {
+    const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    MultiphaseRenderer renderer(scene, budgeted());
+    FrameStats stats;
+    renderer.renderFrame(0, small(), stats);
+    renderer.renderFrame(1, small(), stats);
+    ASSERT_GT(stats.tilesRequested, 0u);
+    const std::vector<TileRequest> adjacent = renderer.adjacentTiles();
+    ASSERT_FALSE(adjacent.empty());
+    for (const TileRequest& r : adjacent) {
+        const ShaderMap& map = *renderer.representation(r.object)->map;
+        EXPECT_FALSE(map.resident(r.key));
+        EXPECT_LT(r.key.tx, map.tilesPerSide(r.key.level));
+        EXPECT_LT(r.key.ty, map.tilesPerSide(r.key.level));
+    }
+    for (size_t k = 1; k < adjacent.size(); ++k)
+        EXPECT_FALSE(adjacent[k].object == adjacent[k - 1].object &&
+                     adjacent[k].key == adjacent[k - 1].key);
+}
+
+}  // namespace
+}  // namespace mpshade
