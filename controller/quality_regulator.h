@@ -33,7 +33,7 @@ struct QualityStep {
 
 struct QualityRegulatorOptions {
     double slowDownAt = 0.7;  // of the budget: a dynamic phase above it steps down
-    double speedUpAt = 0.6;   // of the budget: the step above, predicted below it, steps up
+    double speedUpAt = 0.65;  // of the budget: the step above, predicted below it, steps up
     int calmFrames = 8;       // frames in a row that must predict so before stepping up
 };
 

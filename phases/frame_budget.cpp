@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include <tbb/task_arena.h>
+
 #include "phases/multiphase_renderer.h"
 
 namespace mpshade {
@@ -79,7 +81,10 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     timing.frame = frame;
     const auto fillStart = Clock::now();
     size_t next = 0, chunk = 2;
-    double perTile = tileSeconds_;  // seconds a tile, as measured so far
+    // Seconds a tile, the most a chunk took lately: tiles built from resident children
+    // cost a fifth of those evaluated whole, so chunks are sized for the dear ones.
+    double perTile = tileSeconds_;
+    const size_t threads = static_cast<size_t>(tbb::this_task_arena::max_concurrency());
     // A twentieth of the budget is kept for what follows the fills; chunks are sized to
     // half the time left at the cost a tile has had lately, so one slow chunk does not
     // overshoot. A frame already late gets its minimum share; one that is not is never
@@ -91,7 +96,9 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         const double left = deadline - secondsSince(start);
         if (perTile > 0.0)
             chunk = static_cast<size_t>(std::clamp(0.5 * left / perTile, 0.0, 4096.0));
-        if (left <= 0.0 || chunk == 0) break;
+        // The cost per tile is measured on chunks filled by every thread: a chunk smaller
+        // than the threads takes longer per tile than that, so it is not started.
+        if (left <= 0.0 || chunk < (perTile > 0.0 ? threads : 1)) break;
         const size_t end = std::min(lacking_.size(), next + chunk);
         const std::span<const TileRequest> batch(lacking_.data() + next, end - next);
         size_t incoming = 0;
@@ -102,11 +109,12 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         const auto began = Clock::now();
         static_.fill(batch, drawn_, fills, &timing);
         const double took = secondsSince(began);
-        perTile = std::max(perTile * 0.5, took / static_cast<double>(batch.size()));
-        tileSeconds_ = perTile;
+        perTile = std::max(perTile, took / static_cast<double>(batch.size()));
         for (const TileRequest& r : batch) ++reports_[r.object].staticCosts.tilesFilled;
         next = end;
     }
+    // Forgotten slowly: the next frame's chunks start from nine tenths of this one's worst.
+    if (perTile > 0.0) tileSeconds_ = 0.9 * perTile;
     stats.tilesDeferred = lacking_.size() - next;
     stats.fillSeconds += secondsSince(fillStart);
     stats.staticSeconds += secondsSince(fillStart);

@@ -224,7 +224,7 @@ class MultiphaseRenderer {
     // Prefetching: the last frame's lacking tiles; the tiles prefetched and not yet read
     // (with the use stamp they were filled at); the low-resolution predictor.
     std::vector<TileRequest> lastLacking_;
-    double tileSeconds_ = 0.0;  // what a tile's fill took lately (0: not measured yet)
+    double tileSeconds_ = 0.0;  // the most a tile took lately (0: not measured yet)
     struct Prefetched {
         uint32_t object;
         const ShaderMap* map;

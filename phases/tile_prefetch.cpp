@@ -5,6 +5,8 @@
 // in a frame's slack; and whether what was prefetched was read.
 #include <algorithm>
 #include <chrono>
+
+#include <tbb/task_arena.h>
 #include <cmath>
 
 #include "phases/multiphase_renderer.h"
@@ -107,12 +109,17 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
     std::vector<TileRequest> batch;
     StaticCosts costs;
     size_t next = 0, chunk = 2;
+    // Seconds a tile, the most a chunk took lately: tiles built from resident children
+    // cost a fifth of those evaluated whole, so chunks are sized for the dear ones.
     double perTile = tileSeconds_;
+    const size_t threads = static_cast<size_t>(tbb::this_task_arena::max_concurrency());
     while (next < tiles.size()) {
         const double left = seconds - secondsSince(start);
         if (perTile > 0.0)
             chunk = static_cast<size_t>(std::clamp(0.5 * left / perTile, 0.0, 4096.0));
-        if (left <= 0.0 || chunk == 0) break;
+        // The cost per tile is measured on chunks filled by every thread: a chunk smaller
+        // than the threads takes longer per tile than that, so it is not started.
+        if (left <= 0.0 || chunk < (perTile > 0.0 ? threads : 1)) break;
         batch.clear();
         size_t incoming = 0;
         for (; next < tiles.size() && batch.size() < chunk; ++next) {
@@ -126,14 +133,14 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
         if (!keepMapsInBudget(incoming, stats)) break;
         const auto began = Clock::now();
         static_.fill(batch, maps, costs, nullptr);
-        perTile = std::max(perTile * 0.5, secondsSince(began) / static_cast<double>(batch.size()));
-        tileSeconds_ = perTile;
+        perTile = std::max(perTile, secondsSince(began) / static_cast<double>(batch.size()));
         for (const TileRequest& r : batch) {
             const ShaderMap* map = maps[r.object]->map.get();
             const int slot = map->slotOf(r.key);
             if (slot >= 0) prefetched_.push_back({r.object, map, r.key, slot, useStamp_});
         }
     }
+    if (perTile > 0.0) tileSeconds_ = 0.9 * perTile;
     stats.tilesPrefetched += costs.tilesFilled;
     return secondsSince(start);
 }
