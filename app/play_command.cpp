@@ -108,6 +108,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
              {"tiles_filled", s.tilesFilled},
              {"tiles_evicted", s.tilesEvicted},
              {"probe_hits", s.probes - s.probeFallbacks},
+             {"controller_seconds", s.controllerSeconds},
              {"prefetch",
               {{"predicted", s.tilesPredicted},
                {"adjacent", s.tilesAdjacent},

@@ -93,8 +93,11 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         }
         ++summary.frames;
         summary.deadlinesMet += stats.deadlineMet ? 1 : 0;
-        if (onFrame && !onFrame(stats, image, quality)) break;
+        const auto regulating = std::chrono::steady_clock::now();
         regulator.update(stats, budget);
+        stats.controllerSeconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - regulating).count();
+        if (onFrame && !onFrame(stats, image, quality)) break;
     }
     return summary;
 }

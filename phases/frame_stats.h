@@ -107,7 +107,10 @@ struct FrameStats {
     // MultiphaseOptions::prefetchPatienceFrames, unread (wasted).
     uint64_t tilesPredicted = 0, tilesAdjacent = 0, tilesPrefetched = 0;
     uint64_t prefetchUsed = 0, prefetchWasted = 0;
-    double prefetchSeconds = 0.0;             // of staticSeconds: predicting and prefetching
+    double prefetchSeconds = 0.0;  // of staticSeconds: predicting and prefetching
+    // The controller's own work, within wallSeconds: re-run triggers and deferrals, cache
+    // bookkeeping (eviction, prefetch accounting), the regulator.
+    double controllerSeconds = 0.0;
     std::vector<StaticRunDue> staticRunsDue;  // every object whose static phase was due
 };
 

@@ -254,6 +254,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     options_.dynamic.shadingRate = dynamicOptions.shadingRate;
 
     // 1-2. Objects in view, and the static phase for those that need it.
+    const auto triggersStart = Clock::now();
     const size_t n = scene_.objects.size();
     std::vector<uint8_t> visible(n, 0);
     std::vector<size_t> stale;
@@ -324,6 +325,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         std::sort(due.begin(), due.end());
         stale = due;
     }
+    stats.controllerSeconds += secondsSince(triggersStart);
     const auto staticStart = Clock::now();
     // First a check that needs no dicing survey: with every stale object at the least its
     // representations could cost, does single-phase still win? (A cut every frame then
@@ -491,6 +493,12 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
 }
 
 bool MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
+    const auto start = Clock::now();
+    struct AddTime {
+        Clock::time_point start;
+        double& to;
+        ~AddTime() { to += secondsSince(start); }
+    } addTime{start, stats.controllerSeconds};
     const std::vector<std::shared_ptr<TilePool>> pools = static_.tilePools().all();
     size_t bytes = 0;
     for (const auto& pool : pools) bytes += pool->bytesHeld();

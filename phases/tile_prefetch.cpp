@@ -146,6 +146,7 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
 }
 
 void MultiphaseRenderer::settlePrefetched(FrameStats& stats) {
+    const auto start = Clock::now();
     size_t kept = 0;
     for (const Prefetched& p : prefetched_) {
         const ObjectRepresentation* rep = representations_[p.object].get();
@@ -164,6 +165,7 @@ void MultiphaseRenderer::settlePrefetched(FrameStats& stats) {
         }
     }
     prefetched_.resize(kept);
+    stats.controllerSeconds += secondsSince(start);
 }
 
 }  // namespace mpshade

@@ -566,6 +566,8 @@ TEST(Cli, PlayReportsEveryFramesDeadlineAndWritesFramesUnlessAsked) {
         EXPECT_LE(p["filled"].get<uint64_t>(),
                   p["predicted"].get<uint64_t>() + p["adjacent"].get<uint64_t>());
         EXPECT_GE(p["seconds"].get<double>(), 0.0);
+        EXPECT_GT(f["controller_seconds"].get<double>(), 0.0);
+        EXPECT_LT(f["controller_seconds"].get<double>(), f["wall_seconds"].get<double>());
         EXPECT_EQ(f["probe_hits"].get<uint64_t>() + f["quality"]["probe_fallbacks"].get<uint64_t>(),
                   f["quality"]["probes"].get<uint64_t>());
         EXPECT_LE(f["resident_bytes"].get<double>(), 8.0 * 1024 * 1024);
