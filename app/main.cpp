@@ -141,6 +141,8 @@ int main(int argc, char** argv) {
                      "first; the coarsest levels stay)")
         ->capture_default_str();
     playCmd->add_flag("--no-write", play.noWrite, "Measure without the disk: stats.json only");
+    playCmd->add_flag("--no-prefetch", play.noPrefetch,
+                      "Fill no tiles ahead of the frames that ask for them (for comparisons)");
     playCmd->add_flag("--quiet", play.quiet, "No progress or summary on stderr");
 
     try {

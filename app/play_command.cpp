@@ -36,6 +36,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
     po.first = request.first;
     po.last = request.last;
     po.cacheBytes = static_cast<size_t>(options.cacheMb) << 20;
+    po.prefetch = !options.noPrefetch;
     prepareOutputFolder(options.outDir);
     const std::filesystem::path dir(options.outDir);
     const bool tty = !options.quiet && isatty(STDERR_FILENO);
@@ -56,6 +57,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
             {"samples_per_pixel", spp},
             {"seed", options.seed},
             {"cache_mb", options.cacheMb},
+            {"prefetch", !options.noPrefetch},
             {"preroll_seconds", prerollSeconds},
             {"frames_requested", po.last - po.first},
             {"frames_played", played},
