@@ -102,6 +102,8 @@ int runPlayCommand(const PlayCommandOptions& options) {
               {{"level", quality.level},
                {"shading_rate", shadingRateName(quality.step.rate)},
                {"footprint_scale", quality.step.footprintScale},
+               {"samples_per_pixel",
+                quality.step.samplesPerPixel > 0 ? quality.step.samplesPerPixel : spp},
                {"probes", s.probes},
                {"probe_fallbacks", s.probeFallbacks},
                {"older_representations", s.rebuildsDeferred}}},

@@ -35,12 +35,19 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
     // The regulator's ratios: the first frame again at every step, now warm (its objects
     // built, its buffers allocated); each also fills what its own step reads.
     QualityRegulator regulator(scene.settings.shadingRate, spp, options.regulator);
+    // The request's render options with a step's samples per pixel.
+    const auto stepOptions = [&](int level) {
+        RenderOptions r = options.render;
+        if (regulator.step(level).samplesPerPixel > 0)
+            r.samplesPerPixel = regulator.step(level).samplesPerPixel;
+        return r;
+    };
     std::vector<double> stepSeconds(static_cast<size_t>(regulator.levels()));
     for (int k = 0; k < regulator.levels(); ++k) {
         renderer.setShadingRate(regulator.step(k).rate);
         renderer.setFootprintScale(regulator.step(k).footprintScale);
         FrameStats s;
-        renderer.renderFrame(options.first, options.render, s, image);
+        renderer.renderFrame(options.first, stepOptions(k), s, image);
         stepSeconds[static_cast<size_t>(k)] =
             s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
     }
@@ -59,7 +66,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         renderer.setShadingRate(quality.step.rate);
         renderer.setFootprintScale(quality.step.footprintScale);
         FrameStats stats;
-        renderer.renderFrame(frame, options.render, stats, image);
+        renderer.renderFrame(frame, stepOptions(quality.level), stats, image);
         const double slack = budget - stats.wallSeconds;
         if (options.lookAheadSeconds > 0.0 && slack > 0.0) {
             const int frames =

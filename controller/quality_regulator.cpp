@@ -35,6 +35,8 @@ QualityRegulator::QualityRegulator(ShadingRate sceneRate, int spp,
     }
     steps_.push_back({ShadingRate::Quad, 1.0f});
     steps_.push_back({ShadingRate::Quad, 2.0f});
+    if (spp > 2) steps_.push_back({ShadingRate::Quad, 2.0f, spp / 2});
+    if (spp > 1) steps_.push_back({ShadingRate::Quad, 2.0f, 1});
     // Until measured: as if the whole dynamic phase scaled with the shading points (an
     // overestimate: rasterization and resolve do not).
     ratioAbove_.assign(steps_.size(), 1.0);

@@ -6,8 +6,10 @@
 // A ladder of steps, best first, each cheaper than the one above:
 //   the scene's shading rate at footprint 1; per pixel; per pixel reading one mip level
 //   coarser (footprint x2: a quarter of the tiles to fill); per 2x2 pixels (a quarter of the
-//   shading points, and the same level as the step above); per 2x2 pixels one level coarser.
-// Coverage stays per sample on every step: edges keep their antialiasing.
+//   shading points, and the same level as the step above); per 2x2 pixels one level coarser;
+//   then that with half the samples per pixel, and with one (rasterization, compositing
+//   and the resolve scale with the samples; edges lose their antialiasing).
+// Coverage stays per sample on every step.
 //
 // After each frame the regulator steps down at once when the dynamic phase (warp to
 // resolve) took more than `slowDownAt` of the budget, and steps up after `calmFrames`
@@ -29,6 +31,7 @@ namespace mpshade {
 struct QualityStep {
     ShadingRate rate = ShadingRate::Sample;
     float footprintScale = 1.0f;  // DynamicOptions::footprintScale
+    int samplesPerPixel = 0;      // 0: the request's
 };
 
 struct QualityRegulatorOptions {

@@ -197,6 +197,7 @@ class MultiphaseRenderer {
     StaticPhase static_;
     DynamicPhase dynamic_;
     std::shared_ptr<const SampleLayout> layout_;
+    std::vector<std::shared_ptr<const SampleLayout>> layouts_;  // the last few made
     std::vector<std::unique_ptr<ObjectRepresentation>> representations_;
     std::vector<Representation> kinds_;  // chosen at each static run
     std::vector<float> longestEdge_;     // last frame's measure (combined)

@@ -109,9 +109,11 @@ TEST(Playback, PlaysEveryFrameAndRegulatesItsQuality) {
     EXPECT_GT(summary.prerollSeconds, 0.0);
     ASSERT_EQ(steps.size(), 4u);
     for (const PlaybackQuality& q : steps) {
-        EXPECT_EQ(q.level, 4);  // the scene shades per sample: five steps
+        // The scene shades per sample at 4 samples: seven steps, the last at one sample.
+        EXPECT_EQ(q.level, 6);
         EXPECT_EQ(q.step.rate, ShadingRate::Quad);
         EXPECT_EQ(q.step.footprintScale, 2.0f);
+        EXPECT_EQ(q.step.samplesPerPixel, 1);
     }
 }
 

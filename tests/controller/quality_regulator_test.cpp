@@ -26,31 +26,38 @@ QualityRegulatorOptions exactShares() {
 
 TEST(QualityRegulator, TheLadderStartsAtTheScenesRate) {
     const QualityRegulator fromSample(ShadingRate::Sample, 4);
-    ASSERT_EQ(fromSample.levels(), 5);
+    ASSERT_EQ(fromSample.levels(), 7);
     EXPECT_EQ(fromSample.step().rate, ShadingRate::Sample);
     EXPECT_EQ(fromSample.step().footprintScale, 1.0f);
     EXPECT_EQ(fromSample.step(2).rate, ShadingRate::Pixel);
     EXPECT_EQ(fromSample.step(2).footprintScale, 2.0f);
     EXPECT_EQ(fromSample.step(4).rate, ShadingRate::Quad);
     EXPECT_EQ(fromSample.step(4).footprintScale, 2.0f);
+    EXPECT_EQ(fromSample.step(4).samplesPerPixel, 0);  // the request's
+    EXPECT_EQ(fromSample.step(5).samplesPerPixel, 2);
+    EXPECT_EQ(fromSample.step(6).samplesPerPixel, 1);
+    EXPECT_EQ(fromSample.step(6).rate, ShadingRate::Quad);
     const QualityRegulator fromPixel(ShadingRate::Pixel, 4);
-    EXPECT_EQ(fromPixel.levels(), 4);
+    EXPECT_EQ(fromPixel.levels(), 6);
     EXPECT_EQ(fromPixel.step().rate, ShadingRate::Pixel);
-    const QualityRegulator fromQuad(ShadingRate::Quad, 4);
-    EXPECT_EQ(fromQuad.levels(), 2);
+    const QualityRegulator fromQuad(ShadingRate::Quad, 2);
+    EXPECT_EQ(fromQuad.levels(), 3);  // samples per pixel halved once: to one
     EXPECT_EQ(fromQuad.step().rate, ShadingRate::Quad);
+    EXPECT_EQ(QualityRegulator(ShadingRate::Sample, 1).levels(), 5);
 }
 
 TEST(QualityRegulator, BeforeMeasuringTheRatiosAreTheShadingPoints) {
     const QualityRegulator r(ShadingRate::Sample, 8);
+    ASSERT_EQ(r.levels(), 7);
     EXPECT_EQ(r.costRatioAbove(1), 8.0);  // per sample over per pixel
     EXPECT_EQ(r.costRatioAbove(2), 1.0);  // the footprint alone differs
     EXPECT_EQ(r.costRatioAbove(3), 4.0);  // per pixel over per 2x2 pixels
     EXPECT_EQ(r.costRatioAbove(4), 1.0);
+    EXPECT_EQ(r.costRatioAbove(5), 1.0);  // fewer samples: not a shading-point count
 }
 
 TEST(QualityRegulator, StepsDownOnlyAboveItsShareAndStopsAtTheBottom) {
-    QualityRegulator r(ShadingRate::Sample, 4, exactShares());
+    QualityRegulator r(ShadingRate::Sample, 1, exactShares());  // five steps
     r.update(frame(0.5, 0.25), 1.0);  // exactly at the share is not above it
     EXPECT_EQ(r.level(), 0);
     r.update(frame(0.5, 0.2501), 1.0);
@@ -61,25 +68,25 @@ TEST(QualityRegulator, StepsDownOnlyAboveItsShareAndStopsAtTheBottom) {
 }
 
 TEST(QualityRegulator, StartsAtTheBestStepItsCalibrationFits) {
-    QualityRegulator fits(ShadingRate::Sample, 4, exactShares());
+    QualityRegulator fits(ShadingRate::Sample, 1, exactShares());  // five steps
     const double atTarget[] = {0.625, 0.5, 0.25, 0.125, 0.0625};
     fits.calibrate(atTarget, 1.0);
     EXPECT_EQ(fits.level(), 0);
     EXPECT_EQ(fits.costRatioAbove(1), 1.25);
     EXPECT_EQ(fits.costRatioAbove(2), 2.0);
-    QualityRegulator perPixel(ShadingRate::Sample, 4, exactShares());
+    QualityRegulator perPixel(ShadingRate::Sample, 1, exactShares());
     const double justAbove[] = {0.626, 0.625, 0.5, 0.25, 0.5};  // the last: noise
     perPixel.calibrate(justAbove, 1.0);
     EXPECT_EQ(perPixel.level(), 1);
     EXPECT_EQ(perPixel.costRatioAbove(4), 1.0);  // a lower step costing more counts as equal
-    QualityRegulator none(ShadingRate::Sample, 4, exactShares());
+    QualityRegulator none(ShadingRate::Sample, 1, exactShares());
     const double late[] = {4.0, 2.0, 1.0, 0.75, 0.7};
     none.calibrate(late, 1.0);
     EXPECT_EQ(none.level(), 4);
 }
 
 TEST(QualityRegulator, StepsUpAfterCalmFramesPredictingTheStepAboveFits) {
-    QualityRegulator r(ShadingRate::Sample, 4, exactShares());  // calmFrames 8
+    QualityRegulator r(ShadingRate::Sample, 1, exactShares());  // five steps; calmFrames 8
     const double seconds[] = {1.0, 0.5, 0.375, 0.25, 0.125};
     r.calibrate(seconds, 1.0);
     ASSERT_EQ(r.level(), 1);
@@ -101,7 +108,7 @@ TEST(QualityRegulator, StepsUpAfterCalmFramesPredictingTheStepAboveFits) {
 }
 
 TEST(QualityRegulator, AStepDownMeasuresTheRatioOfTheTwoSteps) {
-    QualityRegulator r(ShadingRate::Pixel, 4, exactShares());
+    QualityRegulator r(ShadingRate::Pixel, 1, exactShares());
     r.update(frame(0.8), 1.0);  // to level 1
     ASSERT_EQ(r.level(), 1);
     r.update(frame(0.2), 1.0);
