@@ -164,7 +164,9 @@ BENCHMARK(warpFloat)->Name("Warp/float")->Unit(benchmark::kMillisecond);
 
 constexpr int kAuto = -1, kFacets = static_cast<int>(Representation::Facets),
               kMap = static_cast<int>(Representation::ShaderMap);
-constexpr int kSceneRate = -1, kPerSample = static_cast<int>(ShadingRate::Sample);
+constexpr int kSceneRate = -1, kPerSample = static_cast<int>(ShadingRate::Sample),
+              kPerPixel = static_cast<int>(ShadingRate::Pixel),
+              kPerQuad = static_cast<int>(ShadingRate::Quad);
 
 #define MPSHADE_FRAME_BENCH(name, path)                                          \
     BENCHMARK_CAPTURE(frameReference, name, path)                                \
@@ -177,6 +179,14 @@ constexpr int kSceneRate = -1, kPerSample = static_cast<int>(ShadingRate::Sample
         ->UseRealTime();                                                         \
     BENCHMARK_CAPTURE(frameMultiphase, name##_sample, path, kAuto, kPerSample)   \
         ->Name("Frame/" #name "/multiphase_per_sample")                          \
+        ->Unit(benchmark::kMillisecond)                                          \
+        ->UseRealTime();                                                         \
+    BENCHMARK_CAPTURE(frameMultiphase, name##_pixel, path, kAuto, kPerPixel)     \
+        ->Name("Frame/" #name "/multiphase_per_pixel")                           \
+        ->Unit(benchmark::kMillisecond)                                          \
+        ->UseRealTime();                                                         \
+    BENCHMARK_CAPTURE(frameMultiphase, name##_quad, path, kAuto, kPerQuad)       \
+        ->Name("Frame/" #name "/multiphase_per_quad")                            \
         ->Unit(benchmark::kMillisecond)                                          \
         ->UseRealTime();                                                         \
     BENCHMARK_CAPTURE(frameMultiphase, name##_facets, path, kFacets, kSceneRate) \

@@ -316,7 +316,55 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
             s.member.resize(static_cast<size_t>(block * block) * pixelSlots);
             for (int by = row0; by < row1; by += block)
                 for (int bx = 0; bx < width; bx += block) {
+                    if (block == 1 && options_.wholePixelShortcut) {
+                        // The common case: one surface covers every sample of the pixel, in
+                        // front. Its point is the pixel's precomputed centroid, on the facet
+                        // of its nearest sample: what the general path below finds.
+                        const size_t first = layout.index(bx, by, 0);
+                        bool whole = vis.count[first] == 1;
+                        const uint32_t o = whole ? vis.object[first * layers] : 0;
+                        for (int k = 1; k < spp && whole; ++k)
+                            whole =
+                                vis.count[first + k] == 1 && vis.object[(first + k) * layers] == o;
+                        if (whole) {
+                            const size_t pixel = first / static_cast<size_t>(spp);
+                            const size_t nearest =
+                                first + static_cast<size_t>(layout.nearestToCentroid(pixel));
+                            const uint32_t point =
+                                addPoint(o, vis.facet[nearest * layers], layout.centroidX(pixel),
+                                         layout.centroidY(pixel));
+                            for (int k = 0; k < spp; ++k)
+                                st.fragmentPoint[(first + k) * layers - firstSlot] = point;
+                            continue;
+                        }
+                    }
                     const int y1 = std::min(row1, by + block), x1 = std::min(width, bx + block);
+                    if (block == 2 && options_.wholePixelShortcut && x1 - bx == 2 && y1 - by == 2 &&
+                        by % 2 == 0) {
+                        // The same for a whole 2x2 block: its four pixels' samples all see
+                        // one surface, in front.
+                        const size_t firsts[4] = {
+                            layout.index(bx, by, 0), layout.index(bx + 1, by, 0),
+                            layout.index(bx, by + 1, 0), layout.index(bx + 1, by + 1, 0)};
+                        bool whole = vis.count[firsts[0]] == 1;
+                        const uint32_t o = whole ? vis.object[firsts[0] * layers] : 0;
+                        for (int q = 0; q < 4 && whole; ++q)
+                            for (int k = 0; k < spp && whole; ++k)
+                                whole = vis.count[firsts[q] + k] == 1 &&
+                                        vis.object[(firsts[q] + k) * layers] == o;
+                        if (whole) {
+                            const size_t quad = static_cast<size_t>(by / 2) * (width / 2) + bx / 2;
+                            const int m = layout.nearestToQuadCentroid(quad);
+                            const size_t nearest = firsts[m / spp] + static_cast<size_t>(m % spp);
+                            const uint32_t point =
+                                addPoint(o, vis.facet[nearest * layers], layout.quadCentroidX(quad),
+                                         layout.quadCentroidY(quad));
+                            for (int q = 0; q < 4; ++q)
+                                for (int k = 0; k < spp; ++k)
+                                    st.fragmentPoint[(firsts[q] + k) * layers - firstSlot] = point;
+                            continue;
+                        }
+                    }
                     // Calls f(sample, layer, member index) for every fragment of the block.
                     auto forEachFragment = [&](auto&& f) {
                         for (int py = by; py < y1; ++py)

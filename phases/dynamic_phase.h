@@ -47,6 +47,10 @@ struct DynamicOptions {
     // stratum), or half a pixel per pixel.
     float footprintScale = 1.0f;
     int bandRows = 4;  // pixel rows per unit of shading work
+    // Per pixel or 2x2 pixels: a pixel (block) whose samples all see one surface in front
+    // takes its point from the layout's precomputed centroid and nearest sample instead of
+    // grouping its fragments; the same points, bit for bit (tested with this off).
+    bool wholePixelShortcut = true;
     // Where the warp, rasterization, shading bands and resolve report their spans (not
     // owned; null: nowhere).
     PhaseTrace* trace = nullptr;

@@ -72,7 +72,61 @@ bool SampleLayout::matches(int width, int height, int spp, uint32_t seed,
 
 void SampleLayout::prepareFilter() {
     MPSHADE_CHECK(filter_.radius > 0.0f && filter_.radius <= 8.0f && filter_.sigma > 0.0f);
+    MPSHADE_CHECK(spp_ <= 16384);  // 4 spp fits the quads' nearest-sample index
     const size_t n = count();
+    const size_t pixels = static_cast<size_t>(width_) * height_;
+    centroid_.resize(2 * pixels);
+    nearest_.resize(pixels);
+    for (size_t p = 0; p < pixels; ++p) {
+        float sx = 0.0f, sy = 0.0f;
+        for (int k = 0; k < spp_; ++k) {
+            sx += xy_[2 * (p * spp_ + k)];
+            sy += xy_[2 * (p * spp_ + k) + 1];
+        }
+        const float cx = sx / static_cast<float>(spp_), cy = sy / static_cast<float>(spp_);
+        float best = 1e30f;
+        int nearest = 0;
+        for (int k = 0; k < spp_; ++k) {
+            const float dx = xy_[2 * (p * spp_ + k)] - cx, dy = xy_[2 * (p * spp_ + k) + 1] - cy;
+            if (dx * dx + dy * dy < best) {
+                best = dx * dx + dy * dy;
+                nearest = k;
+            }
+        }
+        centroid_[2 * p] = cx;
+        centroid_[2 * p + 1] = cy;
+        nearest_[p] = static_cast<uint16_t>(nearest);
+    }
+    const int qw = width_ / 2, qh = height_ / 2;
+    quadCentroid_.resize(2 * static_cast<size_t>(qw) * qh);
+    quadNearest_.resize(static_cast<size_t>(qw) * qh);
+    for (int qy = 0; qy < qh; ++qy)
+        for (int qx = 0; qx < qw; ++qx) {
+            float sx = 0.0f, sy = 0.0f;
+            for (int py = 2 * qy; py < 2 * qy + 2; ++py)
+                for (int px = 2 * qx; px < 2 * qx + 2; ++px)
+                    for (int k = 0; k < spp_; ++k) {
+                        sx += x(index(px, py, k));
+                        sy += y(index(px, py, k));
+                    }
+            const float count = static_cast<float>(4 * spp_);
+            const float cx = sx / count, cy = sy / count;
+            float best = 1e30f;
+            int nearest = 0, m = 0;
+            for (int py = 2 * qy; py < 2 * qy + 2; ++py)
+                for (int px = 2 * qx; px < 2 * qx + 2; ++px)
+                    for (int k = 0; k < spp_; ++k, ++m) {
+                        const float dx = x(index(px, py, k)) - cx, dy = y(index(px, py, k)) - cy;
+                        if (dx * dx + dy * dy < best) {
+                            best = dx * dx + dy * dy;
+                            nearest = m;
+                        }
+                    }
+            const size_t b = static_cast<size_t>(qy) * qw + qx;
+            quadCentroid_[2 * b] = cx;
+            quadCentroid_[2 * b + 1] = cy;
+            quadNearest_[b] = static_cast<uint16_t>(nearest);
+        }
     fx_.resize(n);
     fy_.resize(n);
     for (size_t s = 0; s < n; ++s) {

@@ -48,6 +48,18 @@ class SampleLayout {
     }
     float x(size_t s) const { return xy_[2 * s]; }
     float y(size_t s) const { return xy_[2 * s + 1]; }
+    // Per pixel: the mean of its samples' positions (summed in sample order, then divided by
+    // spp), and which of its samples lies nearest to it (the first, in sample order, of
+    // those nearest). A surface covering a whole pixel is shaded there, per pixel.
+    float centroidX(size_t pixel) const { return centroid_[2 * pixel]; }
+    float centroidY(size_t pixel) const { return centroid_[2 * pixel + 1]; }
+    int nearestToCentroid(size_t pixel) const { return nearest_[pixel]; }
+    // The same per block of 2x2 pixels at even (px, py), whole inside the image (summed row
+    // by row, pixel by pixel, sample by sample); the nearest is 0..4 spp - 1 in that order.
+    // block = (py / 2) * (width / 2) + px / 2.
+    float quadCentroidX(size_t block) const { return quadCentroid_[2 * block]; }
+    float quadCentroidY(size_t block) const { return quadCentroid_[2 * block + 1]; }
+    int nearestToQuadCentroid(size_t block) const { return quadNearest_[block]; }
     // On the 1/256-pixel grid: round(x * 256), round(y * 256).
     const int32_t* fixedX() const { return fx_.data(); }
     const int32_t* fixedY() const { return fy_.data(); }
@@ -69,6 +81,10 @@ class SampleLayout {
     PixelFilter filter_;
     std::vector<float> xy_;
     std::vector<int32_t> fx_, fy_;
+    std::vector<float> centroid_;        // 2 per pixel
+    std::vector<uint16_t> nearest_;      // per pixel
+    std::vector<float> quadCentroid_;    // 2 per whole 2x2 block
+    std::vector<uint16_t> quadNearest_;  // per whole 2x2 block
     // A sample reaches the pixels within `reach_` columns and rows of its own; per sample,
     // taps_ = 2 reach_ + 1 weights across (towards px - reach_ ... px + reach_), then as many
     // down.

@@ -239,6 +239,51 @@ TEST(PixelFilter, UniformPixelsResolveAsTheirSamples) {
     for (size_t i = 0; i < a.rgba.size(); ++i) ASSERT_NEAR(a.rgba[i], b.rgba[i], 1e-6f);
 }
 
+TEST(SamplePattern, CentroidsAndNearestSamplesOfPixelsAndQuads) {
+    // Computed again here in double, by brute force.
+    const SampleLayout layout(7, 5, 3, 11u);
+    for (int py = 0; py < 5; ++py)
+        for (int px = 0; px < 7; ++px) {
+            const size_t pixel = static_cast<size_t>(py) * 7 + px;
+            double cx = 0.0, cy = 0.0;
+            for (int k = 0; k < 3; ++k) {
+                cx += layout.x(layout.index(px, py, k)) / 3.0;
+                cy += layout.y(layout.index(px, py, k)) / 3.0;
+            }
+            EXPECT_NEAR(layout.centroidX(pixel), cx, 1e-5);
+            EXPECT_NEAR(layout.centroidY(pixel), cy, 1e-5);
+            int nearest = 0;
+            double best = 1e30;
+            for (int k = 0; k < 3; ++k) {
+                const double dx = layout.x(layout.index(px, py, k)) - cx,
+                             dy = layout.y(layout.index(px, py, k)) - cy;
+                if (dx * dx + dy * dy < best) best = dx * dx + dy * dy, nearest = k;
+            }
+            EXPECT_EQ(layout.nearestToCentroid(pixel), nearest) << px << " " << py;
+        }
+    for (int qy = 0; qy < 2; ++qy)  // 7x5: 3x2 whole blocks
+        for (int qx = 0; qx < 3; ++qx) {
+            const size_t block = static_cast<size_t>(qy) * 3 + qx;
+            double cx = 0.0, cy = 0.0;
+            std::vector<std::pair<double, double>> samples;
+            for (int py = 2 * qy; py < 2 * qy + 2; ++py)
+                for (int px = 2 * qx; px < 2 * qx + 2; ++px)
+                    for (int k = 0; k < 3; ++k)
+                        samples.push_back(
+                            {layout.x(layout.index(px, py, k)), layout.y(layout.index(px, py, k))});
+            for (const auto& [x, y] : samples) cx += x / 12.0, cy += y / 12.0;
+            EXPECT_NEAR(layout.quadCentroidX(block), cx, 1e-5);
+            EXPECT_NEAR(layout.quadCentroidY(block), cy, 1e-5);
+            int nearest = 0;
+            double best = 1e30;
+            for (int m = 0; m < 12; ++m) {
+                const double dx = samples[m].first - cx, dy = samples[m].second - cy;
+                if (dx * dx + dy * dy < best) best = dx * dx + dy * dy, nearest = m;
+            }
+            EXPECT_EQ(layout.nearestToQuadCentroid(block), nearest) << qx << " " << qy;
+        }
+}
+
 TEST(SamplePattern, StratifiesWithinThePixel) {
     for (int spp : {1, 4, 5, 16}) {
         for (int k = 0; k < spp; ++k) {

@@ -482,6 +482,30 @@ TEST(MultiphaseRenderer, QuadRateShadesOncePerTwoByTwoPixelsAndSurface) {
     EXPECT_LT(quad.tilesRequested * 2, pixel.tilesRequested);
 }
 
+TEST(MultiphaseRenderer, WholePixelShortcutGivesTheSamePointsBitForBit) {
+    // Odd sizes (blocks cut at the edges), several samples per pixel, both coarse rates.
+    const Scene scene = loadScene(test::sourcePath("examples/gallery/scene.json"));
+    for (const ShadingRate rate : {ShadingRate::Pixel, ShadingRate::Quad})
+        for (const int spp : {1, 3, 4}) {
+            RenderOptions options;
+            options.width = 97, options.height = 55;
+            options.samplesPerPixel = spp;
+            MultiphaseOptions shortcut, general;
+            shortcut.shadingRate = general.shadingRate = rate;
+            shortcut.singlePhaseFrames = general.singlePhaseFrames = false;
+            general.dynamic.wholePixelShortcut = false;
+            MultiphaseRenderer a(scene, shortcut), b(scene, general);
+            FrameStats sa, sb;
+            const Image ia = a.renderFrame(2, options, sa);
+            const Image ib = b.renderFrame(2, options, sb);
+            ASSERT_EQ(ia.rgba.size(), ib.rgba.size());
+            EXPECT_EQ(sa.shadedPoints, sb.shadedPoints);
+            size_t differing = 0;
+            for (size_t k = 0; k < ia.rgba.size(); ++k) differing += ia.rgba[k] != ib.rgba[k];
+            EXPECT_EQ(differing, 0u) << shadingRateName(rate) << " spp " << spp;
+        }
+}
+
 TEST(MultiphaseRenderer, MapsStayInTheirMemoryBudget) {
     // A budget far below what the courtyard's maps would take: tiles unused longest are
     // dropped (filled again when a frame needs them), the maps stay near the budget, and
