@@ -51,16 +51,34 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         stepSeconds[static_cast<size_t>(k)] =
             s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
     }
-    // And one prediction, so the first frames know what one costs.
+    const double budget = 1.0 / options.fps;
+    regulator.calibrate(stepSeconds, budget);
+    renderer.setShadingRate(regulator.step().rate);
+    renderer.setFootprintScale(regulator.step().footprintScale);
+    // Warming the cache for the first frames, at the step they start on: the tiles of
+    // every third frame of the first prerollPrefetchSeconds, predicted at half the size,
+    // filled as far as the cache allows. Then one prediction as the frames make them, so
+    // the first frames know what one costs.
     double predictCost = 0.0;  // the last prediction's seconds
-    if (options.prefetch)
-        renderer.predictTiles(options.first, options.render, options.predictDivisor, predictCost);
+    if (options.prefetch) {
+        const int ahead =
+            static_cast<int>(std::lround(options.prerollPrefetchSeconds * scene.settings.fps));
+        std::vector<TileRequest> tiles;
+        for (int f = options.first + 1; f <= std::min(options.last - 1, options.first + ahead);
+             f += 3) {
+            std::vector<TileRequest> more =
+                renderer.predictTiles(f, stepOptions(regulator.level()), 2, predictCost);
+            tiles.insert(tiles.end(), more.begin(), more.end());
+        }
+        FrameStats warm;
+        renderer.prefetch(tiles, 1e9, warm);
+        renderer.predictTiles(options.first, stepOptions(regulator.level()), options.predictDivisor,
+                              predictCost);
+    }
     summary.prerollSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (onPreroll) onPreroll(summary.prerollSeconds);
-    const double budget = 1.0 / options.fps;
     renderer.setFrameBudget(budget);
-    regulator.calibrate(stepSeconds, budget);
     for (int frame = options.first; frame < options.last; ++frame) {
         const PlaybackQuality quality{regulator.level(), regulator.step()};
         renderer.setShadingRate(quality.step.rate);

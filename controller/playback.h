@@ -38,6 +38,10 @@ struct PlaybackOptions {
     // seconds of scene time ahead, predicted at 1/predictDivisor of the image each way
     // (claim 11), then those next to the tiles this frame lacked (claim 10). Off: none.
     bool prefetch = true;
+    // The pre-roll also fills the tiles predicted for the frames of this many seconds of
+    // scene time after the first (every third frame, at half the size), as far as the cache
+    // allows: a player warming its cache while it loads. 0: only the first frame's.
+    double prerollPrefetchSeconds = 1.0;
     double predictSeconds = 0.1;
     int predictDivisor = 4;
 };

@@ -73,10 +73,17 @@ void QualityRegulator::update(const FrameStats& stats, double budget) {
             ratioAbove_[static_cast<size_t>(below)] = std::max(1.0, upper / lower);
         }
     }
+    const bool wasOver = lastLevel_ == current_ && lastDynamic_ > options_.slowDownAt * budget;
     lastLevel_ = current_;
     lastDynamic_ = dynamic;
-    if (dynamic > options_.slowDownAt * budget) {
+    // One frame over the share may be the machine (a frame's time varies by a tenth or
+    // more): a step down waits for a second one, unless the frame nearly took the budget.
+    if (dynamic > options_.dropAt * budget || (dynamic > options_.slowDownAt * budget && wasOver)) {
         current_ = std::min(current_ + 1, levels() - 1);
+        calm_ = 0;
+        return;
+    }
+    if (dynamic > options_.slowDownAt * budget) {
         calm_ = 0;
         return;
     }

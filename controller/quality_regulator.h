@@ -11,10 +11,11 @@
 //   and the resolve scale with the samples; edges lose their antialiasing).
 // Coverage stays per sample on every step.
 //
-// After each frame the regulator steps down at once when the dynamic phase (warp to
-// resolve) took more than `slowDownAt` of the budget, and steps up after `calmFrames`
-// frames in a row whose dynamic phase, times the step above's cost ratio, would take less
-// than `speedUpAt`. The ratios are measured: all of them before the first frame
+// After each frame the regulator steps down when the dynamic phase (warp to resolve) took
+// more than `slowDownAt` of the budget on two frames in a row at one step, or more than
+// `dropAt` on one (a single frame over the share is often the machine), and steps up after
+// `calmFrames` frames in a row whose dynamic phase, times the step above's cost ratio,
+// would take less than `speedUpAt`. The ratios are measured: all of them before the first frame
 // (calibrate: one view rendered at every step), then each again whenever two consecutive
 // frames ran on neighbouring steps. The gap between the two shares and the wait keep it
 // from flickering between steps.
@@ -35,7 +36,8 @@ struct QualityStep {
 };
 
 struct QualityRegulatorOptions {
-    double slowDownAt = 0.7;  // of the budget: a dynamic phase above it steps down
+    double slowDownAt = 0.7;  // of the budget: two frames in a row above it step down
+    double dropAt = 0.9;      // of the budget: one frame above it steps down
     double speedUpAt = 0.65;  // of the budget: the step above, predicted below it, steps up
     int calmFrames = 8;       // frames in a row that must predict so before stepping up
 };

@@ -20,6 +20,7 @@ FrameStats frame(double rest, double shade = 0.0) {
 QualityRegulatorOptions exactShares() {
     QualityRegulatorOptions o;
     o.slowDownAt = 0.75;
+    o.dropAt = 0.875;
     o.speedUpAt = 0.5;
     return o;
 }
@@ -59,10 +60,20 @@ TEST(QualityRegulator, BeforeMeasuringTheRatiosAreTheShadingPoints) {
 TEST(QualityRegulator, StepsDownOnlyAboveItsShareAndStopsAtTheBottom) {
     QualityRegulator r(ShadingRate::Sample, 1, exactShares());  // five steps
     r.update(frame(0.5, 0.25), 1.0);  // exactly at the share is not above it
+    r.update(frame(0.5, 0.25), 1.0);
     EXPECT_EQ(r.level(), 0);
+    r.update(frame(0.5, 0.2501), 1.0);  // one frame above: the machine, maybe
+    EXPECT_EQ(r.level(), 0);
+    r.update(frame(0.5, 0.2), 1.0);  // back under: the count starts again
     r.update(frame(0.5, 0.2501), 1.0);
+    EXPECT_EQ(r.level(), 0);
+    r.update(frame(0.5, 0.2501), 1.0);  // two in a row
     EXPECT_EQ(r.level(), 1);
     EXPECT_EQ(r.step().rate, ShadingRate::Pixel);
+    r.update(frame(0.5, 0.375), 1.0);  // exactly at dropAt: not above it
+    EXPECT_EQ(r.level(), 1);
+    r.update(frame(0.5, 0.3751), 1.0);  // above dropAt: at once
+    EXPECT_EQ(r.level(), 2);
     for (int k = 0; k < 10; ++k) r.update(frame(2.0, 2.0), 1.0);
     EXPECT_EQ(r.level(), 4);
 }
@@ -109,9 +120,9 @@ TEST(QualityRegulator, StepsUpAfterCalmFramesPredictingTheStepAboveFits) {
 
 TEST(QualityRegulator, AStepDownMeasuresTheRatioOfTheTwoSteps) {
     QualityRegulator r(ShadingRate::Pixel, 1, exactShares());
-    r.update(frame(0.8), 1.0);  // to level 1
+    r.update(frame(0.9), 1.0);  // above dropAt: to level 1
     ASSERT_EQ(r.level(), 1);
-    r.update(frame(0.2), 1.0);
+    r.update(frame(0.225), 1.0);
     EXPECT_DOUBLE_EQ(r.costRatioAbove(1), 4.0);
     EXPECT_EQ(r.costRatioAbove(2), 4.0);  // not measured: the points' ratio
 }
