@@ -181,3 +181,61 @@ TEST(RerunTriggers, AnInputMovingWithinTheToleranceRunsNothing) {
 
 }  // namespace
 }  // namespace mpshade
+
+namespace mpshade {
+namespace {
+
+// Two balls far apart; the camera looks at the first, cuts to the second at t = 1 and
+// back to the first view at t = 2.
+std::string writeCutScene() {
+    const std::string path = ::testing::TempDir() + "mpshade_cut_scene.json";
+    std::ofstream f(path);
+    f << R"({
+  "settings": {"width": 64, "height": 36, "fps": 10, "duration": 3.0, "samples_per_pixel": 1},
+  "camera": {"fov_y": 30, "near": 0.1, "far": 100, "keys": [
+    {"t": 0, "eye": [0, 0, 6], "target": [0, 0, 0]},
+    {"t": 0.99, "eye": [0, 0, 6], "target": [0, 0, 0]},
+    {"t": 1.0, "eye": [20, 0, 6], "target": [20, 0, 0]},
+    {"t": 1.99, "eye": [20, 0, 6], "target": [20, 0, 0]},
+    {"t": 2.0, "eye": [0, 0, 6], "target": [0, 0, 0]}]},
+  "lights": [{"type": "distant", "direction": [0, -1, -1], "color": [1, 1, 1]}],
+  "shaders": {"marble": ")"
+      << test::sourcePath("examples/shaders/marble.sl") << R"("},
+  "objects": [
+    {"name": "first", "geometry": {"type": "sphere", "radius": 1.0}, "shader": "marble"},
+    {"name": "second", "geometry": {"type": "sphere", "radius": 1.0}, "shader": "marble",
+     "transform": {"translate": [20, 0, 0]}}]
+})";
+    return path;
+}
+
+TEST(RerunTriggers, ACameraCutRunsOnlyWhatTheNewViewNeeds) {
+    const Scene scene = loadScene(writeCutScene());
+    MultiphaseRenderer renderer(scene, everyFrame());
+    FrameStats stats;
+    renderer.renderFrame(0, tiny(), stats);
+    ASSERT_EQ(stats.staticRunsDue.size(), 1u);
+    EXPECT_EQ(stats.staticRunsDue[0].object, 0u);  // the second ball is not seen: not built
+    EXPECT_EQ(renderer.representation(1), nullptr);
+    for (int frame = 1; frame < 10; ++frame) {
+        renderer.renderFrame(frame, tiny(), stats);
+        EXPECT_TRUE(stats.staticRunsDue.empty()) << frame;
+    }
+    renderer.renderFrame(10, tiny(), stats);  // the cut: only the second ball, first seen
+    ASSERT_EQ(stats.staticRunsDue.size(), 1u);
+    EXPECT_EQ(stats.staticRunsDue[0].object, 1u);
+    EXPECT_EQ(stats.staticRunsDue[0].cause, StaticRunDue::FirstSeen);
+    EXPECT_EQ(stats.staticRuns, 1);
+    for (int frame = 11; frame < 20; ++frame) {
+        renderer.renderFrame(frame, tiny(), stats);
+        EXPECT_TRUE(stats.staticRunsDue.empty()) << frame;
+    }
+    // Back to the first view: the first ball's representation still holds for it.
+    renderer.renderFrame(20, tiny(), stats);
+    EXPECT_TRUE(stats.staticRunsDue.empty());
+    EXPECT_EQ(stats.staticRuns, 0);
+    EXPECT_EQ(stats.objectsDrawn, 1u);
+}
+
+}  // namespace
+}  // namespace mpshade
