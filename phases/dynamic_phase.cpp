@@ -216,14 +216,7 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
     });
     std::vector<TileRequest> all;
     for (const std::vector<TileRequest>& l : lacking) all.insert(all.end(), l.begin(), l.end());
-    std::sort(all.begin(), all.end(), [](const TileRequest& a, const TileRequest& b) {
-        return a.object != b.object ? a.object < b.object : a.key.packed() < b.key.packed();
-    });
-    all.erase(std::unique(all.begin(), all.end(),
-                          [](const TileRequest& a, const TileRequest& b) {
-                              return a.object == b.object && a.key == b.key;
-                          }),
-              all.end());
+    sortUniqueTiles(all);
     for (const TileRequest& r : all) ++costs_[r.object].tilesLacked;
     if (complete()) {
         // Sum the per-thread counters once every band is done.

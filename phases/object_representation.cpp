@@ -33,4 +33,15 @@ ObjectRepresentation::RangeCheck ObjectRepresentation::checkRange(const glm::vec
     return c;
 }
 
+void sortUniqueTiles(std::vector<TileRequest>& tiles) {
+    std::sort(tiles.begin(), tiles.end(), [](const TileRequest& a, const TileRequest& b) {
+        return a.object != b.object ? a.object < b.object : a.key.packed() < b.key.packed();
+    });
+    tiles.erase(std::unique(tiles.begin(), tiles.end(),
+                            [](const TileRequest& a, const TileRequest& b) {
+                                return a.object == b.object && a.key == b.key;
+                            }),
+                tiles.end());
+}
+
 }  // namespace mpshade

@@ -75,4 +75,7 @@ struct TileRequest {
     TileKey key;
 };
 
+// Sorts requests by object, then key, and drops repeats.
+void sortUniqueTiles(std::vector<TileRequest>& tiles);
+
 }  // namespace mpshade

@@ -88,14 +88,7 @@ std::vector<TileRequest> MultiphaseRenderer::adjacentTiles() const {
                 if (!map.resident(key)) out.push_back({r.object, key});
             }
     }
-    std::sort(out.begin(), out.end(), [](const TileRequest& a, const TileRequest& b) {
-        return a.object != b.object ? a.object < b.object : a.key.packed() < b.key.packed();
-    });
-    out.erase(std::unique(out.begin(), out.end(),
-                          [](const TileRequest& a, const TileRequest& b) {
-                              return a.object == b.object && a.key == b.key;
-                          }),
-              out.end());
+    sortUniqueTiles(out);
     return out;
 }
 
