@@ -123,7 +123,10 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
             incoming += rep->map->tileBytes();
         }
         if (batch.empty()) continue;
-        if (!keepMapsInBudget(incoming, stats)) break;
+        // A guess never displaces a tile in the cache: only room left is used.
+        size_t held = 0;
+        for (const auto& pool : static_.tilePools().all()) held += pool->bytesHeld();
+        if (held + incoming > options_.mapMemoryBytes) break;
         const auto began = Clock::now();
         static_.fill(batch, maps, costs, nullptr);
         perTile = std::max(perTile, secondsSince(began) / static_cast<double>(batch.size()));

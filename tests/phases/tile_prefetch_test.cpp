@@ -97,6 +97,36 @@ TEST(TilePrefetch, ATileNoFrameReadsIsWastedAfterThePatience) {
     EXPECT_TRUE(map.resident(corner));  // still an ordinary tile of the cache
 }
 
+TEST(TilePrefetch, AGuessNeverDisplacesATileInTheCache) {
+    const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    // A cache exactly as large as what frames 0 and 8 leave resident: full, nothing evicted.
+    uint64_t full = 0;
+    {
+        MultiphaseRenderer roomy(scene, budgeted());
+        FrameStats stats;
+        roomy.renderFrame(0, small(), stats);
+        roomy.renderFrame(8, small(), stats);
+        full = stats.residentBytes;
+    }
+    MultiphaseOptions o = budgeted();
+    o.mapMemoryBytes = full;
+    MultiphaseRenderer renderer(scene, o);
+    FrameStats stats;
+    renderer.renderFrame(0, small(), stats);
+    renderer.renderFrame(8, small(), stats);  // frame 0's tiles it does not read: evictable
+    ASSERT_EQ(stats.tilesEvicted, 0u);
+    ASSERT_EQ(stats.residentBytes, full);
+    double seconds = 0.0;
+    const std::vector<TileRequest> predicted = renderer.predictTiles(16, small(), 1, seconds);
+    ASSERT_FALSE(predicted.empty());
+    FrameStats slack;
+    renderer.prefetch(predicted, 60.0, slack);
+    // A frame's demand would evict frame 0's tiles to fit (planting that fails here); a
+    // guess finds no room and fills nothing.
+    EXPECT_EQ(slack.tilesEvicted, 0u);
+    EXPECT_EQ(slack.tilesPrefetched, 0u);
+}
+
 TEST(TilePrefetch, NeighboursOfLackedTilesAreAdjacentAndNotResident) {
     const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
     MultiphaseRenderer renderer(scene, budgeted());
