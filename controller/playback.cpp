@@ -71,7 +71,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
             tiles.insert(tiles.end(), more.begin(), more.end());
         }
         FrameStats warm;
-        renderer.prefetch(tiles, 1e9, warm);
+        renderer.prefetch(tiles, options.prerollPrefetchWallSeconds, warm);
         renderer.predictTiles(options.first, stepOptions(regulator.level()), options.predictDivisor,
                               predictCost);
     }

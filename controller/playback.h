@@ -40,8 +40,11 @@ struct PlaybackOptions {
     bool prefetch = true;
     // The pre-roll also fills the tiles predicted for the frames of this many seconds of
     // scene time after the first (every third frame, at half the size), as far as the cache
-    // allows: a player warming its cache while it loads. 0: only the first frame's.
+    // allows and for at most prerollPrefetchWallSeconds: a player warming its cache while it
+    // loads (a scene of dear static shaders would otherwise load for as long as its cache
+    // takes to fill). 0: only the first frame's.
     double prerollPrefetchSeconds = 1.0;
+    double prerollPrefetchWallSeconds = 2.0;
     double predictSeconds = 0.1;
     int predictDivisor = 4;
 };
