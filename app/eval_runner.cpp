@@ -17,9 +17,6 @@ namespace mpshade {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 MultiphaseOptions multiphaseOptions(const EvalConfig& c) {
     MultiphaseOptions o;

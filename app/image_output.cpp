@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 #include <vector>
 
@@ -68,6 +69,13 @@ void writeExr(const Image& image, const std::string& path) {
         clamped[i] = v == v ? std::clamp(v, -65504.0f, 65504.0f) : 0.0f;
     }
     write(path, "openexr", spec, OIIO::TypeDesc::FLOAT, clamped.data());
+}
+
+void writeFrameImages(const Image& image, const std::string& dir, int frame) {
+    const std::string base =
+        (std::filesystem::path(dir) / fmt::format("frame_{:04d}", frame)).string();
+    writeExr(image, base + ".exr");
+    writePng(image, base + ".png");
 }
 
 void writePng(const Image& image, const std::string& path) {

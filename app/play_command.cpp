@@ -73,11 +73,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
         double writeSeconds = 0.0;
         if (!options.noWrite) {
             const auto began = std::chrono::steady_clock::now();
-            char name[32];
-            std::snprintf(name, sizeof name, "frame_%04d", s.index);
-            const std::string base = (dir / name).string();
-            writeExr(image, base + ".exr");
-            writePng(image, base + ".png");
+            writeFrameImages(image, dir.string(), s.index);
             writeSeconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
         }

@@ -198,11 +198,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
             multi->renderFrame(frame, render, stats, image, progress);
         else
             image = reference->renderFrame(frame, render, stats, progress);
-        char name[32];
-        std::snprintf(name, sizeof name, "frame_%04d", frame);
-        const std::string base = (std::filesystem::path(options.outDir) / name).string();
-        writeExr(image, base + ".exr");
-        writePng(image, base + ".png");
+        writeFrameImages(image, options.outDir, frame);
         nlohmann::json entry = {{"index", stats.index},
                                 {"time", stats.time},
                                 {"wall_seconds", stats.wallSeconds},

@@ -15,9 +15,6 @@ namespace mpshade {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Per cluster: whether any of it can be seen this frame. Off screen: its bounding sphere is
 // wholly outside a side plane or in front of the near plane. Facing away: every normal of

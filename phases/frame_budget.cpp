@@ -5,17 +5,13 @@
 #include <algorithm>
 #include <chrono>
 
-#include <tbb/task_arena.h>
-
+#include "phases/fill_pacer.h"
 #include "phases/multiphase_renderer.h"
 
 namespace mpshade {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 }  // namespace
 
@@ -80,25 +76,16 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     timing.trace = options_.trace;
     timing.frame = frame;
     const auto fillStart = Clock::now();
-    size_t next = 0, chunk = 2;
-    // Seconds a tile, the most a chunk took lately: tiles built from resident children
-    // cost a fifth of those evaluated whole, so chunks are sized for the dear ones.
-    double perTile = tileSeconds_;
-    const size_t threads = static_cast<size_t>(tbb::this_task_arena::max_concurrency());
-    // A twentieth of the budget is kept for what follows the fills; chunks are sized to
-    // half the time left at the cost a tile has had lately, so one slow chunk does not
-    // overshoot. A frame already late gets its minimum share; one that is not is never
-    // made late by fills.
+    size_t next = 0;
+    FillPacer pacer(tileSeconds_);
+    // A twentieth of the budget is kept for what follows the fills. A frame already late
+    // gets its minimum share; one that is not is never made late by fills.
     const double budget = options_.frameBudgetSeconds, elapsed = secondsSince(start);
     const double deadline =
         elapsed < 0.95 * budget ? 0.95 * budget : elapsed + options_.minimumStaticShare * budget;
     while (next < lacking_.size()) {
-        const double left = deadline - secondsSince(start);
-        if (perTile > 0.0)
-            chunk = static_cast<size_t>(std::clamp(0.5 * left / perTile, 0.0, 4096.0));
-        // The cost per tile is measured on chunks filled by every thread: a chunk smaller
-        // than the threads takes longer per tile than that, so it is not started.
-        if (left <= 0.0 || chunk < (perTile > 0.0 ? threads : 1)) break;
+        const size_t chunk = pacer.chunk(deadline - secondsSince(start));
+        if (chunk == 0) break;
         const size_t end = std::min(lacking_.size(), next + chunk);
         const std::span<const TileRequest> batch(lacking_.data() + next, end - next);
         size_t incoming = 0;
@@ -108,13 +95,11 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         if (!keepMapsInBudget(incoming, stats)) break;
         const auto began = Clock::now();
         static_.fill(batch, drawn_, fills, &timing);
-        const double took = secondsSince(began);
-        perTile = std::max(perTile, took / static_cast<double>(batch.size()));
+        pacer.filled(secondsSince(began), batch.size());
         for (const TileRequest& r : batch) ++reports_[r.object].staticCosts.tilesFilled;
         next = end;
     }
-    // Forgotten slowly: the next frame's chunks start from nine tenths of this one's worst.
-    if (perTile > 0.0) tileSeconds_ = 0.9 * perTile;
+    tileSeconds_ = pacer.remembered();
     stats.tilesDeferred = lacking_.size() - next;
     stats.fillSeconds += secondsSince(fillStart);
     stats.staticSeconds += secondsSince(fillStart);
@@ -130,12 +115,7 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         reports_[i].staticCosts.seconds += timing.objectSeconds[i];
         reports_[i].staticCosts.instructions += timing.objectInstructions[i];
     }
-    stats.residentTiles = stats.residentBytes = stats.residentPinnedBytes = 0;
-    for (const auto& pool : static_.tilePools().all()) {
-        stats.residentTiles += pool->tilesHeld();
-        stats.residentBytes += pool->bytesHeld();
-        stats.residentPinnedBytes += pool->pinnedBytesHeld();
-    }
+    recordResidency(stats);
     lastLacking_.swap(lacking_);
     lacking_.clear();
 }

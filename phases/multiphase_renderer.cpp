@@ -14,9 +14,6 @@ namespace mpshade {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 }  // namespace
 
@@ -479,11 +476,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         }
         ++stats.objectsDrawn;
     }
-    for (const auto& pool : static_.tilePools().all()) {
-        stats.residentTiles += pool->tilesHeld();
-        stats.residentBytes += pool->bytesHeld();
-        stats.residentPinnedBytes += pool->pinnedBytesHeld();
-    }
+    recordResidency(stats);
     stats.warpSeconds = d.warpSeconds;
     stats.rasterSeconds = d.rasterSeconds;
     stats.shadeSeconds = d.shadeSeconds;
@@ -502,6 +495,15 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     stats.time = frame_.time;
     stats.samples = static_cast<uint64_t>(frame_.width) * frame_.height * frame_.spp;
     stats.wallSeconds = secondsSince(start);
+}
+
+void MultiphaseRenderer::recordResidency(FrameStats& stats) const {
+    stats.residentTiles = stats.residentBytes = stats.residentPinnedBytes = 0;
+    for (const auto& pool : static_.tilePools().all()) {
+        stats.residentTiles += pool->tilesHeld();
+        stats.residentBytes += pool->bytesHeld();
+        stats.residentPinnedBytes += pool->pinnedBytesHeld();
+    }
 }
 
 bool MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {

@@ -169,6 +169,8 @@ class MultiphaseRenderer {
     // Drops the least recently used tiles until `incoming` more bytes of tiles fit the
     // budget (or nothing the frame has not used is left); returns whether they fit.
     bool keepMapsInBudget(size_t incoming, FrameStats& stats);
+    // The tiles every map holds now, and their bytes (of them the always-resident levels').
+    void recordResidency(FrameStats& stats) const;
     // Of the tiles prefetched, those this frame's probes read (used) and those dropped or
     // left unread too long (wasted), counted in stats and forgotten.
     void settlePrefetched(FrameStats& stats);

@@ -25,6 +25,11 @@ enum class PhaseKind : uint8_t {
     Reference,  // a frame rendered single-phase
 };
 
+// Seconds of the steady clock since `start`: how every phase times itself.
+inline double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 class PhaseTrace {
   public:
     using Clock = std::chrono::steady_clock;

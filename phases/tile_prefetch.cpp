@@ -6,18 +6,15 @@
 #include <algorithm>
 #include <chrono>
 
-#include <tbb/task_arena.h>
 #include <cmath>
 
+#include "phases/fill_pacer.h"
 #include "phases/multiphase_renderer.h"
 
 namespace mpshade {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // A shading point's probe footprint in pixels at `rate` (dynamic_phase.h), before
 // DynamicOptions::footprintScale.
@@ -101,18 +98,11 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
     for (size_t i = 0; i < representations_.size(); ++i) maps[i] = representations_[i].get();
     std::vector<TileRequest> batch;
     StaticCosts costs;
-    size_t next = 0, chunk = 2;
-    // Seconds a tile, the most a chunk took lately: tiles built from resident children
-    // cost a fifth of those evaluated whole, so chunks are sized for the dear ones.
-    double perTile = tileSeconds_;
-    const size_t threads = static_cast<size_t>(tbb::this_task_arena::max_concurrency());
+    size_t next = 0;
+    FillPacer pacer(tileSeconds_);
     while (next < tiles.size()) {
-        const double left = seconds - secondsSince(start);
-        if (perTile > 0.0)
-            chunk = static_cast<size_t>(std::clamp(0.5 * left / perTile, 0.0, 4096.0));
-        // The cost per tile is measured on chunks filled by every thread: a chunk smaller
-        // than the threads takes longer per tile than that, so it is not started.
-        if (left <= 0.0 || chunk < (perTile > 0.0 ? threads : 1)) break;
+        const size_t chunk = pacer.chunk(seconds - secondsSince(start));
+        if (chunk == 0) break;
         batch.clear();
         size_t incoming = 0;
         for (; next < tiles.size() && batch.size() < chunk; ++next) {
@@ -124,19 +114,17 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
         }
         if (batch.empty()) continue;
         // A guess never displaces a tile in the cache: only room left is used.
-        size_t held = 0;
-        for (const auto& pool : static_.tilePools().all()) held += pool->bytesHeld();
-        if (held + incoming > options_.mapMemoryBytes) break;
+        if (static_.tilePools().bytesHeld() + incoming > options_.mapMemoryBytes) break;
         const auto began = Clock::now();
         static_.fill(batch, maps, costs, nullptr);
-        perTile = std::max(perTile, secondsSince(began) / static_cast<double>(batch.size()));
+        pacer.filled(secondsSince(began), batch.size());
         for (const TileRequest& r : batch) {
             const ShaderMap* map = maps[r.object]->map.get();
             const int slot = map->slotOf(r.key);
             if (slot >= 0) prefetched_.push_back({r.object, map, r.key, slot, useStamp_});
         }
     }
-    if (perTile > 0.0) tileSeconds_ = 0.9 * perTile;
+    tileSeconds_ = pacer.remembered();
     stats.tilesPrefetched += costs.tilesFilled;
     return secondsSince(start);
 }
