@@ -2,6 +2,22 @@
 
 namespace mpshade {
 
+void addMultiphaseFrameJson(const Scene& scene, const FrameStats& stats, nlohmann::json& entry) {
+    entry["static_seconds"] = stats.staticSeconds;
+    entry["fill_seconds"] = stats.fillSeconds;
+    entry["warp_seconds"] = stats.warpSeconds;
+    entry["raster_seconds"] = stats.rasterSeconds;
+    entry["shade_seconds"] = stats.shadeSeconds;
+    entry["resolve_seconds"] = stats.resolveSeconds;
+    entry["static_runs"] = stats.staticRuns;
+    entry["static_runs_due"] = staticRunsDueJson(scene, stats);
+    entry["tiles_requested"] = stats.tilesRequested;
+    entry["tiles_filled"] = stats.tilesFilled;
+    entry["tiles_evicted"] = stats.tilesEvicted;
+    entry["resident_bytes"] = stats.residentBytes;
+    entry["resident_pinned_bytes"] = stats.residentPinnedBytes;
+}
+
 nlohmann::json staticRunsDueJson(const Scene& scene, const FrameStats& stats) {
     nlohmann::json due = nlohmann::json::array();
     for (const StaticRunDue& d : stats.staticRunsDue) {

@@ -14,4 +14,9 @@ namespace mpshade {
 // single-phase: nothing is built then).
 nlohmann::json staticRunsDueJson(const Scene& scene, const FrameStats& stats);
 
+// A multi-phase frame's figures both commands write into its entry: the phases' seconds
+// (static_seconds, of it fill_seconds; warp, raster, shade, resolve), its static runs and
+// why, and the tile cache (requested, filled, evicted; resident and pinned bytes).
+void addMultiphaseFrameJson(const Scene& scene, const FrameStats& stats, nlohmann::json& entry);
+
 }  // namespace mpshade

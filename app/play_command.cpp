@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 
 #include <unistd.h>
 #include <nlohmann/json.hpp>
@@ -78,47 +79,36 @@ int runPlayCommand(const PlayCommandOptions& options) {
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
         }
         met += s.deadlineMet ? 1 : 0;
-        frames.push_back(
-            {{"index", s.index},
-             {"time", s.time},
-             {"wall_seconds", s.wallSeconds},
-             {"budget_seconds", s.budgetSeconds},
-             {"deadline_met", s.deadlineMet},
-             {"static_seconds", s.staticSeconds},
-             {"fill_seconds", s.fillSeconds},
-             {"warp_seconds", s.warpSeconds},
-             {"raster_seconds", s.rasterSeconds},
-             {"shade_seconds", s.shadeSeconds},
-             {"resolve_seconds", s.resolveSeconds},
-             {"write_seconds", writeSeconds},
-             {"static_runs", s.staticRuns},
-             {"built_ahead", s.builtAhead},
-             {"static_runs_due", staticRunsDueJson(scene, s)},
-             {"quality",
-              {{"level", quality.level},
-               {"shading_rate", shadingRateName(quality.step.rate)},
-               {"footprint_scale", quality.step.footprintScale},
-               {"samples_per_pixel",
-                quality.step.samplesPerPixel > 0 ? quality.step.samplesPerPixel : spp},
-               {"probes", s.probes},
-               {"probe_fallbacks", s.probeFallbacks},
-               {"older_representations", s.rebuildsDeferred}}},
-             {"deferred", {{"tiles", s.tilesDeferred}, {"rebuilds", s.rebuildsDeferred}}},
-             {"tiles_requested", s.tilesRequested},
-             {"tiles_filled", s.tilesFilled},
-             {"tiles_evicted", s.tilesEvicted},
-             {"probe_hits", s.probes - s.probeFallbacks},
-             {"controller_seconds", s.controllerSeconds},
-             {"prefetch",
-              {{"predicted", s.tilesPredicted},
-               {"adjacent", s.tilesAdjacent},
-               {"filled", s.tilesPrefetched},
-               {"used", s.prefetchUsed},
-               {"wasted", s.prefetchWasted},
-               {"seconds", s.prefetchSeconds}}},
-             {"resident_bytes", s.residentBytes},
-             {"resident_pinned_bytes", s.residentPinnedBytes},
-             {"shaded_points", s.shadedPoints}});
+        nlohmann::json entry = {
+            {"index", s.index},
+            {"time", s.time},
+            {"wall_seconds", s.wallSeconds},
+            {"budget_seconds", s.budgetSeconds},
+            {"deadline_met", s.deadlineMet},
+            {"write_seconds", writeSeconds},
+            {"built_ahead", s.builtAhead},
+            {"quality",
+             {{"level", quality.level},
+              {"shading_rate", shadingRateName(quality.step.rate)},
+              {"footprint_scale", quality.step.footprintScale},
+              {"samples_per_pixel",
+               quality.step.samplesPerPixel > 0 ? quality.step.samplesPerPixel : spp},
+              {"probes", s.probes},
+              {"probe_fallbacks", s.probeFallbacks},
+              {"older_representations", s.rebuildsDeferred}}},
+            {"deferred", {{"tiles", s.tilesDeferred}, {"rebuilds", s.rebuildsDeferred}}},
+            {"probe_hits", s.probes - s.probeFallbacks},
+            {"controller_seconds", s.controllerSeconds},
+            {"prefetch",
+             {{"predicted", s.tilesPredicted},
+              {"adjacent", s.tilesAdjacent},
+              {"filled", s.tilesPrefetched},
+              {"used", s.prefetchUsed},
+              {"wasted", s.prefetchWasted},
+              {"seconds", s.prefetchSeconds}}},
+            {"shaded_points", s.shadedPoints}};
+        addMultiphaseFrameJson(scene, s, entry);
+        frames.push_back(std::move(entry));
         if (tty)
             std::fprintf(stderr, "\rframe %d: %.1f ms of %.1f, %d of %zu on time", s.index,
                          1e3 * s.wallSeconds, 1e3 * s.budgetSeconds, met, frames.size());

@@ -212,14 +212,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
             double covered = 0.0;
             for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
             entry["single_phase"] = stats.singlePhase;
-            entry["static_runs"] = stats.staticRuns;
-            entry["static_runs_due"] = staticRunsDueJson(scene, stats);
-            entry["static_seconds"] = stats.staticSeconds;
-            entry["fill_seconds"] = stats.fillSeconds;
-            entry["warp_seconds"] = stats.warpSeconds;
-            entry["raster_seconds"] = stats.rasterSeconds;
-            entry["shade_seconds"] = stats.shadeSeconds;
-            entry["resolve_seconds"] = stats.resolveSeconds;
+            addMultiphaseFrameJson(scene, stats, entry);
             entry["static_instructions"] = stats.staticInstructions;
             entry["objects_drawn"] = stats.objectsDrawn;
             entry["facets"] = stats.facets;
@@ -233,14 +226,9 @@ int runRenderCommand(const RenderCommandOptions& options) {
             entry["shade_passes"] = stats.shadePasses;
             entry["probes"] = stats.probes;
             entry["probe_fallbacks"] = stats.probeFallbacks;
-            entry["tiles_requested"] = stats.tilesRequested;
-            entry["tiles_filled"] = stats.tilesFilled;
             entry["tiles_from_children"] = stats.tilesFromChildren;
             entry["texels_filled"] = stats.texelsFilled;
             entry["resident_tiles"] = stats.residentTiles;
-            entry["resident_bytes"] = stats.residentBytes;
-            entry["resident_pinned_bytes"] = stats.residentPinnedBytes;
-            entry["tiles_evicted"] = stats.tilesEvicted;
         }
         if (options.compare) {
             FrameStats refStats;
