@@ -35,8 +35,8 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--seed", render.seed, "Seed of the sample positions")
         ->capture_default_str();
     renderCmd->add_option("--shading-rate", render.shadingRate,
-                          "Multiphase: run the dynamic shader per 'sample' or per 'pixel' "
-                          "(overrides the scene)");
+                          "Multiphase: run the dynamic shader per 'sample', per 'pixel' or per "
+                          "2x2 pixels, 'quad' (overrides the scene)");
     renderCmd->add_option("--footprint-scale", render.footprintScale,
                           "Multiphase: shader map texels per shading point spacing, inverted "
                           "(default 1; larger reads coarser levels: faster, blurrier)");
