@@ -11,7 +11,7 @@
 
 #include "app/eval_metrics.h"
 #include "phases/image_compare.h"
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 
 namespace mpshade {
 namespace {

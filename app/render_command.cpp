@@ -19,7 +19,7 @@
 #include "controller/cost_profile.h"
 #include "geometry/error.h"
 #include "phases/image_compare.h"
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
 

@@ -12,7 +12,7 @@
 
 #include "phases/facet_rasterizer.h"
 #include "phases/fixed_point_warp.h"
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "controller/trace_recorder.h"
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 
 namespace mpshade {
 

@@ -15,7 +15,7 @@
 #include <functional>
 
 #include "controller/quality_regulator.h"
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 
 namespace mpshade {
 

@@ -7,7 +7,7 @@
 
 #include "fuzz/fuzz_support.h"
 #include "geometry/error.h"
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
 

@@ -15,7 +15,7 @@
 #include "phases/facet_rasterizer.h"
 #include "phases/fixed_point_warp.h"
 #include "phases/image_compare.h"
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 #include "phases/reference_renderer.h"
 #include "phases/representation_choice.h"
 #include "test_support.h"

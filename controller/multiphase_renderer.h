@@ -1,6 +1,8 @@
-// multiphase_renderer.h -- multi-phase rendering at constant quality (patent FIG. 2): the
-// policy that drives the static phase (static_phase.h) and the dynamic phase
-// (dynamic_phase.h) frame by frame, as `mpshade render` uses it.
+// multiphase_renderer.h -- the controller's frame policy (patent FIG. 2, controller 240):
+// what drives the static phase (phases/static_phase.h) and the dynamic phase
+// (phases/dynamic_phase.h) frame by frame -- re-run triggers, the tile cache's budget,
+// fills -- at constant quality as `mpshade render` uses it, or within a frame budget as
+// playback (playback.h) uses it.
 //
 // Per frame:
 //   1. Objects out of view are skipped: no static work is done for an object until a

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 #include "test_support.h"
 
 namespace mpshade {

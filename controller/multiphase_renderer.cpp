@@ -1,4 +1,4 @@
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 
 #include <algorithm>
 #include <chrono>

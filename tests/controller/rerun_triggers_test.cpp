@@ -7,7 +7,7 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
-#include "phases/multiphase_renderer.h"
+#include "controller/multiphase_renderer.h"
 #include "scene/scene_state.h"
 #include "test_support.h"
 

@@ -8,8 +8,8 @@
 
 #include <cmath>
 
-#include "phases/fill_pacer.h"
-#include "phases/multiphase_renderer.h"
+#include "controller/fill_pacer.h"
+#include "controller/multiphase_renderer.h"
 
 namespace mpshade {
 namespace {
