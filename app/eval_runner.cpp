@@ -10,8 +10,8 @@
 #include <string>
 
 #include "app/eval_metrics.h"
-#include "phases/image_compare.h"
 #include "controller/multiphase_renderer.h"
+#include "phases/image_compare.h"
 
 namespace mpshade {
 namespace {

@@ -17,9 +17,9 @@
 #include "app/memory_limit.h"
 #include "app/output_files.h"
 #include "controller/cost_profile.h"
+#include "controller/multiphase_renderer.h"
 #include "geometry/error.h"
 #include "phases/image_compare.h"
-#include "controller/multiphase_renderer.h"
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
 

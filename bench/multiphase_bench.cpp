@@ -10,9 +10,9 @@
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
 
+#include "controller/multiphase_renderer.h"
 #include "phases/facet_rasterizer.h"
 #include "phases/fixed_point_warp.h"
-#include "controller/multiphase_renderer.h"
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
 

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "controller/trace_recorder.h"
 #include "controller/multiphase_renderer.h"
+#include "controller/trace_recorder.h"
 
 namespace mpshade {
 

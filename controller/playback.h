@@ -14,8 +14,8 @@
 
 #include <functional>
 
-#include "controller/quality_regulator.h"
 #include "controller/multiphase_renderer.h"
+#include "controller/quality_regulator.h"
 
 namespace mpshade {
 

@@ -11,10 +11,10 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "controller/multiphase_renderer.h"
 #include "phases/facet_rasterizer.h"
 #include "phases/fixed_point_warp.h"
 #include "phases/image_compare.h"
-#include "controller/multiphase_renderer.h"
 #include "phases/reference_renderer.h"
 #include "test_support.h"
 

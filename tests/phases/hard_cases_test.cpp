@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "phases/image_compare.h"
 #include "controller/multiphase_renderer.h"
+#include "phases/image_compare.h"
 #include "phases/reference_renderer.h"
 #include "test_support.h"
 

@@ -10,12 +10,12 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "controller/multiphase_renderer.h"
 #include "phases/dicing.h"
 #include "phases/facet_clipping.h"
 #include "phases/facet_rasterizer.h"
 #include "phases/fixed_point_warp.h"
 #include "phases/image_compare.h"
-#include "controller/multiphase_renderer.h"
 #include "phases/reference_renderer.h"
 #include "phases/representation_choice.h"
 #include "test_support.h"
