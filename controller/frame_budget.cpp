@@ -36,7 +36,8 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
             const RepresentationChoice estimate = chooseRepresentation(in, options_.costModel);
             const double cost = kind == Representation::Facets ? estimate.facetsStaticSeconds
                                                                : estimate.mapStaticSeconds;
-            if (secondsSince(start) + cost > seconds) continue;
+            // Half as much again, as rebuilds are admitted: an estimate, not a measure.
+            if (secondsSince(start) + 1.5 * cost > seconds) continue;
             const ScopedSpan span(options_.trace, "build ahead", PhaseKind::Static,
                                   SpanLevel::Phase, static_cast<int64_t>(i), frame);
             StaticCosts costs;

@@ -129,10 +129,10 @@ class MultiphaseRenderer {
     const FactoredShader& factored(size_t object) const;
     // Sets MultiphaseOptions::frameBudgetSeconds for the frames that follow (0: constant
     // quality), as playback does after rendering its first frame at constant quality.
-    void setFrameBudget(double seconds) { options_.frameBudgetSeconds = seconds; }
+    void setFrameBudget(double seconds);
     // Looks ahead (Fearing 1996's prediction, patent col. 11): objects not built yet that
     // frames (frame, frame + frames] will see are built now, each for the view of the first
-    // of those frames that sees it, nearest first, while the estimated cost of the next
+    // of those frames that sees it, nearest first, while 1.5 times the estimated cost of the next
     // fits in `seconds`. Returns the seconds spent; `built` counts the objects built.
     double buildAhead(int frame, int frames, const RenderOptions& options, double seconds,
                       int& built);
@@ -242,6 +242,7 @@ class MultiphaseRenderer {
     std::shared_ptr<const SampleLayout> predictLayout_;
     FrameState predictState_;
     std::vector<TileRequest> lacking_;
+    std::vector<TilePool::Held> evictionScratch_;  // keepMapsInBudget's candidates
     std::vector<const ObjectRepresentation*> drawn_;
     double lastDynamicSeconds_ = 0.0;
 };

@@ -85,7 +85,8 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         renderer.setFootprintScale(quality.step.footprintScale);
         FrameStats stats;
         renderer.renderFrame(frame, stepOptions(quality.level), stats, image);
-        const double slack = budget - stats.wallSeconds;
+        // The twentieth of the budget kept for the end of the frame, as fills keep it.
+        const double slack = 0.95 * budget - stats.wallSeconds;
         if (options.lookAheadSeconds > 0.0 && slack > 0.0) {
             const int frames =
                 static_cast<int>(std::ceil(options.lookAheadSeconds * scene.settings.fps));

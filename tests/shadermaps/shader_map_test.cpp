@@ -196,6 +196,50 @@ TEST(ShaderMap, MissingTilesFallBackToCoarserLevels) {
     EXPECT_EQ(touched[0].level, 0);
 }
 
+// A Feline line whose tile is missing falls back as a whole line to the coarser level's fast
+// path; the per-tap path (forced by asking for the tiles read) falls back tap by tap. Both
+// must read the same coarser texels with the same weights, and count the same fallbacks.
+TEST(ShaderMap, FelineLinesFallBackLikeTheirTaps) {
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;
+    options.resolution = 256;
+    options.alwaysResidentLevels = 3;  // levels 6-8
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    map.fillLevels(4, 4);  // 16 x 16 texels: one tile; levels 0-3 and 5 are missing
+    ProbeOptions probe;
+    probe.filter = ProbeFilter::Feline;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> pos(0.05f, 0.95f), angle(0.0f, 3.14159f),
+        size(1.0f, 6.0f);
+    std::vector<ProbeQuery> queries;
+    for (int i = 0; i < 200; ++i)
+        queries.push_back(
+            query(pos(rng), pos(rng), size(rng) / 256.0f, size(rng) / 256.0f, 4.0f, angle(rng)));
+    std::vector<TileKey> missing(1 << 16), touched(1 << 16), missingSlow(1 << 16);
+    ProbeResidency fast{missing.data(), missing.size()};
+    ProbeResidency slow{missingSlow.data(), missingSlow.size()};
+    slow.touched = touched.data();
+    slow.touchedCapacity = touched.size();
+    std::vector<float> a(queries.size() * 3), b(queries.size() * 3);
+    probeShaderMap(map, probe, queries, a.data(), &fast);
+    probeShaderMap(map, probe, queries, b.data(), &slow);
+    for (size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], 2e-6f) << "value " << i;
+    EXPECT_GT(fast.fallbacks, 1000u);
+    EXPECT_EQ(fast.fallbacks, slow.fallbacks);
+    EXPECT_EQ(fast.bilinearProbes, slow.bilinearProbes);
+    EXPECT_EQ(fast.missingProbes, slow.missingProbes);
+    // The tiles a line reports are those its fast path reads: once they are filled, no
+    // probe falls back. (Tap by tap, a tap in a tile's border reports the neighbour
+    // holding that texel, so the two lists differ there.)
+    for (size_t i = 0; i < fast.count; ++i) EXPECT_LT(missing[i].level, 4);
+    map.fill({missing.data(), fast.count});
+    ProbeResidency again{missing.data(), missing.size()};
+    probeShaderMap(map, probe, queries, a.data(), &again);
+    EXPECT_EQ(again.fallbacks, 0u);
+    EXPECT_EQ(again.count, 0u);
+    for (size_t i = 0; i < fast.count; ++i) EXPECT_LT(missing[i].level, 4);
+}
+
 // The levels a probe of footprint k level-0 texels (an isotropic query) reads, observed
 // through the tiles it reports lacking from a map holding only its 1 x 1 level.
 std::set<int> levelsRead(const MapFixture& f, ProbeFilter filter, float k) {
