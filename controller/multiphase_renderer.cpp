@@ -22,7 +22,8 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
       options_(options),
       resources_(scene, SceneResources::RayScenes::ForOcclusion),
       static_(scene, resources_, options.staticPhase),
-      dynamic_(scene) {
+      dynamic_(scene),
+      cache_(options.mapMemoryBytes) {
     options_.dynamic.trace = options.trace;
     const size_t n = scene.objects.size();
     representations_.resize(n);
@@ -508,59 +509,14 @@ void MultiphaseRenderer::recordResidency(FrameStats& stats) const {
 
 bool MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
     const auto start = Clock::now();
-    struct AddTime {
-        Clock::time_point start;
-        double& to;
-        ~AddTime() { to += secondsSince(start); }
-    } addTime{start, stats.controllerSeconds};
-    const std::vector<std::shared_ptr<TilePool>> pools = static_.tilePools().all();
-    size_t bytes = 0;
-    for (const auto& pool : pools) bytes += pool->bytesHeld();
-    if (bytes + incoming <= options_.mapMemoryBytes) return true;
-    // Down to 2% under the budget, so the next frames do not each evict a few tiles, yet
-    // no frame evicts a large batch at once: dropping a tenth of a 256 MB cache (6900
-    // tiles) had cost one frame 16 ms. Tiles this frame used are not candidates: they may
-    // be over the budget when the frame needs them all.
-    const size_t target = options_.mapMemoryBytes - options_.mapMemoryBytes / 50;
-    const size_t excess = bytes + incoming - std::min(bytes + incoming, target);
-    std::vector<TilePool::Held>& candidates = evictionScratch_;
-    candidates.clear();
-    for (const auto& pool : pools) pool->evictable(useStamp_, candidates);
-    // Least recently used first: only the oldest tiles that cover the excess are put in
-    // order (a frame at the budget evicts a few hundred of tens of thousands).
-    auto older = [](const TilePool::Held& a, const TilePool::Held& b) {
-        return a.lastUse < b.lastUse || (a.lastUse == b.lastUse && a.slot < b.slot);
-    };
-    size_t smallest = SIZE_MAX;
-    for (const auto& pool : pools) smallest = std::min(smallest, pool->tileBytes());
-    // At most this many tiles cover the excess (each holds at least `smallest` bytes).
-    const size_t count =
-        std::min(candidates.size(), (excess + smallest - 1) / std::max<size_t>(smallest, 1));
-    if (count < candidates.size())
-        std::nth_element(candidates.begin(), candidates.begin() + static_cast<ptrdiff_t>(count),
-                         candidates.end(), older);
-    std::sort(candidates.begin(), candidates.begin() + static_cast<ptrdiff_t>(count), older);
-    for (size_t i = 0; i < count && bytes + incoming > target; ++i) {
-        const TilePool::Held& h = candidates[i];
-        h.owner->evict(h.key);
-        bytes -= h.owner->tileBytes();
-        ++stats.tilesEvicted;
-    }
-    return bytes + incoming <= options_.mapMemoryBytes;
+    const bool fits = cache_.makeRoom(static_.tilePools(), incoming, useStamp_, stats.tilesEvicted);
+    stats.controllerSeconds += secondsSince(start);
+    return fits;
 }
 
 void MultiphaseRenderer::setFrameBudget(double seconds) {
     options_.frameBudgetSeconds = seconds;
-    // The eviction candidates' storage, touched now: grown on a frame's first eviction it
-    // had cost that frame 16 ms of page faults (69 000 candidates, the grazing floor).
-    size_t smallest = 0;
-    for (const auto& pool : static_.tilePools().all())
-        smallest = smallest ? std::min(smallest, pool->tileBytes()) : pool->tileBytes();
-    if (seconds > 0.0 && smallest > 0) {
-        evictionScratch_.resize(
-            std::max(evictionScratch_.size(), options_.mapMemoryBytes / smallest + 1));
-        evictionScratch_.clear();
-    }
+    if (seconds > 0.0) cache_.reserve(static_.tilePools());
 }
 
 Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,

@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "controller/tile_cache.h"
 #include "phases/dynamic_phase.h"
 #include "phases/reference_renderer.h"
 #include "phases/representation_choice.h"
@@ -168,8 +169,8 @@ class MultiphaseRenderer {
     // With a frame budget: fills this frame's lacking tiles (lacking_) until the budget,
     // counted from `start`, is spent.
     void fillWithinBudget(std::chrono::steady_clock::time_point start, FrameStats& stats);
-    // Drops the least recently used tiles until `incoming` more bytes of tiles fit the
-    // budget (or nothing the frame has not used is left); returns whether they fit.
+    // Makes room in the tile cache for `incoming` more bytes (tile_cache.h), its time
+    // counted as the controller's; returns whether they fit.
     bool keepMapsInBudget(size_t incoming, FrameStats& stats);
     // The tiles every map holds now, and their bytes (of them the always-resident levels').
     void recordResidency(FrameStats& stats) const;
@@ -200,6 +201,7 @@ class MultiphaseRenderer {
     SceneResources resources_;
     StaticPhase static_;
     DynamicPhase dynamic_;
+    TileCache cache_;
     std::shared_ptr<const SampleLayout> layout_;
     std::vector<std::shared_ptr<const SampleLayout>> layouts_;  // the last few made
     std::vector<std::unique_ptr<ObjectRepresentation>> representations_;
@@ -242,7 +244,6 @@ class MultiphaseRenderer {
     std::shared_ptr<const SampleLayout> predictLayout_;
     FrameState predictState_;
     std::vector<TileRequest> lacking_;
-    std::vector<TilePool::Held> evictionScratch_;  // keepMapsInBudget's candidates
     std::vector<const ObjectRepresentation*> drawn_;
     double lastDynamicSeconds_ = 0.0;
 };
