@@ -143,6 +143,9 @@ int main(int argc, char** argv) {
     playCmd->add_flag("--no-write", play.noWrite, "Measure without the disk: stats.json only");
     playCmd->add_flag("--no-prefetch", play.noPrefetch,
                       "Fill no tiles ahead of the frames that ask for them (for comparisons)");
+    playCmd->add_flag("--no-background-fills", play.noBackgroundFills,
+                      "Fill lacking tiles only in frames' slack, on no worker thread alongside "
+                      "them (for comparisons)");
     playCmd->add_flag("--quiet", play.quiet, "No progress or summary on stderr");
 
     try {

@@ -38,6 +38,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
     po.last = request.last;
     po.cacheBytes = static_cast<size_t>(options.cacheMb) << 20;
     po.prefetch = !options.noPrefetch;
+    po.backgroundFills = !options.noBackgroundFills;
     prepareOutputFolder(options.outDir);
     const std::filesystem::path dir(options.outDir);
     const bool tty = !options.quiet && isatty(STDERR_FILENO);
@@ -59,6 +60,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
             {"seed", options.seed},
             {"cache_mb", options.cacheMb},
             {"prefetch", !options.noPrefetch},
+            {"background_fills", !options.noBackgroundFills},
             {"preroll_seconds", prerollSeconds},
             {"frames_requested", po.last - po.first},
             {"frames_played", played},
@@ -106,6 +108,10 @@ int runPlayCommand(const PlayCommandOptions& options) {
               {"used", s.prefetchUsed},
               {"wasted", s.prefetchWasted},
               {"seconds", s.prefetchSeconds}}},
+            {"background",
+             {{"filled", s.backgroundTilesFilled},
+              {"evicted", s.backgroundTilesEvicted},
+              {"seconds", s.backgroundSeconds}}},
             {"shaded_points", s.shadedPoints}};
         addMultiphaseFrameJson(scene, s, entry);
         frames.push_back(std::move(entry));

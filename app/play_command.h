@@ -17,9 +17,10 @@ struct PlayCommandOptions {
     std::string size;    // "WxH"; empty = the scene's
     int spp = -1;        // -1 = the scene's; else 1..1024
     uint32_t seed = 0;
-    int64_t cacheMb = 256;    // shader-map tiles' memory budget, MB; >= 1
-    bool noWrite = false;     // measure without the disk: stats.json only
-    bool noPrefetch = false;  // no predicted or adjacent tiles filled ahead (comparisons)
+    int64_t cacheMb = 256;           // shader-map tiles' memory budget, MB; >= 1
+    bool noWrite = false;            // measure without the disk: stats.json only
+    bool noPrefetch = false;         // no predicted or adjacent tiles filled ahead (comparisons)
+    bool noBackgroundFills = false;  // no worker thread filling deferred tiles (comparisons)
     bool quiet = false;
 };
 

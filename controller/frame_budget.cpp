@@ -19,6 +19,11 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
                                       double seconds, int& built) {
     const auto start = Clock::now();
     built = 0;
+    pauseFiller();
+    struct Resume {
+        MultiphaseRenderer& r;
+        ~Resume() { r.resumeFiller(); }
+    } resume{*this};
     const size_t n = scene_.objects.size();
     const int last = std::min(scene_.frameCount() - 1, frame + frames);
     std::vector<uint8_t> planned(n, 0);
@@ -67,6 +72,7 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         return;
     }
     const int frame = stats.index;
+    pauseFiller();  // the cache's budget is this loop's alone
     // Coarser levels first: a tile there serves four times the surface of one a level
     // finer, and (built from its children where they are resident) costs no more.
     std::stable_sort(
@@ -117,6 +123,18 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         reports_[i].staticCosts.instructions += timing.objectInstructions[i];
     }
     recordResidency(stats);
+    if (options_.backgroundFills && next < lacking_.size()) {
+        if (!filler_)
+            filler_ =
+                std::make_unique<BackgroundFiller>(static_.tilePools(), options_.mapMemoryBytes);
+        std::vector<BackgroundJob> jobs;
+        const size_t end = std::min(lacking_.size(), next + options_.backgroundQueue);
+        jobs.reserve(end - next);
+        for (size_t k = next; k < end; ++k)
+            jobs.push_back({lacking_[k].object, drawn_[lacking_[k].object]->map, lacking_[k].key});
+        filler_->submit(std::move(jobs));
+    }
+    resumeFiller();
     lastLacking_.swap(lacking_);
     lacking_.clear();
 }

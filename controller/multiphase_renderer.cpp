@@ -55,7 +55,19 @@ float MultiphaseRenderer::inputsMoved(size_t object) {
     return staticInputChange(builtInputs_[object], inputScratch_, inputSpans_[object]);
 }
 
+void MultiphaseRenderer::pauseFiller() {
+    if (filler_) filler_->pause();
+}
+
+void MultiphaseRenderer::resumeFiller() {
+    if (filler_) filler_->resume(useStamp_);
+}
+
 void MultiphaseRenderer::discardStaticWork() {
+    if (filler_) {
+        filler_->pause();
+        filler_->submit({});
+    }
     for (auto& rep : representations_) rep.reset();
     kinds_.assign(kinds_.size(), Representation::Auto);
     longestEdge_.assign(longestEdge_.size(), 0.0f);
@@ -236,6 +248,19 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         frameStateAt(resources_, frame, options.width, options.height, options.samplesPerPixel);
     frameStaticSeconds_.assign(scene_.objects.size(), 0.0);
     frameDynamic_.assign(scene_.objects.size(), ObjectFrameCost{});
+    if (filler_) {
+        // Held while this frame's static work runs; no probe runs now either, so the
+        // storage of the tiles it dropped meanwhile is free again.
+        filler_->pause();
+        const BackgroundTotals t = filler_->totals();
+        stats.backgroundTilesFilled = t.tilesFilled - fillerTotals_.tilesFilled;
+        stats.backgroundTilesEvicted = t.tilesEvicted - fillerTotals_.tilesEvicted;
+        stats.backgroundSeconds = t.seconds - fillerTotals_.seconds;
+        fillerTotals_ = t;
+        for (const auto& pool : static_.tilePools().all()) pool->reclaim();
+        for (const auto& rep : representations_)
+            if (rep && rep->map) rep->map->reclaim();
+    }
     const CameraState& camera = frame_.camera;
     if (!layout_ ||
         !layout_->matches(frame_.width, frame_.height, frame_.spp, options.seed, options.filter)) {
@@ -416,6 +441,15 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     ++useStamp_;
     for (const auto& rep : representations_)
         if (rep && rep->map) rep->map->setUseStamp(useStamp_);
+    if (filler_) {
+        // Queued tiles of maps a static run has just replaced are of no use now.
+        if (stats.staticRuns > 0)
+            filler_->retain([&](const BackgroundJob& job) {
+                const ObjectRepresentation* rep = representations_[job.object].get();
+                return rep && rep->map == job.map;
+            });
+        filler_->resume(useStamp_);
+    }
     dynamic_.begin(frame_, drawn, layout_, dynamicOptions);
     if (progress) progress(2, 4);
     StaticCosts fills;

@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "controller/background_filler.h"
 #include "controller/tile_cache.h"
 #include "phases/dynamic_phase.h"
 #include "phases/reference_renderer.h"
@@ -82,6 +83,12 @@ struct MultiphaseOptions {
     // A prefetched tile no frame read within this many frames counts as wasted (it stays
     // resident, an ordinary tile for the cache).
     int prefetchPatienceFrames = 30;
+    // With a frame budget: the lacking tiles a frame had no time left to fill are queued
+    // for a worker thread that fills them at idle priority while the next frames render
+    // (background_filler.h); at most this many are queued (the newest frame's, coarser
+    // levels first). Off: they wait for a later frame's slack.
+    bool backgroundFills = false;
+    size_t backgroundQueue = 4096;
 };
 
 // Per object, for stats.json: what the static phase chose and did.
@@ -156,6 +163,8 @@ class MultiphaseRenderer {
     // level coarser than the shading points' footprint asks).
     void setFootprintScale(float scale) { options_.dynamic.footprintScale = scale; }
     const ObjectReport& report(size_t object) const { return reports_[object]; }
+    // Tiles queued for the background filler and not filled yet (0 without one).
+    size_t backgroundQueued() const { return filler_ ? filler_->queued() : 0; }
     size_t objectCount() const { return reports_.size(); }
     // Per object, what the last frame cost: its static work (building, filling tiles), in
     // seconds summed over threads; and its dynamic work (not drawn: all zero; a frame
@@ -246,6 +255,12 @@ class MultiphaseRenderer {
     std::vector<TileRequest> lacking_;
     std::vector<const ObjectRepresentation*> drawn_;
     double lastDynamicSeconds_ = 0.0;
+    // The background filler (made at the first frame that defers tiles), and its totals at
+    // the last frame. Last: destroyed (its worker joined) before anything it uses.
+    void pauseFiller();
+    void resumeFiller();
+    BackgroundTotals fillerTotals_;
+    std::unique_ptr<BackgroundFiller> filler_;
 };
 
 }  // namespace mpshade

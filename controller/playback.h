@@ -47,6 +47,9 @@ struct PlaybackOptions {
     double prerollPrefetchWallSeconds = 2.0;
     double predictSeconds = 0.1;
     int predictDivisor = 4;
+    // Tiles a frame lacked and had no time left to fill go to a worker thread at idle
+    // priority, which fills them while the next frames render (background_filler.h).
+    bool backgroundFills = true;
 };
 
 struct PlaybackSummary {

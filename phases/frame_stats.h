@@ -108,6 +108,11 @@ struct FrameStats {
     uint64_t tilesPredicted = 0, tilesAdjacent = 0, tilesPrefetched = 0;
     uint64_t prefetchUsed = 0, prefetchWasted = 0;
     double prefetchSeconds = 0.0;  // of staticSeconds: predicting and prefetching
+    // The background filler (MultiphaseOptions::backgroundFills), since the last frame:
+    // tiles it filled and dropped, and its worker's wall time (alongside the frames, not
+    // within wallSeconds).
+    uint64_t backgroundTilesFilled = 0, backgroundTilesEvicted = 0;
+    double backgroundSeconds = 0.0;
     // The controller's own work, within wallSeconds: re-run triggers and deferrals, cache
     // bookkeeping (eviction, prefetch accounting), the regulator.
     double controllerSeconds = 0.0;

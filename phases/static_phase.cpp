@@ -305,11 +305,11 @@ void StaticPhase::fill(std::span<const TileRequest> requests,
             work.push_back({rep->map.get(), &keys,
                             objects_[object]->staticKernel->instructionCount(), object});
     }
-    std::vector<FillStats> before(work.size());
-    for (size_t w = 0; w < work.size(); ++w) before[w] = work[w].map->fillStats();
+    // What each fill did, as it reports it: another thread may be filling the same map.
+    std::vector<FillStats> done(work.size());
     tbb::parallel_for(size_t{0}, work.size(), [&](size_t w) {
         const auto began = Clock::now();
-        work[w].map->fill(*work[w].keys);
+        done[w] = work[w].map->fill(*work[w].keys);
         const auto ended = Clock::now();
         work[w].seconds = std::chrono::duration<double>(ended - began).count();
         if (timing && timing->trace)
@@ -319,15 +319,14 @@ void StaticPhase::fill(std::span<const TileRequest> requests,
     if (timing)
         for (const Work& w : work) timing->objectSeconds[w.object] += w.seconds;
     for (size_t w = 0; w < work.size(); ++w) {
-        const FillStats& after = work[w].map->fillStats();
-        const uint64_t instructions =
-            (after.programRuns - before[w].programRuns) * work[w].instructionsPerRun;
+        const FillStats& d = done[w];
+        const uint64_t instructions = d.programRuns * work[w].instructionsPerRun;
         costs.instructions += instructions;
         if (timing) timing->objectInstructions[work[w].object] += instructions;
-        costs.tilesFilled += after.tiles - before[w].tiles;
-        costs.tilesFromChildren += after.tilesFromChildren - before[w].tilesFromChildren;
-        costs.texelsFilled += after.texels - before[w].texels;
-        costs.programRuns += after.programRuns - before[w].programRuns;
+        costs.tilesFilled += d.tiles;
+        costs.tilesFromChildren += d.tilesFromChildren;
+        costs.texelsFilled += d.texels;
+        costs.programRuns += d.programRuns;
     }
     costs.seconds += std::chrono::duration<double>(Clock::now() - start).count();
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <unordered_map>
 #include <unordered_set>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -76,7 +77,7 @@ size_t ShaderMap::tileBytes() const {
 }
 
 size_t ShaderMap::bytes() const {
-    return residentTiles_ * tileBytes() + table_.bytes();
+    return residentTiles() * tileBytes() + table_.bytes();
 }
 
 void ShaderMap::texel(const TileKey& key, int slot, int i, int j, float* out) const {
@@ -99,7 +100,8 @@ void ShaderMap::store(int slot, size_t at, float value) {
         reinterpret_cast<float*>(tileData(slot))[at] = value;
 }
 
-void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, ShadingBatch& scratch,
+void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
+                         const PendingTiles& pending, ShadingBatch& scratch,
                          std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
                          std::vector<float>& workspace, FillStats& stats) {
     const int res = resolution(key.level);
@@ -122,7 +124,7 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
                j >= key.ty * T && j < (key.ty + 1) * T && j < res;
     };
     // Border texels a resident neighbour holds are copied after the batch (copyBorders).
-    const Neighbours around = neighboursOf(key);
+    const Neighbours around = neighboursOf(key, &pending);
     auto skipped = [&](int i, int j) {
         return interior(i, j) || neighbourSlot(around, key, i, j) >= 0;
     };
@@ -205,18 +207,23 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren, Shadin
     stats.programRuns += n;
 }
 
-ShaderMap::Neighbours ShaderMap::neighboursOf(const TileKey& key) const {
+ShaderMap::Neighbours ShaderMap::neighboursOf(const TileKey& key,
+                                              const PendingTiles* pending) const {
     Neighbours around;
     const int n = tilesPerSide(key.level);
     for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
             const int tx = key.tx + dx, ty = key.ty + dy;
             const bool other = (dx || dy) && tx >= 0 && ty >= 0 && tx < n && ty < n;
-            around.slot[dy + 1][dx + 1] =
-                other ? table_.find(TileKey{key.chart, key.level, static_cast<uint16_t>(tx),
-                                            static_cast<uint16_t>(ty)}
-                                        .packed())
-                      : -1;
+            const uint64_t packed =
+                TileKey{key.chart, key.level, static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)}
+                    .packed();
+            int slot = other ? table_.find(packed) : -1;
+            if (other && slot < 0 && pending) {
+                const auto it = pending->find(packed);
+                if (it != pending->end()) slot = it->second;
+            }
+            around.slot[dy + 1][dx + 1] = slot;
         }
     return around;
 }
@@ -227,10 +234,11 @@ int ShaderMap::neighbourSlot(const Neighbours& around, const TileKey& key, int i
     return around.slot[(j >> tileShift_) - key.ty + 1][(i >> tileShift_) - key.tx + 1];
 }
 
-void ShaderMap::copyBorders(const TileKey& key, int slot, FillStats& stats) {
+void ShaderMap::copyBorders(const TileKey& key, int slot, const PendingTiles& pending,
+                            FillStats& stats) {
     const int T = options_.tileSize, border = options_.border;
     const int res = resolution(key.level);
-    const Neighbours around = neighboursOf(key);
+    const Neighbours around = neighboursOf(key, &pending);
     // Both tiles store the same type: the texel's channels are copied as they are.
     const size_t texelBytes = tileBytes() / (static_cast<size_t>(stride_) * stride_);
     auto at = [&](int s, int li, int lj) {
@@ -253,7 +261,7 @@ void ShaderMap::copyBorders(const TileKey& key, int slot, FillStats& stats) {
         }
 }
 
-void ShaderMap::fill(std::span<const TileKey> keys) {
+FillStats ShaderMap::fill(std::span<const TileKey> keys) {
     std::lock_guard<std::mutex> lock(fillMutex_);
     std::vector<TileKey> work;
     std::unordered_set<uint64_t> seen;
@@ -263,7 +271,7 @@ void ShaderMap::fill(std::span<const TileKey> keys) {
         if (table_.find(key.packed()) >= 0 || !seen.insert(key.packed()).second) continue;
         work.push_back(key);
     }
-    if (work.empty()) return;
+    if (work.empty()) return {};
     std::stable_sort(work.begin(), work.end(),
                      [](const TileKey& a, const TileKey& b) { return a.level < b.level; });
     tbb::enumerable_thread_specific<FillScratch> scratch;
@@ -287,40 +295,67 @@ void ShaderMap::fill(std::span<const TileKey> keys) {
                                    static_cast<uint16_t>(ctx), static_cast<uint16_t>(cty)}) >= 0;
             }
             const bool pinned = key.level >= levels_ - options_.alwaysResidentLevels;
-            const int slot = pool_->allocate(this, key.packed(), pinned, useStamp_);
-            ++residentTiles_;
+            const int slot = pool_->allocate(this, key.packed(), pinned, useStamp());
             plan[w - begin] = {slot, children};
         }
-        for (size_t w = begin; w < end; ++w) table_.insert(work[w].packed(), plan[w - begin].first);
+        // The level's tiles are published once whole (probes may be reading the map); till
+        // then their borders find one another here.
+        PendingTiles pending;
+        for (size_t w = begin; w < end; ++w)
+            pending.emplace(work[w].packed(), plan[w - begin].first);
         tbb::parallel_for(begin, end, [&](size_t w) {
             enableFlushToZero();
             FillScratch& s = scratch.local();
-            fillTile(work[w], plan[w - begin].first, plan[w - begin].second, s.batch, s.points,
-                     s.geometry, s.workspace, s.stats);
+            fillTile(work[w], plan[w - begin].first, plan[w - begin].second, pending, s.batch,
+                     s.points, s.geometry, s.workspace, s.stats);
         });
         // A texel is the same wherever it is evaluated (the program sees only its chart
         // point), so borders inside the chart come from the neighbouring tile when that is
         // resident: a 16 x 16 tile with a 1-texel border evaluates 256 texels, not 324.
         tbb::parallel_for(begin, end, [&](size_t w) {
-            copyBorders(work[w], plan[w - begin].first, scratch.local().stats);
+            copyBorders(work[w], plan[w - begin].first, pending, scratch.local().stats);
         });
+        for (size_t w = begin; w < end; ++w) table_.insert(work[w].packed(), plan[w - begin].first);
+        residentTiles_.fetch_add(end - begin, std::memory_order_relaxed);
         begin = end;
     }
+    FillStats done;
     for (const FillScratch& s : scratch) {
-        fillStats_.tiles += s.stats.tiles;
-        fillStats_.tilesFromChildren += s.stats.tilesFromChildren;
-        fillStats_.texels += s.stats.texels;
-        fillStats_.programRuns += s.stats.programRuns;
-        fillStats_.texelsCopied += s.stats.texelsCopied;
+        done.tiles += s.stats.tiles;
+        done.tilesFromChildren += s.stats.tilesFromChildren;
+        done.texels += s.stats.texels;
+        done.programRuns += s.stats.programRuns;
+        done.texelsCopied += s.stats.texelsCopied;
     }
+    fillStats_.tiles += done.tiles;
+    fillStats_.tilesFromChildren += done.tilesFromChildren;
+    fillStats_.texels += done.texels;
+    fillStats_.programRuns += done.programRuns;
+    fillStats_.texelsCopied += done.texelsCopied;
+    return done;
 }
 
 void ShaderMap::evict(uint64_t key) {
+    std::lock_guard<std::mutex> lock(fillMutex_);
     const int slot = table_.find(key);
-    MPSHADE_CHECK(slot >= 0);
+    if (slot < 0) return;  // retired meanwhile by a background filler
     table_.erase(key);
     pool_->free(slot);
-    --residentTiles_;
+    residentTiles_.fetch_sub(1, std::memory_order_relaxed);
+}
+
+void ShaderMap::retire(uint64_t key) {
+    std::lock_guard<std::mutex> lock(fillMutex_);
+    const int slot = table_.find(key);
+    if (slot < 0) return;  // dropped already (the owner's view of the pool may be stale)
+    table_.erase(key);
+    pool_->retire(slot);
+    residentTiles_.fetch_sub(1, std::memory_order_relaxed);
+}
+
+void ShaderMap::reclaim() {
+    std::lock_guard<std::mutex> lock(fillMutex_);
+    table_.reclaim();
 }
 
 void ShaderMap::fillLevels(int first, int last) {

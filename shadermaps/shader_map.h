@@ -37,10 +37,12 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 #include "geometry/chart_adjacency.h"
@@ -118,22 +120,30 @@ class ShaderMap {
 
     bool resident(const TileKey& key) const { return slotOf(key) >= 0; }
     // Fills the tiles that are not resident yet: batched, in parallel, finest level first
-    // so coarser tiles can be built from their children.
-    void fill(std::span<const TileKey> keys);
+    // so coarser tiles can be built from their children. Returns what this call did.
+    // Probes may run alongside (on other threads): a tile appears to them once it is whole,
+    // a level at a time. One fill (or evict) of a map runs at a time; others wait.
+    FillStats fill(std::span<const TileKey> keys);
     // Fills every tile of the levels in [first, last] (inclusive) of every chart.
     void fillLevels(int first, int last);
     const FillStats& fillStats() const { return fillStats_; }
-    size_t residentTiles() const { return residentTiles_; }
+    size_t residentTiles() const { return residentTiles_.load(std::memory_order_relaxed); }
     size_t bytes() const;      // its tiles' storage and its table
     size_t tileBytes() const;  // storage of one tile
     const std::shared_ptr<TilePool>& pool() const { return pool_; }
 
     // Recency, for a cache that keeps the maps under a memory budget (tile_pool.h): probes
     // mark the tiles they read with the current use stamp; evict() drops a tile (the pool
-    // says which are unused longest). Neither evict() nor fill() may run during probes.
-    void setUseStamp(uint32_t stamp) { useStamp_ = stamp; }
-    void markUsed(int slot) const { pool_->markUsed(slot, useStamp_); }
+    // says which are unused longest), and must not run while probes may read the map;
+    // retire() drops it while they may: its storage is reused only after the pool's
+    // reclaim(). reclaim() frees the map's own superseded lookup storage; like the pool's,
+    // only when no probe of the map can be running.
+    void setUseStamp(uint32_t stamp) { useStamp_.store(stamp, std::memory_order_relaxed); }
+    uint32_t useStamp() const { return useStamp_.load(std::memory_order_relaxed); }
+    void markUsed(int slot) const { pool_->markUsed(slot, useStamp()); }
     void evict(uint64_t key);
+    void retire(uint64_t key);
+    void reclaim();
 
     // The tile holding texel (i, j) of a level (clamped to the level).
     TileKey tileOf(uint32_t chart, int level, int i, int j) const {
@@ -168,11 +178,14 @@ class ShaderMap {
     }
 
   private:
+    // A fill's tiles not yet published, by packed key.
+    using PendingTiles = std::unordered_map<uint64_t, int>;
     const unsigned char* tileData(int slot) const { return pool_->data(slot); }
     unsigned char* tileData(int slot) { return pool_->data(slot); }
-    void fillTile(const TileKey& key, int slot, bool fromChildren, ShadingBatch& scratch,
-                  std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
-                  std::vector<float>& workspace, FillStats& stats);
+    void fillTile(const TileKey& key, int slot, bool fromChildren, const PendingTiles& pending,
+                  ShadingBatch& scratch, std::vector<ChartPoint>& points,
+                  std::vector<SurfaceSample>& geometry, std::vector<float>& workspace,
+                  FillStats& stats);
     void store(int slot, size_t at, float value);
     // The slots of the eight tiles around `key` in its chart and level (-1: not resident,
     // or beyond the level), found once per tile; a border (at most a tile wide) lies in
@@ -180,11 +193,11 @@ class ShaderMap {
     struct Neighbours {
         int slot[3][3];
     };
-    Neighbours neighboursOf(const TileKey& key) const;
+    Neighbours neighboursOf(const TileKey& key, const PendingTiles* pending = nullptr) const;
     // The slot of the resident neighbour holding texel (i, j) of key's border, or -1 when
     // it must be evaluated (no such tile resident, or beyond the chart's edge).
     int neighbourSlot(const Neighbours& around, const TileKey& key, int i, int j) const;
-    void copyBorders(const TileKey& key, int slot, FillStats& stats);
+    void copyBorders(const TileKey& key, int slot, const PendingTiles& pending, FillStats& stats);
 
     const Surface& surface_;
     std::unique_ptr<ChartAdjacency> adjacency_;
@@ -200,8 +213,8 @@ class ShaderMap {
     std::vector<int> tilesPerSide_;
     TileTable table_;
     std::shared_ptr<TilePool> pool_;  // tile storage
-    size_t residentTiles_ = 0;
-    uint32_t useStamp_ = 0;
+    std::atomic<size_t> residentTiles_{0};
+    std::atomic<uint32_t> useStamp_{0};
     FillStats fillStats_;
     std::mutex fillMutex_;
 };

@@ -6,7 +6,7 @@ namespace mpshade {
 
 TilePool::TilePool(size_t tileBytes)
     : tileBytes_(tileBytes),
-      blocks_(std::make_unique<std::unique_ptr<unsigned char[]>[]>(kMaxTiles / kTilesPerBlock)) {}
+      blocks_(std::make_unique<std::unique_ptr<Block>[]>(kMaxTiles / kTilesPerBlock)) {}
 
 int TilePool::allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t stamp) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -17,21 +17,27 @@ int TilePool::allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t sta
     } else {
         slot = static_cast<int>(owner_.size());
         MPSHADE_CHECK(owner_.size() < kMaxTiles);
-        if (owner_.size() == blockCount_ * kTilesPerBlock)
-            blocks_[blockCount_++] =
+        const size_t blocks = blockCount_.load(std::memory_order_relaxed);
+        if (owner_.size() == blocks * kTilesPerBlock) {
+            auto block = std::make_unique<Block>();
+            block->data =
                 std::make_unique<unsigned char[]>(kTilesPerBlock * tileBytes_ + kSlackBytes);
+            for (std::atomic<uint32_t>& use : block->lastUse)
+                use.store(0, std::memory_order_relaxed);
+            blocks_[blocks] = std::move(block);
+            blockCount_.store(blocks + 1, std::memory_order_relaxed);
+        }
         owner_.push_back(nullptr);
         key_.push_back(0);
         pinned_.push_back(0);
-        lastUse_.push_back(0);
     }
     const size_t s = static_cast<size_t>(slot);
     owner_[s] = owner;
     key_[s] = key;
     pinned_[s] = pinned ? 1 : 0;
-    lastUse_[s] = stamp;
-    ++held_;
-    pinnedHeld_ += pinned ? 1 : 0;
+    useOf(slot).store(stamp, std::memory_order_relaxed);
+    held_.fetch_add(1, std::memory_order_relaxed);
+    if (pinned) pinnedHeld_.fetch_add(1, std::memory_order_relaxed);
     return slot;
 }
 
@@ -41,14 +47,35 @@ void TilePool::free(int slot) {
     MPSHADE_CHECK(s < owner_.size() && owner_[s] != nullptr);
     owner_[s] = nullptr;
     free_.push_back(slot);
-    --held_;
-    pinnedHeld_ -= pinned_[s];
+    held_.fetch_sub(1, std::memory_order_relaxed);
+    if (pinned_[s]) pinnedHeld_.fetch_sub(1, std::memory_order_relaxed);
+}
+
+void TilePool::retire(int slot) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const size_t s = static_cast<size_t>(slot);
+    MPSHADE_CHECK(s < owner_.size() && owner_[s] != nullptr);
+    owner_[s] = nullptr;
+    retired_.push_back(slot);
+}
+
+void TilePool::reclaim() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (int slot : retired_) {
+        free_.push_back(slot);
+        held_.fetch_sub(1, std::memory_order_relaxed);
+        if (pinned_[static_cast<size_t>(slot)]) pinnedHeld_.fetch_sub(1, std::memory_order_relaxed);
+    }
+    retired_.clear();
 }
 
 void TilePool::evictable(uint32_t before, std::vector<Held>& out) const {
-    for (size_t s = 0; s < owner_.size(); ++s)
-        if (owner_[s] && !pinned_[s] && lastUse_[s] < before)
-            out.push_back({lastUse_[s], static_cast<int>(s), owner_[s], key_[s]});
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (size_t s = 0; s < owner_.size(); ++s) {
+        if (!owner_[s] || pinned_[s]) continue;
+        const uint32_t use = lastUse(static_cast<int>(s));
+        if (use < before) out.push_back({use, static_cast<int>(s), owner_[s], key_[s]});
+    }
 }
 
 std::shared_ptr<TilePool> TilePools::forTileBytes(size_t tileBytes) {

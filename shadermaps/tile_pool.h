@@ -9,12 +9,15 @@
 // Each block ends in kSlackBytes of zeros, so probes may load a texel's channels in whole
 // vectors (8 floats for 5 channels) even at a block's last texel.
 //
-// Threads: allocate() and free() may run on several threads at once (maps filled in
-// parallel share a pool); data() of a slot may run alongside them (blocks never move);
-// markUsed() may run on many threads at once (it writes atomically) but not alongside
-// allocate(); evictable() runs alone.
+// Threads: allocate(), free(), retire() and evictable() may run on several threads at once
+// (maps filled in parallel share a pool; a background filler evicts while a frame fills);
+// data() and markUsed() of a slot may run alongside all of them (blocks never move, and
+// each block keeps its slots' recency). A slot retired while probes may still read it
+// (its tile was just evicted) keeps its storage until reclaim(), which runs when no probe
+// can be reading: then it is free for reuse.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -34,30 +37,38 @@ class TilePool {
     TilePool& operator=(const TilePool&) = delete;
 
     size_t tileBytes() const { return tileBytes_; }
-    size_t tilesHeld() const { return held_; }
-    size_t bytesHeld() const { return held_ * tileBytes_; }
+    // Tiles held, retired ones included (their storage is not free yet).
+    size_t tilesHeld() const { return held_.load(std::memory_order_relaxed); }
+    size_t bytesHeld() const { return tilesHeld() * tileBytes_; }
     // Of them, the always-resident levels' (never dropped).
-    size_t pinnedBytesHeld() const { return pinnedHeld_ * tileBytes_; }
-    size_t bytesAllocated() const { return blockCount_ * kTilesPerBlock * tileBytes_; }
+    size_t pinnedBytesHeld() const {
+        return pinnedHeld_.load(std::memory_order_relaxed) * tileBytes_;
+    }
+    size_t bytesAllocated() const {
+        return blockCount_.load(std::memory_order_relaxed) * kTilesPerBlock * tileBytes_;
+    }
 
     int allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t stamp);
+    // Frees a slot no probe can be reading.
     void free(int slot);
+    // Frees a slot probes may still be reading: its storage is reused only after reclaim().
+    void retire(int slot);
+    // Frees the retired slots. Only when no probe can be reading them.
+    void reclaim();
 
     unsigned char* data(int slot) {
-        return blocks_[static_cast<size_t>(slot) >> kBlockShift].get() +
+        return blocks_[static_cast<size_t>(slot) >> kBlockShift]->data.get() +
                static_cast<size_t>(slot & (kTilesPerBlock - 1)) * tileBytes_;
     }
     const unsigned char* data(int slot) const {
-        return blocks_[static_cast<size_t>(slot) >> kBlockShift].get() +
+        return blocks_[static_cast<size_t>(slot) >> kBlockShift]->data.get() +
                static_cast<size_t>(slot & (kTilesPerBlock - 1)) * tileBytes_;
     }
     static constexpr size_t kMaxTiles = size_t{1} << 22;  // per pool
     void markUsed(int slot, uint32_t stamp) const {
-        __atomic_store_n(&lastUse_[static_cast<size_t>(slot)], stamp, __ATOMIC_RELAXED);
+        useOf(slot).store(stamp, std::memory_order_relaxed);
     }
-    uint32_t lastUse(int slot) const {
-        return __atomic_load_n(&lastUse_[static_cast<size_t>(slot)], __ATOMIC_RELAXED);
-    }
+    uint32_t lastUse(int slot) const { return useOf(slot).load(std::memory_order_relaxed); }
 
     struct Held {
         uint32_t lastUse;
@@ -65,26 +76,33 @@ class TilePool {
         ShaderMap* owner;
         uint64_t key;
     };
-    // Appends the tiles held that may be dropped: not always-resident, last used before
-    // `before`.
+    // Appends the tiles held that may be dropped: not always-resident, not retired, last
+    // used before `before`.
     void evictable(uint32_t before, std::vector<Held>& out) const;
 
   private:
     static constexpr int kBlockShift = 6;
     static constexpr int kTilesPerBlock = 1 << kBlockShift;
+    struct Block {
+        std::unique_ptr<unsigned char[]> data;
+        std::atomic<uint32_t> lastUse[kTilesPerBlock];
+    };
+    std::atomic<uint32_t>& useOf(int slot) const {
+        return blocks_[static_cast<size_t>(slot) >> kBlockShift]
+            ->lastUse[slot & (kTilesPerBlock - 1)];
+    }
 
     size_t tileBytes_;
-    size_t held_ = 0, pinnedHeld_ = 0;
-    std::mutex mutex_;
+    std::atomic<size_t> held_{0}, pinnedHeld_{0};
+    mutable std::mutex mutex_;
     // Block pointers in an array that never grows: data() reads it while other threads
     // allocate.
-    std::unique_ptr<std::unique_ptr<unsigned char[]>[]> blocks_;
-    size_t blockCount_ = 0;
-    std::vector<int> free_;
-    std::vector<ShaderMap*> owner_;  // per slot; null: free
+    std::unique_ptr<std::unique_ptr<Block>[]> blocks_;
+    std::atomic<size_t> blockCount_{0};
+    std::vector<int> free_, retired_;
+    std::vector<ShaderMap*> owner_;  // per slot; null: free or retired
     std::vector<uint64_t> key_;
     std::vector<uint8_t> pinned_;
-    mutable std::vector<uint32_t> lastUse_;
 };
 
 // The pools of a renderer, one per tile size, created on first use. Thread safe.

@@ -4,50 +4,65 @@
 
 namespace mpshade {
 
-void TileTable::grow() {
-    std::vector<uint64_t> keys = std::move(keys_);
-    std::vector<int32_t> slots = std::move(slots_);
-    const size_t capacity = keys.empty() ? 64 : keys.size() * 2;
-    keys_.assign(capacity, kEmpty);
-    slots_.assign(capacity, -1);
-    mask_ = capacity - 1;
-    shift_ = 64;
-    for (size_t c = capacity; c > 1; c >>= 1) --shift_;
-    size_ = 0;
-    for (size_t i = 0; i < keys.size(); ++i)
-        if (keys[i] != kEmpty) insert(keys[i], slots[i]);
+TileTable::Buckets::Buckets(size_t capacity)
+    : mask(capacity - 1),
+      keys(std::make_unique<std::atomic<uint64_t>[]>(capacity)),
+      slots(std::make_unique<std::atomic<int32_t>[]>(capacity)) {
+    for (size_t c = capacity; c > 1; c >>= 1) --shift;
+    for (size_t i = 0; i < capacity; ++i) {
+        keys[i].store(kEmpty, std::memory_order_relaxed);
+        slots[i].store(-1, std::memory_order_relaxed);
+    }
+}
+
+void TileTable::rebuild(size_t capacity) {
+    auto next = std::make_unique<Buckets>(capacity);
+    forEach([&](uint64_t key, int32_t slot) {
+        size_t i = next->home(key);
+        while (next->keys[i].load(std::memory_order_relaxed) != kEmpty) i = (i + 1) & next->mask;
+        next->slots[i].store(slot, std::memory_order_relaxed);
+        next->keys[i].store(key, std::memory_order_relaxed);
+    });
+    used_ = size_;
+    current_.store(next.get(), std::memory_order_release);
+    if (owned_) retired_.push_back(std::move(owned_));
+    owned_ = std::move(next);
 }
 
 void TileTable::insert(uint64_t key, int32_t slot) {
-    if (2 * (size_ + 1) > keys_.size()) grow();
-    size_t i = hash(key);
-    while (keys_[i] != kEmpty) i = (i + 1) & mask_;
-    keys_[i] = key;
-    slots_[i] = slot;
+    const size_t capacity = owned_ ? owned_->mask + 1 : 0;
+    if (2 * (used_ + 1) > capacity) {
+        // Twice the live keys' room; tombstones alone are purged at the same size.
+        size_t next = 64;
+        while (next < 4 * (size_ + 1)) next *= 2;
+        rebuild(std::max(next, capacity));
+    }
+    Buckets& b = *owned_;
+    size_t i = b.home(key);
+    while (b.keys[i].load(std::memory_order_relaxed) != kEmpty) i = (i + 1) & b.mask;
+    b.slots[i].store(slot, std::memory_order_relaxed);
+    b.keys[i].store(key, std::memory_order_release);
     ++size_;
+    ++used_;
 }
 
 void TileTable::erase(uint64_t key) {
-    if (keys_.empty()) return;
-    size_t i = hash(key);
-    while (keys_[i] != key) {
-        if (keys_[i] == kEmpty) return;
-        i = (i + 1) & mask_;
-    }
-    // Backward-shift deletion keeps every probe sequence unbroken without tombstones.
-    for (size_t j = (i + 1) & mask_; keys_[j] != kEmpty; j = (j + 1) & mask_) {
-        const size_t home = hash(keys_[j]);
-        // Move j into the hole at i if its home is not cyclically in (i, j].
-        const bool between = i <= j ? (i < home && home <= j) : (i < home || home <= j);
-        if (!between) {
-            keys_[i] = keys_[j];
-            slots_[i] = slots_[j];
-            i = j;
+    if (!owned_) return;
+    Buckets& b = *owned_;
+    for (size_t i = b.home(key);; i = (i + 1) & b.mask) {
+        const uint64_t k = b.keys[i].load(std::memory_order_relaxed);
+        if (k == kEmpty) return;
+        if (k == key) {
+            b.keys[i].store(kErased, std::memory_order_release);
+            --size_;
+            return;
         }
     }
-    keys_[i] = kEmpty;
-    slots_[i] = -1;
-    --size_;
+}
+
+size_t TileTable::bytes() const {
+    const size_t capacity = owned_ ? owned_->mask + 1 : 0;
+    return capacity * (sizeof(uint64_t) + sizeof(int32_t));
 }
 
 }  // namespace mpshade
