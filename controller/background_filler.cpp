@@ -11,8 +11,8 @@ namespace mpshade {
 namespace {
 
 // Tiles taken at once: pause() waits for at most this many (the dearest tiles seen cost
-// about 1 ms each).
-constexpr size_t kBatch = 2;
+// about 1 ms each; two a batch had held a frame up to 5 ms).
+constexpr size_t kBatch = 1;
 
 void lowerPriority() {
     sched_param param{};

@@ -1,16 +1,19 @@
-// background_filler.h -- fills shader-map tiles on a worker thread while frames render:
-// the tiles a locked-rate frame lacked and had no time left to fill are queued here, and
-// the worker fills them while later frames probe the same maps (each tile appears to
-// probes once whole; until then they read the finest coarser level resident). Patent col.
-// 10-11: the controller schedules static work apart from the frames that need it.
+// background_filler.h -- fills shader-map tiles on a worker thread beside the frames: the
+// tiles a locked-rate frame lacked and had no time left to fill are queued here, and the
+// worker fills them while the controller does other things -- the frame's image being
+// written, a prediction's probes of the same maps (controller/tile_prefetch.cpp), the next
+// frame's dynamic phase if the controller lets it (MultiphaseOptions::
+// backgroundDuringFrames). Each tile appears to probes once whole; until then they read the
+// finest coarser level resident. Patent col. 10-11: the controller schedules static work
+// apart from the frames that need it.
 //
-// The worker runs at idle priority (SCHED_IDLE, else nice 19) on one thread: it takes the
-// cores only when a frame leaves them idle (a frame's serial stretches, the writing of its
-// image), so the frame's own work is not slowed. It keeps the tiles under the cache's
+// The worker runs at idle priority (SCHED_IDLE, else nice 19) on one thread, so it takes a
+// core only when the frame's own work leaves one idle. It keeps the tiles under the cache's
 // budget: when a tile would not fit it drops tiles no probe used in the last two frames,
-// oldest first, while probes run -- through ShaderMap::retire, so a probe that found such a
-// tile a moment before still reads whole storage (its slot is reused only after the
-// pools' reclaim, which the controller runs between frames, with the worker paused).
+// oldest first, while probes may run -- through ShaderMap::retire, so a probe that found
+// such a tile a moment before still reads whole storage (its slot is reused only after the
+// pools' reclaim, which the controller runs between frames, with the worker paused) -- and
+// then waits for that reclaim.
 //
 // Threads: every method is called from one controlling thread. Between pause() and
 // resume() the worker touches nothing: the controller may then rebuild or destroy maps,

@@ -448,7 +448,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
                 const ObjectRepresentation* rep = representations_[job.object].get();
                 return rep && rep->map == job.map;
             });
-        filler_->resume(useStamp_);
+        if (options_.backgroundDuringFrames) filler_->resume(useStamp_);
     }
     dynamic_.begin(frame_, drawn, layout_, dynamicOptions);
     if (progress) progress(2, 4);

@@ -84,11 +84,14 @@ struct MultiphaseOptions {
     // resident, an ordinary tile for the cache).
     int prefetchPatienceFrames = 30;
     // With a frame budget: the lacking tiles a frame had no time left to fill are queued
-    // for a worker thread that fills them at idle priority while the next frames render
-    // (background_filler.h); at most this many are queued (the newest frame's, coarser
-    // levels first). Off: they wait for a later frame's slack.
+    // for a worker thread that fills them at idle priority (background_filler.h), from the
+    // end of the frame's fills until the next frame starts -- and, with
+    // backgroundDuringFrames, alongside its dynamic phase too. At most backgroundQueue are
+    // queued (the newest frame's, coarser levels first). Off: they wait for a later
+    // frame's slack.
     bool backgroundFills = false;
     size_t backgroundQueue = 4096;
+    bool backgroundDuringFrames = false;
 };
 
 // Per object, for stats.json: what the static phase chose and did.

@@ -18,6 +18,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
     mo.singlePhaseFrames = false;  // the reference renderer cannot keep a frame rate
     mo.mapMemoryBytes = options.cacheBytes;
     mo.backgroundFills = options.backgroundFills;
+    mo.backgroundDuringFrames = options.backgroundDuringFrames;
     mo.trace = options.trace;
     MultiphaseRenderer renderer(scene, mo);
     renderer.plan(options.first, options.last, options.render);

@@ -48,8 +48,12 @@ struct PlaybackOptions {
     double predictSeconds = 0.1;
     int predictDivisor = 4;
     // Tiles a frame lacked and had no time left to fill go to a worker thread at idle
-    // priority, which fills them while the next frames render (background_filler.h).
+    // priority, which fills them outside the frames' dynamic phase: while the frame's image
+    // is written, a prediction's probes run, and between frames (background_filler.h).
+    // backgroundDuringFrames: also alongside the dynamic phase. Measured at 640x360 on 2
+    // cores (docs/playback.md), that cost a frame's deadline in about one run of two.
     bool backgroundFills = true;
+    bool backgroundDuringFrames = false;
 };
 
 struct PlaybackSummary {
