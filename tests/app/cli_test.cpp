@@ -566,6 +566,10 @@ TEST(Cli, PlayReportsEveryFramesDeadlineAndWritesFramesUnlessAsked) {
         EXPECT_LE(p["filled"].get<uint64_t>(),
                   p["predicted"].get<uint64_t>() + p["adjacent"].get<uint64_t>());
         EXPECT_GE(p["seconds"].get<double>(), 0.0);
+        // The background filler's work since the last frame: what it filled was deferred.
+        const nlohmann::json& b = f["background"];
+        EXPECT_TRUE(b["filled"].is_number() && b["evicted"].is_number());
+        EXPECT_GE(b["seconds"].get<double>(), 0.0);
         EXPECT_GT(f["controller_seconds"].get<double>(), 0.0);
         EXPECT_LT(f["controller_seconds"].get<double>(), f["wall_seconds"].get<double>());
         EXPECT_EQ(f["probe_hits"].get<uint64_t>() + f["quality"]["probe_fallbacks"].get<uint64_t>(),
@@ -573,18 +577,23 @@ TEST(Cli, PlayReportsEveryFramesDeadlineAndWritesFramesUnlessAsked) {
         EXPECT_LE(f["resident_bytes"].get<double>(), 8.0 * 1024 * 1024);
     }
     EXPECT_EQ(stats["deadlines_met"], met);
+    EXPECT_EQ(stats["background_fills"], true);
     for (int k = 0; k < 3; ++k)
         EXPECT_TRUE(std::filesystem::exists(out + fmt::format("/frame_{:04d}.exr", k)));
 
     const std::string quiet = tempDir("play_no_write");
     const CliRun noWrite = mpshade(
         "play examples/teapot/scene.json --frames 0:2 --size 96x54 "
-        "--no-write --quiet --out " +
+        "--no-write --no-background-fills --quiet --out " +
         quiet);
     ASSERT_EQ(noWrite.exitCode, 0) << noWrite.output;
     EXPECT_EQ(noWrite.output, "");
     EXPECT_TRUE(std::filesystem::exists(quiet + "/stats.json"));
     EXPECT_FALSE(std::filesystem::exists(quiet + "/frame_0000.exr"));
+    std::ifstream quietStats(quiet + "/stats.json");
+    const nlohmann::json q = nlohmann::json::parse(quietStats);
+    EXPECT_EQ(q["background_fills"], false);
+    for (const nlohmann::json& f : q["frames"]) EXPECT_EQ(f["background"]["filled"], 0);
 
     for (const char* bad : {"--fps 0", "--fps -3", "--cache-mb 0", "--spp 0"}) {
         const CliRun r =
