@@ -267,6 +267,41 @@ TEST(Playback, AnObjectEnteringTheViewHasItsTilesBeforeItsFrames) {
 namespace mpshade {
 namespace {
 
+TEST(Playback, TheBackgroundFillerEvictsUnderTheFramesProbesWithinTheCache) {
+    // The filler beside the dynamic phase, at a frame rate nothing fits and with a cache
+    // a few frames overflow: it fills and evicts while the frames' probes read the same
+    // maps. Every frame is drawn, finite, with the tiles within the cache (beyond the
+    // always-resident levels); run under the sanitizers in CI.
+    const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    PlaybackOptions options;
+    options.render.width = 240;
+    options.render.height = 135;
+    options.first = 0;
+    options.last = 16;
+    options.fps = 1000.0;
+    options.cacheBytes = size_t{5} << 20;  // the always-resident levels take 3.5 MB
+    options.backgroundDuringFrames = true;
+    options.prefetch = false;
+    // Full quality throughout, so every frame asks for fine tiles.
+    options.regulator.slowDownAt = options.regulator.dropAt = 1e9;
+    uint64_t filled = 0, evicted = 0;
+    int frames = 0;
+    playScene(scene, options, [&](const FrameStats& s, const Image& image, const PlaybackQuality&) {
+        ++frames;
+        filled += s.backgroundTilesFilled;
+        evicted += s.backgroundTilesEvicted;
+        EXPECT_LE(s.residentBytes - s.residentPinnedBytes, options.cacheBytes) << s.index;
+        for (float v : image.rgba) EXPECT_TRUE(std::isfinite(v));
+        EXPECT_GT(coverage(image), 0.3);
+        // Give the idle-priority worker idle cores, as writing a frame does.
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        return true;
+    });
+    EXPECT_EQ(frames, 16);
+    EXPECT_GT(filled, 0u);
+    EXPECT_GT(evicted, 0u);
+}
+
 TEST(Playback, AOneMegabyteCacheHoldsEveryFrameAndStillDrawsThem) {
     // The maps could use far more (the vase's frames fill 16 MB at its own size): with a
     // 1 MB cache, no frame holds more than 1 MB of tiles beyond the always-resident levels,
