@@ -72,7 +72,7 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         return;
     }
     const int frame = stats.index;
-    pauseFiller();  // the cache's budget is this loop's alone
+    stats.controllerSeconds += pauseFiller();  // the cache's budget is this loop's alone
     // Coarser levels first: a tile there serves four times the surface of one a level
     // finer, and (built from its children where they are resident) costs no more.
     std::stable_sort(

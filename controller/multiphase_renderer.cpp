@@ -55,8 +55,11 @@ float MultiphaseRenderer::inputsMoved(size_t object) {
     return staticInputChange(builtInputs_[object], inputScratch_, inputSpans_[object]);
 }
 
-void MultiphaseRenderer::pauseFiller() {
-    if (filler_) filler_->pause();
+double MultiphaseRenderer::pauseFiller() {
+    if (!filler_) return 0.0;
+    const auto start = Clock::now();
+    filler_->pause();
+    return secondsSince(start);
 }
 
 void MultiphaseRenderer::resumeFiller() {
@@ -250,8 +253,9 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     frameDynamic_.assign(scene_.objects.size(), ObjectFrameCost{});
     if (filler_) {
         // Held while this frame's static work runs; no probe runs now either, so the
-        // storage of the tiles it dropped meanwhile is free again.
-        filler_->pause();
+        // storage of the tiles it dropped meanwhile is free again. The wait (at most the
+        // tile under way) is the controller's time.
+        stats.controllerSeconds += pauseFiller();
         const BackgroundTotals t = filler_->totals();
         stats.backgroundTilesFilled = t.tilesFilled - fillerTotals_.tilesFilled;
         stats.backgroundTilesEvicted = t.tilesEvicted - fillerTotals_.tilesEvicted;

@@ -260,7 +260,7 @@ class MultiphaseRenderer {
     double lastDynamicSeconds_ = 0.0;
     // The background filler (made at the first frame that defers tiles), and its totals at
     // the last frame. Last: destroyed (its worker joined) before anything it uses.
-    void pauseFiller();
+    double pauseFiller();  // returns the seconds it waited for the worker
     void resumeFiller();
     BackgroundTotals fillerTotals_;
     std::unique_ptr<BackgroundFiller> filler_;
