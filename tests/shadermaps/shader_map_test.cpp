@@ -476,7 +476,8 @@ TEST(Probe, DegenerateFootprintsGiveFiniteResults) {
 
 TEST(TileTable, FindsWhatWasInsertedAndForgetsWhatWasErased) {
     // Random keys in and out, checked against std::map; erasing from the middle of a
-    // probe run must keep the keys after it findable (backward-shift deletion).
+    // probe run must keep the keys after it findable (tombstones), and growing past
+    // them must keep every live key.
     TileTable table;
     std::map<uint64_t, int32_t> truth;
     std::mt19937_64 rng(7);
