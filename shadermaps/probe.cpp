@@ -71,10 +71,11 @@ struct Prober {
     int maxLevel;
     static constexpr bool kFixed = kChannels > 0;
     static constexpr int kArr = kFixed ? kChannels : kMaxChannels;
-    // The last tile looked up: neighbouring lookups mostly read the same tile, and each
-    // lookup otherwise costs a hash-table probe.
-    mutable uint64_t lastKey = ~uint64_t{0};
-    mutable int lastSlot = -1;
+    // The last tile looked up, one per level parity: neighbouring lookups mostly read the
+    // same tile, and each lookup otherwise costs a hash-table probe; a tap that falls back
+    // reads a level and the next, which with one entry had cost two probes a tap.
+    mutable uint64_t lastKey[2] = {~uint64_t{0}, ~uint64_t{0}};
+    mutable int lastSlot[2] = {-1, -1};
     // The fast path's own cache, one tile per level parity: trilinear and Feline alternate
     // between two adjacent levels.
     mutable uint64_t cachedKey[2] = {~uint64_t{0}, ~uint64_t{0}};
@@ -203,12 +204,13 @@ struct Prober {
         li = i - key.tx * T + border;
         lj = j - key.ty * T + border;
         const uint64_t packed = key.packed();
-        if (packed != lastKey) {
-            lastKey = packed;
-            lastSlot = map.slotOf(key);
-            if (lastSlot >= 0) map.markUsed(lastSlot);
+        const int p = level & 1;
+        if (packed != lastKey[p]) {
+            lastKey[p] = packed;
+            lastSlot[p] = map.slotOf(key);
+            if (lastSlot[p] >= 0) map.markUsed(lastSlot[p]);
         }
-        return lastSlot;
+        return lastSlot[p];
     }
 
     // Reports a lacking tile unless it was reported lately: the taps of a frame's probes
