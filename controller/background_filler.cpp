@@ -1,6 +1,5 @@
 #include "controller/background_filler.h"
 
-#include <algorithm>
 #include <chrono>
 
 #include <sched.h>
@@ -75,17 +74,12 @@ size_t BackgroundFiller::queued() const {
 }
 
 void BackgroundFiller::makeRoom(size_t wanted, uint32_t stamp, uint64_t& evicted) {
-    candidates_.clear();
-    for (const auto& pool : pools_.all()) pool->evictable(stamp > 0 ? stamp - 1 : 0, candidates_);
-    std::sort(candidates_.begin(), candidates_.end(),
-              [](const TilePool::Held& a, const TilePool::Held& b) {
-                  return a.lastUse != b.lastUse ? a.lastUse < b.lastUse : a.slot < b.slot;
-              });
+    const size_t count = oldestTiles(pools_, stamp > 0 ? stamp - 1 : 0, wanted, candidates_);
     // Retired tiles hold their storage until the controller's next reclaim, so the room
     // made here is for the frames after it.
     size_t freed = 0;
-    for (const TilePool::Held& h : candidates_) {
-        if (freed >= wanted) break;
+    for (size_t i = 0; i < count && freed < wanted; ++i) {
+        const TilePool::Held& h = candidates_[i];
         h.owner->retire(h.key);
         freed += h.owner->tileBytes();
         ++evicted;

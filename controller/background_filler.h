@@ -28,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "controller/tile_cache.h"
 #include "shadermaps/shader_map.h"
 
 namespace mpshade {

@@ -19,11 +19,7 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
                                       double seconds, int& built) {
     const auto start = Clock::now();
     built = 0;
-    pauseFiller();
-    struct Resume {
-        MultiphaseRenderer& r;
-        ~Resume() { r.resumeFiller(); }
-    } resume{*this};
+    const PausedFiller paused(*this);
     const size_t n = scene_.objects.size();
     const int last = std::min(scene_.frameCount() - 1, frame + frames);
     std::vector<uint8_t> planned(n, 0);
@@ -72,7 +68,8 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         return;
     }
     const int frame = stats.index;
-    stats.controllerSeconds += pauseFiller();  // the cache's budget is this loop's alone
+    const PausedFiller paused(*this);  // the cache's budget is this loop's alone
+    stats.controllerSeconds += paused.seconds;
     // Coarser levels first: a tile there serves four times the surface of one a level
     // finer, and (built from its children where they are resident) costs no more.
     std::stable_sort(
@@ -134,7 +131,6 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
             jobs.push_back({lacking_[k].object, drawn_[lacking_[k].object]->map, lacking_[k].key});
         filler_->submit(std::move(jobs));
     }
-    resumeFiller();
     lastLacking_.swap(lacking_);
     lacking_.clear();
 }

@@ -262,6 +262,16 @@ class MultiphaseRenderer {
     // the last frame. Last: destroyed (its worker joined) before anything it uses.
     double pauseFiller();  // returns the seconds it waited for the worker
     void resumeFiller();
+    // Holds the background filler while it lives: the holder's fills and evictions are the
+    // cache's only ones. `seconds`: the wait for the worker's tile under way.
+    struct PausedFiller {
+        explicit PausedFiller(MultiphaseRenderer& r) : renderer(r), seconds(r.pauseFiller()) {}
+        ~PausedFiller() { renderer.resumeFiller(); }
+        PausedFiller(const PausedFiller&) = delete;
+        PausedFiller& operator=(const PausedFiller&) = delete;
+        MultiphaseRenderer& renderer;
+        double seconds;
+    };
     BackgroundTotals fillerTotals_;
     std::unique_ptr<BackgroundFiller> filler_;
 };

@@ -6,32 +6,30 @@
 
 namespace mpshade {
 
-bool TileCache::makeRoom(const TilePools& pools, size_t incoming, uint32_t currentStamp,
-                         uint64_t& evicted) {
-    const std::vector<std::shared_ptr<TilePool>> all = pools.all();
-    size_t bytes = 0;
-    for (const auto& pool : all) bytes += pool->bytesHeld();
-    if (bytes + incoming <= budget_) return true;
-    const size_t target = budget_ - budget_ / 50;
-    const size_t excess = bytes + incoming - std::min(bytes + incoming, target);
-    candidates_.clear();
-    size_t smallest = 0;
-    for (const auto& pool : all) {
-        pool->evictable(currentStamp, candidates_);
-        smallest = smallest ? std::min(smallest, pool->tileBytes()) : pool->tileBytes();
-    }
-    // Only the oldest tiles that can cover the excess are put in order (at most this many,
-    // each holding at least `smallest` bytes): a frame at the budget evicts a few hundred
-    // of tens of thousands. Ties go by slot, so the order does not depend on the sort.
+size_t oldestTiles(const TilePools& pools, uint32_t before, size_t bytes,
+                   std::vector<TilePool::Held>& out) {
+    out.clear();
+    for (const auto& pool : pools.all()) pool->evictable(before, out);
+    const size_t smallest = pools.smallestTileBytes();
+    // At most this many cover `bytes`, each tile holding at least `smallest`.
+    const size_t count =
+        std::min(out.size(), (bytes + smallest - 1) / std::max<size_t>(smallest, 1));
     auto older = [](const TilePool::Held& a, const TilePool::Held& b) {
         return a.lastUse != b.lastUse ? a.lastUse < b.lastUse : a.slot < b.slot;
     };
-    const size_t count =
-        std::min(candidates_.size(), (excess + smallest - 1) / std::max<size_t>(smallest, 1));
-    const auto end = candidates_.begin() + static_cast<std::ptrdiff_t>(count);
-    if (count < candidates_.size())
-        std::nth_element(candidates_.begin(), end, candidates_.end(), older);
-    std::sort(candidates_.begin(), end, older);
+    const auto end = out.begin() + static_cast<std::ptrdiff_t>(count);
+    if (count < out.size()) std::nth_element(out.begin(), end, out.end(), older);
+    std::sort(out.begin(), end, older);
+    return count;
+}
+
+bool TileCache::makeRoom(const TilePools& pools, size_t incoming, uint32_t currentStamp,
+                         uint64_t& evicted) {
+    size_t bytes = pools.bytesHeld();
+    if (bytes + incoming <= budget_) return true;
+    const size_t target = budget_ - budget_ / 50;
+    const size_t excess = bytes + incoming - std::min(bytes + incoming, target);
+    const size_t count = oldestTiles(pools, currentStamp, excess, candidates_);
     for (size_t i = 0; i < count && bytes + incoming > target; ++i) {
         const TilePool::Held& h = candidates_[i];
         h.owner->evict(h.key);
@@ -42,9 +40,7 @@ bool TileCache::makeRoom(const TilePools& pools, size_t incoming, uint32_t curre
 }
 
 void TileCache::reserve(const TilePools& pools) {
-    size_t smallest = 0;
-    for (const auto& pool : pools.all())
-        smallest = smallest ? std::min(smallest, pool->tileBytes()) : pool->tileBytes();
+    const size_t smallest = pools.smallestTileBytes();
     if (smallest == 0) return;
     candidates_.resize(std::max(candidates_.size(), budget_ / smallest + 1));
     candidates_.clear();

@@ -17,6 +17,13 @@
 
 namespace mpshade {
 
+// Gathers into `out` the tiles of `pools` that may be dropped (not pinned, not retired) last
+// used before `before`, and puts in order, oldest first (ties by slot), at least those
+// whose storage reaches `bytes`: the front of `out`. Returns how many are in order. Only
+// those are sorted: a frame at the budget drops a few hundred of tens of thousands.
+size_t oldestTiles(const TilePools& pools, uint32_t before, size_t bytes,
+                   std::vector<TilePool::Held>& out);
+
 class TileCache {
   public:
     // budgetBytes: the tiles' storage, pinned levels included, in bytes.

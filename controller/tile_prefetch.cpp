@@ -94,11 +94,7 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
     const auto start = Clock::now();
     const ScopedSpan span(options_.trace, "prefetch", PhaseKind::Static, SpanLevel::Phase, -1,
                           stats.index);
-    pauseFiller();  // room in the cache is this loop's alone
-    struct Resume {
-        MultiphaseRenderer& r;
-        ~Resume() { r.resumeFiller(); }
-    } resume{*this};
+    const PausedFiller paused(*this);  // room in the cache is this loop's alone
     std::vector<const ObjectRepresentation*> maps(representations_.size(), nullptr);
     for (size_t i = 0; i < representations_.size(); ++i) maps[i] = representations_[i].get();
     std::vector<TileRequest> batch;

@@ -350,15 +350,14 @@ struct Prober {
                 // 2.7x slower on its fallbacks (the grazing floor, 640x360).
                 if (level < maxLevel && !(residency && residency->stopAtMissing)) {
                     missed = true;
-                    if (!residency)
-                        return lineAccumulate(chart, level + 1, u0, v0, du, dv, n, weight, scale,
-                                              sum);
-                    const uint64_t taps = static_cast<uint64_t>(n);
-                    residency->bilinearProbes += taps;
-                    residency->missingProbes += taps;
-                    residency->fallbacks += taps;
-                    report({static_cast<uint32_t>(chart), static_cast<uint16_t>(level),
-                            static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)});
+                    if (residency) {
+                        const uint64_t taps = static_cast<uint64_t>(n);
+                        residency->bilinearProbes += taps;
+                        residency->missingProbes += taps;
+                        residency->fallbacks += taps;
+                        report({static_cast<uint32_t>(chart), static_cast<uint16_t>(level),
+                                static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)});
+                    }
                     return lineAccumulate(chart, level + 1, u0, v0, du, dv, n, weight, scale, sum);
                 }
             }

@@ -320,18 +320,8 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys) {
         begin = end;
     }
     FillStats done;
-    for (const FillScratch& s : scratch) {
-        done.tiles += s.stats.tiles;
-        done.tilesFromChildren += s.stats.tilesFromChildren;
-        done.texels += s.stats.texels;
-        done.programRuns += s.stats.programRuns;
-        done.texelsCopied += s.stats.texelsCopied;
-    }
-    fillStats_.tiles += done.tiles;
-    fillStats_.tilesFromChildren += done.tilesFromChildren;
-    fillStats_.texels += done.texels;
-    fillStats_.programRuns += done.programRuns;
-    fillStats_.texelsCopied += done.texelsCopied;
+    for (const FillScratch& s : scratch) done += s.stats;
+    fillStats_ += done;
     return done;
 }
 

@@ -93,6 +93,15 @@ struct FillStats {
     uint64_t texels = 0;
     uint64_t programRuns = 0;   // static program evaluations (texels x supersamples)
     uint64_t texelsCopied = 0;  // border texels copied from a resident neighbouring tile
+
+    FillStats& operator+=(const FillStats& o) {
+        tiles += o.tiles;
+        tilesFromChildren += o.tilesFromChildren;
+        texels += o.texels;
+        programRuns += o.programRuns;
+        texelsCopied += o.texelsCopied;
+        return *this;
+    }
 };
 
 class ShaderMap {

@@ -1,5 +1,6 @@
 #include "shadermaps/tile_pool.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "geometry/error.h"
@@ -48,14 +49,18 @@ int TilePool::allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t sta
     return slot;
 }
 
+void TilePool::release(int slot) {
+    free_.push_back(slot);
+    held_.fetch_sub(1, std::memory_order_relaxed);
+    if (pinned_[static_cast<size_t>(slot)]) pinnedHeld_.fetch_sub(1, std::memory_order_relaxed);
+}
+
 void TilePool::free(int slot) {
     std::lock_guard<std::mutex> lock(mutex_);
     const size_t s = static_cast<size_t>(slot);
     MPSHADE_CHECK(s < owner_.size() && owner_[s] != nullptr);
     owner_[s] = nullptr;
-    free_.push_back(slot);
-    held_.fetch_sub(1, std::memory_order_relaxed);
-    if (pinned_[s]) pinnedHeld_.fetch_sub(1, std::memory_order_relaxed);
+    release(slot);
 }
 
 void TilePool::retire(int slot) {
@@ -68,11 +73,7 @@ void TilePool::retire(int slot) {
 
 void TilePool::reclaim() {
     std::lock_guard<std::mutex> lock(mutex_);
-    for (int slot : retired_) {
-        free_.push_back(slot);
-        held_.fetch_sub(1, std::memory_order_relaxed);
-        if (pinned_[static_cast<size_t>(slot)]) pinnedHeld_.fetch_sub(1, std::memory_order_relaxed);
-    }
+    for (int slot : retired_) release(slot);
     retired_.clear();
 }
 
@@ -96,6 +97,14 @@ std::shared_ptr<TilePool> TilePools::forTileBytes(size_t tileBytes) {
 std::vector<std::shared_ptr<TilePool>> TilePools::all() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return pools_;
+}
+
+size_t TilePools::smallestTileBytes() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    size_t smallest = 0;
+    for (const auto& pool : pools_)
+        smallest = smallest ? std::min(smallest, pool->tileBytes()) : pool->tileBytes();
+    return smallest;
 }
 
 size_t TilePools::bytesHeld() const {

@@ -87,6 +87,8 @@ class TilePool {
         std::unique_ptr<unsigned char[]> data;
         std::atomic<uint32_t> lastUse[kTilesPerBlock];
     };
+    // Puts an unowned slot back on the free list (under mutex_).
+    void release(int slot);
     std::atomic<uint32_t>& useOf(int slot) const {
         return blocks_[static_cast<size_t>(slot) >> kBlockShift]
             ->lastUse[slot & (kTilesPerBlock - 1)];
@@ -111,6 +113,7 @@ class TilePools {
     std::shared_ptr<TilePool> forTileBytes(size_t tileBytes);
     std::vector<std::shared_ptr<TilePool>> all() const;
     size_t bytesHeld() const;
+    size_t smallestTileBytes() const;  // 0: no pool yet
 
   private:
     mutable std::mutex mutex_;
