@@ -20,8 +20,11 @@ void lowerPriority() {
 
 }  // namespace
 
-BackgroundFiller::BackgroundFiller(const TilePools& pools, size_t budgetBytes)
-    : pools_(pools), budget_(budgetBytes), worker_([this] { run(); }) {}
+BackgroundFiller::BackgroundFiller(const TilePools& pools, size_t budgetBytes, bool idlePriority)
+    : pools_(pools),
+      budget_(budgetBytes),
+      idlePriority_(idlePriority),
+      worker_([this] { run(); }) {}
 
 BackgroundFiller::~BackgroundFiller() {
     {
@@ -73,6 +76,11 @@ size_t BackgroundFiller::queued() const {
     return jobs_.size() - next_ + (busy_ ? 1 : 0);
 }
 
+bool BackgroundFiller::settled() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return paused_ || (!busy_ && (next_ >= jobs_.size() || waitForReclaim_));
+}
+
 void BackgroundFiller::makeRoom(size_t wanted, uint32_t stamp, uint64_t& evicted) {
     const size_t count = oldestTiles(pools_, stamp > 0 ? stamp - 1 : 0, wanted, candidates_);
     // Retired tiles hold their storage until the controller's next reclaim, so the room
@@ -87,7 +95,7 @@ void BackgroundFiller::makeRoom(size_t wanted, uint32_t stamp, uint64_t& evicted
 }
 
 void BackgroundFiller::run() {
-    lowerPriority();
+    if (idlePriority_) lowerPriority();
     // The worker's fills run on this thread alone: none of the frame's workers join them.
     tbb::task_arena arena(1);
     std::vector<TileKey> keys;

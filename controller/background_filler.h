@@ -47,7 +47,9 @@ struct BackgroundTotals {
 class BackgroundFiller {
   public:
     // pools: the renderer's (not owned; must outlive the filler). budgetBytes: the cache's.
-    BackgroundFiller(const TilePools& pools, size_t budgetBytes);
+    // idlePriority false: the worker runs at normal priority (a caller that waits on it
+    // while other processes load the machine, as tests under `ctest -j` do).
+    BackgroundFiller(const TilePools& pools, size_t budgetBytes, bool idlePriority = true);
     ~BackgroundFiller();
     BackgroundFiller(const BackgroundFiller&) = delete;
     BackgroundFiller& operator=(const BackgroundFiller&) = delete;
@@ -65,6 +67,9 @@ class BackgroundFiller {
     BackgroundTotals totals() const;
     // Jobs queued and not yet done (a batch being filled counts).
     size_t queued() const;
+    // Whether the worker can do nothing more before the next frame: paused, or idle with
+    // its queue done or the cache full of tiles it may not drop yet.
+    bool settled() const;
 
   private:
     void run();
@@ -78,6 +83,7 @@ class BackgroundFiller {
     std::condition_variable wake_, idle_;
     std::vector<BackgroundJob> jobs_;
     size_t next_ = 0;
+    bool idlePriority_;
     bool paused_ = true, busy_ = false, stop_ = false;
     bool waitForReclaim_ = false;  // the cache is full: nothing more until the next frame
     uint32_t stamp_ = 0;

@@ -122,8 +122,8 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     recordResidency(stats);
     if (options_.backgroundFills && next < lacking_.size()) {
         if (!filler_)
-            filler_ =
-                std::make_unique<BackgroundFiller>(static_.tilePools(), options_.mapMemoryBytes);
+            filler_ = std::make_unique<BackgroundFiller>(
+                static_.tilePools(), options_.mapMemoryBytes, options_.backgroundIdlePriority);
         std::vector<BackgroundJob> jobs;
         const size_t end = std::min(lacking_.size(), next + options_.backgroundQueue);
         jobs.reserve(end - next);

@@ -92,6 +92,9 @@ struct MultiphaseOptions {
     bool backgroundFills = false;
     size_t backgroundQueue = 4096;
     bool backgroundDuringFrames = false;
+    // The worker at idle priority; false: normal priority (a caller that waits on it while
+    // other processes load the machine, as tests do).
+    bool backgroundIdlePriority = true;
 };
 
 // Per object, for stats.json: what the static phase chose and did.
@@ -168,6 +171,9 @@ class MultiphaseRenderer {
     const ObjectReport& report(size_t object) const { return reports_[object]; }
     // Tiles queued for the background filler and not filled yet (0 without one).
     size_t backgroundQueued() const { return filler_ ? filler_->queued() : 0; }
+    // Whether the background filler can do nothing more before the next frame (true
+    // without one): background_filler.h.
+    bool backgroundSettled() const { return !filler_ || filler_->settled(); }
     size_t objectCount() const { return reports_.size(); }
     // Per object, what the last frame cost: its static work (building, filling tiles), in
     // seconds summed over threads; and its dynamic work (not drawn: all zero; a frame
