@@ -157,22 +157,35 @@ TEST(FixedPointWarp, ExtremesNeitherOverflowNorCrash) {
     }
 }
 
-// A 12 x 9 grid of vertices on exact sub-pixel positions, two triangles per cell with
-// alternating splits and windings (as different charts would have), and 16 samples per pixel
-// on the 1/4-pixel lattice, so many land exactly on vertices and edges.
+// A grid of vertices on exact sub-pixel positions (12 x 9 of them 3 pixels apart, unless
+// asked otherwise), two triangles per cell with alternating splits and windings (as
+// different charts would have), and samples on the 1/4-pixel lattice (16 per pixel, or the
+// first `spp` of them in a scattered order), so many land exactly on vertices and edges.
 struct GridFixture {
-    static constexpr int gw = 12, gh = 9, W = 40, H = 30, spp = 16;
+    int gw = 12, gh = 9, W = 40, H = 30, spp = 16;
+    float cell = 3.0f;  // pixels, a multiple of 1/4
     FacetMesh mesh;
     WarpedVertices warped;
     std::shared_ptr<SampleLayout> layout;
-    GridFixture() {
+    GridFixture() { build(); }
+    // Sub-pixel cells: every facet's box holds only a few samples.
+    GridFixture(int columns, int rows, float cellPixels, int samplesPerPixel)
+        : gw(columns), gh(rows), spp(samplesPerPixel), cell(cellPixels) {
+        build();
+    }
+    void build() {
         std::mt19937 rng(3);
-        std::uniform_int_distribution<int> jitter(-40, 40);
+        const int amplitude = static_cast<int>(40 * cell / 3.0f);
+        std::uniform_int_distribution<int> jitter(-amplitude, amplitude);
         for (int j = 0; j < gh; ++j)
             for (int i = 0; i < gw; ++i) {
                 const bool inner = i > 0 && j > 0 && i < gw - 1 && j < gh - 1;
-                warped.x.push_back(256 * (2 + 3 * i) + (inner ? jitter(rng) : 0));
-                warped.y.push_back(256 * (2 + 3 * j) + (inner ? jitter(rng) : 0));
+                // Every other inner vertex stays on the lattice, on samples and edges.
+                const bool moved = inner && (i + j) % 2 == 0;
+                warped.x.push_back(static_cast<int32_t>(256 * (2 + cell * i)) +
+                                   (moved ? jitter(rng) : 0));
+                warped.y.push_back(static_cast<int32_t>(256 * (2 + cell * j)) +
+                                   (moved ? jitter(rng) : 0));
                 warped.invDepth.push_back(0.2f + 0.001f * i);
                 mesh.qx.push_back(0), mesh.qy.push_back(0), mesh.qz.push_back(0);
             }
@@ -189,13 +202,15 @@ struct GridFixture {
         std::vector<float> xy;
         for (int py = 0; py < H; ++py)
             for (int px = 0; px < W; ++px)
-                for (int k = 0; k < spp; ++k)
-                    xy.push_back(px + 0.25f * (k % 4)), xy.push_back(py + 0.25f * (k / 4));
+                for (int k = 0; k < spp; ++k) {
+                    const int q = spp == 16 ? k : (5 * k + 3 * (px + py)) % 16;
+                    xy.push_back(px + 0.25f * (q % 4)), xy.push_back(py + 0.25f * (q / 4));
+                }
         layout = std::make_shared<SampleLayout>(W, H, spp, xy);
     }
     // Inside the grid: the convex hull of the border (an axis-aligned rectangle).
     int inside(size_t s) const {
-        const float x0 = 2.0f, x1 = 2 + 3 * (gw - 1.0f), y0 = 2.0f, y1 = 2 + 3 * (gh - 1.0f);
+        const float x0 = 2.0f, x1 = 2 + cell * (gw - 1.0f), y0 = 2.0f, y1 = 2 + cell * (gh - 1.0f);
         const float x = layout->x(s), y = layout->y(s);
         if (x > x0 && x < x1 && y > y0 && y < y1) return 1;
         if (x < x0 || x > x1 || y < y0 || y > y1) return 0;
@@ -250,6 +265,41 @@ TEST(FacetRasterizer, OpaqueDepthTestCoversTheSameSamples) {
     VisibilityBuffer far;
     rasterizeFacets({{&g.mesh, &g.warped, nullptr, true}}, *g.layout, 4.0f, options, far, b);
     for (size_t s = 0; s < g.layout->count(); ++s) ASSERT_EQ(far.count[s], 0);
+}
+
+TEST(FacetRasterizer, SubPixelFacetsCoverEverySampleOnce) {
+    // Facets a little under a pixel across, at 1, 2 and 4 samples per pixel, so the opaque
+    // path tests most of them sample by sample (their boxes hold at most 8 samples): the
+    // translucent path, which keeps every facet covering a sample, must find every interior
+    // sample covered exactly once, and the opaque path must give each the same facet.
+    for (int spp : {1, 2, 4}) {
+        GridFixture g(50, 38, 0.75f, spp);
+        VisibilityBuffer layered, opaque;
+        RasterStats a, b;
+        RasterOptions options;
+        options.layers = 4;
+        rasterizeFacets({{&g.mesh, &g.warped, nullptr, false}}, *g.layout, 1e30f, options, layered,
+                        a);
+        rasterizeFacets({{&g.mesh, &g.warped, nullptr, true}}, *g.layout, 1e30f, options, opaque,
+                        b);
+        int interior = 0;
+        for (size_t s = 0; s < g.layout->count(); ++s) {
+            const int in = g.inside(s);
+            if (in == 1) {
+                ++interior;
+                ASSERT_EQ(layered.count[s], 1) << spp << " spp, sample at (" << g.layout->x(s)
+                                               << ", " << g.layout->y(s) << ")";
+            } else if (in == 0) {
+                ASSERT_EQ(layered.count[s], 0);
+            }
+            ASSERT_EQ(opaque.count[s], layered.count[s]) << spp << " spp, sample " << s;
+            if (opaque.count[s]) {
+                ASSERT_EQ(opaque.facet[s], layered.facet[s * layered.layers]);
+            }
+        }
+        EXPECT_GT(interior, 700 * spp);
+        EXPECT_EQ(a.fragments, b.fragments);
+    }
 }
 
 TEST(FacetRasterizer, SkipsDegenerateAndCulledFacets) {

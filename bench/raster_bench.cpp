@@ -1,0 +1,121 @@
+// The rasterizer and the resolve alone, at 1280 x 720 or 640 x 360.
+//
+// Rasterizer: facets as the static phase makes them, a screen-filling grid of facets `cell`
+// pixels across (two per cell, in clusters of 8 x 8 cells) over a tilted plane, so every
+// facet is visible and their sizes are what dicing to a quarter-pixel flatness or half-pixel
+// edges gives (about one or two facets per pixel).
+//
+// Resolve: samples to pixels through the reconstruction filter, with every pixel's samples
+// alike (one shading point a pixel, or one sample a pixel) or not.
+#include <cmath>
+#include <string>
+
+#include <benchmark/benchmark.h>
+
+#include "phases/facet_rasterizer.h"
+#include "phases/image.h"
+#include "phases/sample_pattern.h"
+
+namespace mpshade {
+namespace {
+
+struct FacetGrid {
+    FacetMesh mesh;
+    WarpedVertices warped;
+    SampleLayout layout;
+
+    FacetGrid(int width, int height, int spp, float cell) : layout(width, height, spp, 1u) {
+        const int nx = static_cast<int>(std::ceil(width / cell)) + 1;
+        const int ny = static_cast<int>(std::ceil(height / cell)) + 1;
+        warped.resize(static_cast<size_t>(nx) * ny);
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                const size_t v = static_cast<size_t>(j) * nx + i;
+                // A little jitter, so edges are not aligned with the sample grid.
+                const float jx = 0.13f * std::sin(1.7f * i + 0.9f * j);
+                const float jy = 0.11f * std::cos(1.3f * i - 0.7f * j);
+                warped.x[v] = static_cast<int32_t>(std::lround(256.0f * (i + jx) * cell));
+                warped.y[v] = static_cast<int32_t>(std::lround(256.0f * (j + jy) * cell));
+                warped.invDepth[v] = 1.0f / (2.0f + 0.01f * (i + j));
+            }
+        constexpr int kClusterCells = 8;
+        for (int cj = 0; cj < ny - 1; cj += kClusterCells)
+            for (int ci = 0; ci < nx - 1; ci += kClusterCells) {
+                FacetCluster cluster;
+                cluster.firstFacet = static_cast<uint32_t>(mesh.positionIndex.size() / 3);
+                for (int j = cj; j < std::min(cj + kClusterCells, ny - 1); ++j)
+                    for (int i = ci; i < std::min(ci + kClusterCells, nx - 1); ++i) {
+                        const uint32_t a = static_cast<uint32_t>(j * nx + i), b = a + 1,
+                                       c = a + static_cast<uint32_t>(nx), d = c + 1;
+                        for (uint32_t p : {a, c, b, b, c, d}) mesh.positionIndex.push_back(p);
+                    }
+                cluster.facetCount =
+                    static_cast<uint32_t>(mesh.positionIndex.size() / 3) - cluster.firstFacet;
+                mesh.clusters.push_back(cluster);
+            }
+        mesh.attributeIndex = mesh.positionIndex;
+    }
+};
+
+void rasterGrid(benchmark::State& state, int spp, float cell) {
+    const FacetGrid grid(640, 360, spp, cell);
+    FacetRasterizer rasterizer;
+    VisibilityBuffer visibility;
+    RasterStats stats;
+    const std::vector<RasterObject> objects = {{&grid.mesh, &grid.warped, nullptr, true}};
+    for (auto _ : state) {
+        rasterizer.rasterize(objects, grid.layout, 100.0f, RasterOptions{}, visibility, stats);
+        benchmark::DoNotOptimize(visibility.facet.data());
+    }
+    state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * stats.facets));
+    state.counters["facets"] = static_cast<double>(stats.facets);
+    state.counters["fragments"] = static_cast<double>(stats.fragments);
+    state.counters["facet_tile_pairs"] = static_cast<double>(stats.facetsBinned);
+}
+
+BENCHMARK_CAPTURE(rasterGrid, cell1_spp1, 1, 1.0f)
+    ->Name("Raster/640x360/1spp/facets_1px")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(rasterGrid, cell1_spp4, 4, 1.0f)
+    ->Name("Raster/640x360/4spp/facets_1px")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(rasterGrid, cell05_spp1, 1, 0.5f)
+    ->Name("Raster/640x360/1spp/facets_half_px")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(rasterGrid, cell4_spp4, 4, 4.0f)
+    ->Name("Raster/640x360/4spp/facets_4px")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void resolveSamples(benchmark::State& state, int spp, bool uniform) {
+    const SampleLayout layout(1280, 720, spp, 1u);
+    std::vector<float> rgba(layout.count() * 4);
+    for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = static_cast<float>(i % 97) / 97.0f;
+    const std::vector<uint8_t> alike(static_cast<size_t>(layout.width()) * layout.height(),
+                                     uniform ? 1 : 0);
+    Image image;
+    for (auto _ : state) {
+        layout.resolve(rgba.data(), alike.data(), image);
+        benchmark::DoNotOptimize(image.rgba.data());
+    }
+    state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * layout.count()));
+}
+
+BENCHMARK_CAPTURE(resolveSamples, spp1, 1, true)
+    ->Name("Resolve/1280x720/1spp")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(resolveSamples, spp4, 4, false)
+    ->Name("Resolve/1280x720/4spp")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(resolveSamples, spp4_alike, 4, true)
+    ->Name("Resolve/1280x720/4spp_alike")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace mpshade
