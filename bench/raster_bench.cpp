@@ -6,7 +6,8 @@
 // edges gives (about one or two facets per pixel).
 //
 // Resolve: samples to pixels through the reconstruction filter, with every pixel's samples
-// alike (one shading point a pixel, or one sample a pixel) or not.
+// alike (one shading point a pixel, or one sample a pixel) or not, or every 2x2 block alike
+// (one shading point per 2x2 pixels).
 #include <cmath>
 #include <string>
 
@@ -90,15 +91,22 @@ BENCHMARK_CAPTURE(rasterGrid, cell4_spp4, 4, 4.0f)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-void resolveSamples(benchmark::State& state, int spp, bool uniform) {
+void resolveSamples(benchmark::State& state, int spp, bool uniform, bool quads = false) {
     const SampleLayout layout(1280, 720, spp, 1u);
     std::vector<float> rgba(layout.count() * 4);
     for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = static_cast<float>(i % 97) / 97.0f;
+    if (quads)  // one color a 2x2 block, as shading per 2x2 pixels gives
+        for (int py = 0; py < layout.height(); ++py)
+            for (int px = 0; px < layout.width(); ++px)
+                for (int k = 0; k < spp; ++k)
+                    for (int c = 0; c < 4; ++c)
+                        rgba[4 * layout.index(px, py, k) + c] =
+                            static_cast<float>((px / 2 + 7 * (py / 2) + c) % 97) / 97.0f;
     const std::vector<uint8_t> alike(static_cast<size_t>(layout.width()) * layout.height(),
                                      uniform ? 1 : 0);
     Image image;
     for (auto _ : state) {
-        layout.resolve(rgba.data(), alike.data(), image);
+        layout.resolve(rgba.data(), alike.data(), image, quads);
         benchmark::DoNotOptimize(image.rgba.data());
     }
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * layout.count()));
@@ -106,6 +114,10 @@ void resolveSamples(benchmark::State& state, int spp, bool uniform) {
 
 BENCHMARK_CAPTURE(resolveSamples, spp1, 1, true)
     ->Name("Resolve/1280x720/1spp")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(resolveSamples, spp1_quads, 1, true, true)
+    ->Name("Resolve/1280x720/1spp_2x2_alike")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(resolveSamples, spp4, 4, false)

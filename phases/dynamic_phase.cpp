@@ -556,7 +556,8 @@ void DynamicPhase::resolve(Image& out) {
     const auto start = Clock::now();
     const ScopedSpan span(options_.trace, "resolve", PhaseKind::Resolve, SpanLevel::Phase, -1,
                           frame_->index);
-    layout_->resolve(samples_.rgba.data(), uniform_.data(), out);
+    layout_->resolve(samples_.rgba.data(), uniform_.data(), out,
+                     options_.shadingRate == ShadingRate::Quad);
     stats_.resolveSeconds = secondsSince(start);
 }
 

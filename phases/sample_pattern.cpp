@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include <tbb/parallel_for.h>
 
@@ -170,6 +171,29 @@ void SampleLayout::prepareFilter() {
             }
         }
     });
+    // Per whole 2x2 block, for a filter reaching one pixel around: its four pixels' summed
+    // weights towards the 4 x 4 pixels it reaches (rows then columns, from the pixel up
+    // and left of it).
+    blockWeights_.clear();
+    if (reach_ == 1) {
+        const int bw = width_ / 2, bh = height_ / 2;
+        blockWeights_.assign(static_cast<size_t>(bw) * bh * 16, 0.0f);
+        tbb::parallel_for(0, bh, [&](int by) {
+            for (int bx = 0; bx < bw; ++bx) {
+                float* bwt = &blockWeights_[(static_cast<size_t>(by) * bw + bx) * 16];
+                for (int dy = 0; dy < 2; ++dy)
+                    for (int dx = 0; dx < 2; ++dx) {
+                        const float* pw =
+                            &pixelWeights_[(static_cast<size_t>(2 * by + dy) * width_ + 2 * bx +
+                                            dx) *
+                                           9];
+                        for (int oy = 0; oy < 3; ++oy)
+                            for (int ox = 0; ox < 3; ++ox)
+                                bwt[(oy + dy) * 4 + ox + dx] += pw[oy * 3 + ox];
+                    }
+            }
+        });
+    }
     inverseSum_.assign(static_cast<size_t>(width_) * height_, 0.0f);
     tbb::parallel_for(0, height_, [&](int py) {
         for (int px = 0; px < width_; ++px) {
@@ -189,7 +213,8 @@ void SampleLayout::prepareFilter() {
     });
 }
 
-void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out) const {
+void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out,
+                           bool quads) const {
     if (out.width != width_ || out.height != height_) out = Image(width_, height_);
     const size_t taps = static_cast<size_t>(taps_), spp = static_cast<size_t>(spp_);
     const float* weights = weights_.data();
@@ -205,14 +230,61 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
     // a pixel's samples are summed in registers and the nine pixels they reach read and
     // written once: read-modify-writes, each waiting on the last through memory, were what
     // the resolve's time went to (Resolve benchmarks: 1.5-1.8x faster).
+    // Shaded per 2x2 pixels, a block whose four pixels are alike and hold the same color
+    // goes in one step: 16 pixels reached, against 36 for four pixels (1.3x faster
+    // resolves at one sample a pixel; looking for such blocks in frames shaded otherwise
+    // costs more than it finds).
+    const bool blocks = quads && uniform && reach == 1 && !blockWeights_.empty();
+    const int blocksX = width / 2;
+    const float* blockWeights = blockWeights_.data();
+    auto blockAlike = [&](int bx, int by) {
+        const size_t p = static_cast<size_t>(2 * by) * width + 2 * bx;
+        if (!(uniform[p] && uniform[p + 1] && uniform[p + width] && uniform[p + width + 1]))
+            return false;
+        // Bit for bit, as the dynamic phase marks alike pixels.
+        uint64_t first[2];
+        std::memcpy(first, rgba + 4 * p * spp, 16);
+        auto same = [&](size_t q) {
+            uint64_t other[2];
+            std::memcpy(other, rgba + 4 * q * spp, 16);
+            return ((first[0] ^ other[0]) | (first[1] ^ other[1])) == 0;
+        };
+        return same(p + 1) && same(p + width) && same(p + width + 1);
+    };
     constexpr int kBand = 8;
     tbb::parallel_for(0, (height + kBand - 1) / kBand, [&](int band) {
         const int r0 = band * kBand, r1 = std::min(height, r0 + kBand);
         std::fill(pixels + static_cast<size_t>(r0) * width * 4,
                   pixels + static_cast<size_t>(r1) * width * 4, 0.0f);
-        for (int qy = std::max(0, r0 - reach); qy < std::min(height, r1 + reach); ++qy) {
+        // From an even row, so every 2x2 block in reach is met at its top row.
+        for (int qy = std::max(0, r0 - reach) & ~1; qy < std::min(height, r1 + reach); ++qy) {
             const int py0 = std::max(r0, qy - reach), py1 = std::min(r1 - 1, qy + reach);
+            const int by = qy / 2;
+            const bool blockRow = blocks && by >= 1 && 2 * by + 2 < height;
+            bool alike = false;  // the current block's, found at its left column
             for (int qx = 0; qx < width; ++qx) {
+                if (qx % 2 == 0)
+                    alike = blockRow && qx >= 2 && qx + 3 < width && blockAlike(qx / 2, by);
+                if (alike) {
+                    // A 2x2 block shaded once (at one shading point per 2x2 pixels): its one
+                    // color to the 4 x 4 pixels it reaches, from its top row, for both.
+                    if (qy % 2 == 0 && qx % 2 == 0) {
+                        const float* w =
+                            blockWeights + (static_cast<size_t>(by) * blocksX + qx / 2) * 16;
+                        const Float4 c =
+                            loadFloat4(rgba + 4 * (static_cast<size_t>(qy) * width + qx) * spp);
+                        for (int py = std::max(r0, qy - 1); py <= std::min(r1 - 1, qy + 2); ++py) {
+                            const float* wr = w + 4 * (py - qy + 1);
+                            float* o = pixels + (static_cast<size_t>(py) * width + qx - 1) * 4;
+                            storeFloat4(o, loadFloat4(o) + wr[0] * c);
+                            storeFloat4(o + 4, loadFloat4(o + 4) + wr[1] * c);
+                            storeFloat4(o + 8, loadFloat4(o + 8) + wr[2] * c);
+                            storeFloat4(o + 12, loadFloat4(o + 12) + wr[3] * c);
+                        }
+                    }
+                    continue;
+                }
+                if (py0 > py1) continue;  // a row read for the blocks it starts
                 const int px0 = std::max(0, qx - reach), px1 = std::min(width - 1, qx + reach);
                 const size_t pixel = static_cast<size_t>(qy) * width + qx;
                 const size_t first = pixel * spp;

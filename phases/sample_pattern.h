@@ -68,9 +68,11 @@ class SampleLayout {
     // Pixels from per-sample RGBA (4 floats per sample, index order): each pixel is the
     // filter-weighted mean of the samples within the filter's radius of its centre.
     // `uniform` (per pixel, may be null): 1 where every sample of the pixel holds the same
-    // RGBA as its first, which is then read once. `out` keeps its storage when its size is
-    // the layout's.
-    void resolve(const float* rgba, const uint8_t* uniform, Image& out) const;
+    // RGBA as its first, which is then read once. `quads`: the frame was shaded once per
+    // 2x2 pixels, so whole 2x2 blocks of uniform pixels holding one RGBA are looked for and
+    // read once (with `uniform` only). `out` keeps its storage when its size is the
+    // layout's.
+    void resolve(const float* rgba, const uint8_t* uniform, Image& out, bool quads = false) const;
 
   private:
     void prepareFilter();
@@ -91,6 +93,7 @@ class SampleLayout {
     int reach_ = 1, taps_ = 3;
     std::vector<float> weights_;
     std::vector<float> pixelWeights_;  // per pixel: taps x taps, its samples' weights summed
+    std::vector<float> blockWeights_;  // per whole 2x2 block (reach 1): 4 x 4, summed
     std::vector<float> inverseSum_;    // per pixel: 1 / the sum of the weights reaching it
 };
 

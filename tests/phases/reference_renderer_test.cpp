@@ -239,6 +239,36 @@ TEST(PixelFilter, UniformPixelsResolveAsTheirSamples) {
     for (size_t i = 0; i < a.rgba.size(); ++i) ASSERT_NEAR(a.rgba[i], b.rgba[i], 1e-6f);
 }
 
+TEST(PixelFilter, BlocksShadedOnceResolveAsTheirSamples) {
+    // Shading once per 2x2 pixels: most blocks' four pixels hold one color and go to the
+    // resolve as one; a block with one pixel of another color, or one pixel whose samples
+    // differ, must not. Over three bands of rows (8 each) and odd sizes, so blocks meet
+    // band edges and the image's last, partial, row and column.
+    for (int spp : {1, 2}) {
+        const int w = 21, h = 19;
+        const SampleLayout layout(w, h, spp, 7u);
+        std::vector<float> rgba(layout.count() * 4);
+        std::vector<uint8_t> uniform(static_cast<size_t>(w) * h);
+        for (int py = 0; py < h; ++py)
+            for (int px = 0; px < w; ++px) {
+                const int bx = px / 2, by = py / 2;
+                const bool odd = (bx + 2 * by) % 5 == 0 && px % 2 == 1 && py % 2 == 0;
+                const bool mixed = (bx + by) % 7 == 3 && px % 2 == 0 && py % 2 == 1;
+                uniform[static_cast<size_t>(py) * w + px] = mixed ? 0 : 1;
+                for (int k = 0; k < spp; ++k)
+                    for (int c = 0; c < 4; ++c)
+                        rgba[4 * layout.index(px, py, k) + c] = 0.1f * c + 0.05f * bx + 0.03f * by +
+                                                                (odd ? 0.2f : 0.0f) +
+                                                                (mixed ? 0.07f * (k + 1) : 0.0f);
+            }
+        Image a, b;
+        layout.resolve(rgba.data(), nullptr, a);
+        layout.resolve(rgba.data(), uniform.data(), b, true);
+        for (size_t i = 0; i < a.rgba.size(); ++i)
+            ASSERT_NEAR(a.rgba[i], b.rgba[i], 1e-6f) << spp << " spp, pixel " << i / 4;
+    }
+}
+
 TEST(SamplePattern, CentroidsAndNearestSamplesOfPixelsAndQuads) {
     // Computed again here in double, by brute force.
     const SampleLayout layout(7, 5, 3, 11u);
