@@ -53,7 +53,9 @@ void BackgroundFiller::retain(const std::function<bool(const BackgroundJob&)>& k
 void BackgroundFiller::pause() {
     std::unique_lock<std::mutex> lock(mutex_);
     paused_ = true;
+    abandon_.store(true, std::memory_order_relaxed);
     idle_.wait(lock, [&] { return !busy_; });
+    abandon_.store(false, std::memory_order_relaxed);
 }
 
 void BackgroundFiller::resume(uint32_t stamp) {
@@ -134,7 +136,8 @@ void BackgroundFiller::run() {
             }
             makeRoom(wanted, stamp, evicted);
         }
-        if (room && !missing.empty()) arena.execute([&] { filled = map->fill(missing).tiles; });
+        if (room && !missing.empty())
+            arena.execute([&] { filled = map->fill(missing, &abandon_).tiles; });
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         map.reset();  // here, not after the controller sees the worker idle

@@ -20,6 +20,7 @@
 // fill, evict and reclaim.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -85,6 +86,9 @@ class BackgroundFiller {
     size_t next_ = 0;
     bool idlePriority_;
     bool paused_ = true, busy_ = false, stop_ = false;
+    // Set while pause() waits: the fill in progress drops its level and returns, so a
+    // frame waits for at most a run of the static shader, not a whole tile.
+    std::atomic<bool> abandon_{false};
     bool waitForReclaim_ = false;  // the cache is full: nothing more until the next frame
     uint32_t stamp_ = 0;
     BackgroundTotals totals_;

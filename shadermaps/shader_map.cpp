@@ -17,6 +17,34 @@ namespace mpshade {
 namespace {
 
 // Per thread: the fill's batches, reused from tile to tile.
+// Background fills run the static shader in runs of this many points, checking between
+// them whether to stop (ShaderMap::fill's `abandon`); with more channels than this, whole.
+constexpr size_t kAbandonPoints = ShaderKernel::kLanes;
+constexpr size_t kMaxChunkedChannels = 64;
+
+// `in` and `out` moved on to point `begin` of their batch.
+void offsetBatch(ShadingInputs& in, ShadingOutputs& out, size_t begin, size_t channels,
+                 const float** inChannels, float** outChannels) {
+    for (const float** p : {in.P, in.N, in.Ng, in.dPdu, in.dPdv, in.I})
+        for (int a = 0; a < 3; ++a)
+            if (p[a]) p[a] += begin;
+    for (const float** p : {&in.u, &in.v, &in.s, &in.t})
+        if (*p) *p += begin;
+    if (in.channels) {
+        for (size_t c = 0; c < channels; ++c)
+            inChannels[c] = in.channels[c] ? in.channels[c] + begin : nullptr;
+        in.channels = inChannels;
+    }
+    for (float** p : {out.Ci, out.Oi})
+        for (int a = 0; a < 3; ++a)
+            if (p[a]) p[a] += begin;
+    if (out.channels) {
+        for (size_t c = 0; c < channels; ++c)
+            outChannels[c] = out.channels[c] ? out.channels[c] + begin : nullptr;
+        out.channels = outChannels;
+    }
+}
+
 struct FillScratch {
     ShadingBatch batch;
     std::vector<ChartPoint> points;
@@ -100,10 +128,11 @@ void ShaderMap::store(int slot, size_t at, float value) {
         reinterpret_cast<float*>(tileData(slot))[at] = value;
 }
 
-void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
+bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                          const PendingTiles& pending, ShadingBatch& scratch,
                          std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
-                         std::vector<float>& workspace, FillStats& stats) {
+                         std::vector<float>& workspace, FillStats& stats,
+                         const std::atomic<bool>* abandon) {
     const int res = resolution(key.level);
     const int T = options_.tileSize, border = options_.border;
     const int k = options_.prefilter == Prefilter::Box
@@ -184,7 +213,21 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                              len > 0.0f ? toP / len : glm::vec3(0.0f, 0.0f, -1.0f));
         }
         ShadingCounters counters;
-        kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters);
+        if (!abandon || channels > kMaxChunkedChannels) {
+            kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters);
+        } else {
+            // In runs of kAbandonPoints, so a request to stop is seen within one of them.
+            const float* inChannels[kMaxChunkedChannels];
+            float* outChannels[kMaxChunkedChannels];
+            for (size_t begin = 0; begin < n; begin += kAbandonPoints) {
+                if (abandon->load(std::memory_order_relaxed)) return false;
+                ShadingInputs in = scratch.in;
+                ShadingOutputs out = scratch.out;
+                offsetBatch(in, out, begin, channels, inChannels, outChannels);
+                kernel_.run(uniforms_, in, std::min(kAbandonPoints, n - begin), out, workspace,
+                            counters);
+            }
+        }
         float* const* channelOut = scratch.out.channels;
         const float inv = 1.0f / static_cast<float>(k * k);
         size_t first = 0;
@@ -205,6 +248,7 @@ void ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
     ++stats.tiles;
     stats.texels += static_cast<uint64_t>(validW) * static_cast<uint64_t>(validH);
     stats.programRuns += n;
+    return true;
 }
 
 ShaderMap::Neighbours ShaderMap::neighboursOf(const TileKey& key,
@@ -261,7 +305,7 @@ void ShaderMap::copyBorders(const TileKey& key, int slot, const PendingTiles& pe
         }
 }
 
-FillStats ShaderMap::fill(std::span<const TileKey> keys) {
+FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>* abandon) {
     std::lock_guard<std::mutex> lock(fillMutex_);
     std::vector<TileKey> work;
     std::unordered_set<uint64_t> seen;
@@ -274,6 +318,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys) {
     if (work.empty()) return {};
     std::stable_sort(work.begin(), work.end(),
                      [](const TileKey& a, const TileKey& b) { return a.level < b.level; });
+    uint64_t abandonedTiles = 0;  // whole, but in a level dropped
     tbb::enumerable_thread_specific<FillScratch> scratch;
     for (size_t begin = 0; begin < work.size();) {
         size_t end = begin;
@@ -303,12 +348,20 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys) {
         PendingTiles pending;
         for (size_t w = begin; w < end; ++w)
             pending.emplace(work[w].packed(), plan[w - begin].first);
+        std::atomic<uint64_t> whole{0};
         tbb::parallel_for(begin, end, [&](size_t w) {
             enableFlushToZero();
             FillScratch& s = scratch.local();
-            fillTile(work[w], plan[w - begin].first, plan[w - begin].second, pending, s.batch,
-                     s.points, s.geometry, s.workspace, s.stats);
+            if (fillTile(work[w], plan[w - begin].first, plan[w - begin].second, pending, s.batch,
+                         s.points, s.geometry, s.workspace, s.stats, abandon))
+                whole.fetch_add(1, std::memory_order_relaxed);
         });
+        if (whole.load() < end - begin) {
+            // Abandoned: none of the level is published, so no probe can hold its slots.
+            for (size_t w = begin; w < end; ++w) pool_->free(plan[w - begin].first);
+            abandonedTiles += whole.load();
+            break;
+        }
         // A texel is the same wherever it is evaluated (the program sees only its chart
         // point), so borders inside the chart come from the neighbouring tile when that is
         // resident: a 16 x 16 tile with a 1-texel border evaluates 256 texels, not 324.
@@ -321,6 +374,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys) {
     }
     FillStats done;
     for (const FillScratch& s : scratch) done += s.stats;
+    done.tiles -= abandonedTiles;
     fillStats_ += done;
     return done;
 }

@@ -132,7 +132,10 @@ class ShaderMap {
     // so coarser tiles can be built from their children. Returns what this call did.
     // Probes may run alongside (on other threads): a tile appears to them once it is whole,
     // a level at a time. One fill (or evict) of a map runs at a time; others wait.
-    FillStats fill(std::span<const TileKey> keys);
+    // `abandon` (may be null): checked between runs of the static shader of at most 128
+    // points; once it is set, the level being filled is dropped unpublished (its slots
+    // freed) and the call returns, so whoever set it waits for a fraction of a tile.
+    FillStats fill(std::span<const TileKey> keys, const std::atomic<bool>* abandon = nullptr);
     // Fills every tile of the levels in [first, last] (inclusive) of every chart.
     void fillLevels(int first, int last);
     const FillStats& fillStats() const { return fillStats_; }
@@ -191,10 +194,11 @@ class ShaderMap {
     using PendingTiles = std::unordered_map<uint64_t, int>;
     const unsigned char* tileData(int slot) const { return pool_->data(slot); }
     unsigned char* tileData(int slot) { return pool_->data(slot); }
-    void fillTile(const TileKey& key, int slot, bool fromChildren, const PendingTiles& pending,
+    // False if `abandon` was set before the tile was whole.
+    bool fillTile(const TileKey& key, int slot, bool fromChildren, const PendingTiles& pending,
                   ShadingBatch& scratch, std::vector<ChartPoint>& points,
                   std::vector<SurfaceSample>& geometry, std::vector<float>& workspace,
-                  FillStats& stats);
+                  FillStats& stats, const std::atomic<bool>* abandon);
     void store(int slot, size_t at, float value);
     // The slots of the eight tiles around `key` in its chart and level (-1: not resident,
     // or beyond the level), found once per tile; a border (at most a tile wide) lies in

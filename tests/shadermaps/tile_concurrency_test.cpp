@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <random>
 #include <thread>
@@ -118,6 +119,59 @@ TEST(TileConcurrency, ProbesReadWholeTilesWhileTilesAreFilledAndDropped) {
     EXPECT_GT(retired, 100u);
     EXPECT_GT(fallbacks.load(), 0u);
     EXPECT_GT(probes.load(), fallbacks.load());
+}
+
+TEST(TileConcurrency, AnAbandonedFillPublishesNothingAndKeepsNoStorage) {
+    // A background fill is told to stop when a frame starts: the level it was filling must
+    // not appear (its tiles may be half evaluated) and its slots must go back to the pool.
+    const Surface surface = Plane{4.0f, 4.0f};
+    FactorOptions store;
+    store.storeAboveCost = 0;
+    const FactoredShader factored = factorShader(
+        *compileShaderText("uv.sl", "surface uv() { Ci = color(bake(u), bake(v), 0); }"), {},
+        store);
+    const ShaderKernel kernel(factored.staticPart);
+    ShaderMapOptions options;
+    options.resolution = 512;  // level 0: 32 x 32 tiles
+    options.alwaysResidentLevels = 3;
+    ShaderMap map(surface, kernel, ShadingUniforms{}, options);
+    const size_t pinnedHeld = map.pool()->tilesHeld(), pinnedResident = map.residentTiles();
+    std::vector<TileKey> keys;
+    for (uint16_t ty = 0; ty < 32; ++ty)
+        for (uint16_t tx = 0; tx < 32; ++tx) keys.push_back({0, 0, tx, ty});
+    for (uint16_t ty = 0; ty < 4; ++ty)
+        for (uint16_t tx = 0; tx < 4; ++tx) keys.push_back({0, 1, tx, ty});
+
+    // Told before it starts: nothing at all.
+    const std::atomic<bool> stopNow{true};
+    EXPECT_EQ(map.fill(keys, &stopNow).tiles, 0u);
+    EXPECT_EQ(map.residentTiles(), pinnedResident);
+    EXPECT_EQ(map.pool()->tilesHeld(), pinnedHeld);
+
+    // Told while it runs (whenever that lands): the levels published are whole, the one
+    // under way is gone, and every slot held is a resident tile's.
+    std::atomic<bool> stop{false};
+    std::thread stopper([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        stop = true;
+    });
+    const uint64_t filled = map.fill(keys, &stop).tiles;
+    stopper.join();
+    EXPECT_EQ(map.residentTiles(), pinnedResident + filled);
+    EXPECT_EQ(map.pool()->tilesHeld(), pinnedHeld + filled);
+    EXPECT_TRUE(filled == 0 || filled == 1024 || filled == keys.size()) << filled;
+    for (const TileKey& key : keys)
+        if (map.resident(key)) {
+            float texel[2];
+            const int i = key.tx * 16 + 5, j = key.ty * 16 + 9;  // a texel of this tile
+            map.texel(key, map.slotOf(key), i, j, texel);
+            const float res = static_cast<float>(map.resolution(key.level));
+            ASSERT_NEAR(texel[0], (i + 0.5f) / res, 1e-5f);
+            ASSERT_NEAR(texel[1], (j + 0.5f) / res, 1e-5f);
+        }
+
+    // Not told: all of it.
+    EXPECT_EQ(map.fill(keys).tiles, keys.size() - filled);
 }
 
 }  // namespace
