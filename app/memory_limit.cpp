@@ -17,6 +17,9 @@ namespace {
 constexpr uint64_t kMultiphaseBytesPerSample = 240;
 constexpr uint64_t kReferenceBytesPerSample = 55;
 constexpr uint64_t kBaseBytes = uint64_t{300} << 20;
+// Per pixel of each renderer's sample layout: the filter weights summed per pixel (9
+// floats), per 2x2 block (16 floats, 4 a pixel) and their inverse sum (SampleLayout).
+constexpr uint64_t kFilterBytesPerPixel = (9 + 4 + 1) * sizeof(float);
 
 std::string gigabytes(uint64_t bytes) {
     char buf[32];
@@ -47,10 +50,15 @@ FrameMemoryEstimate estimateFrameMemory(int width, int height, int spp, bool mul
     const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
     FrameMemoryEstimate e;
     e.bytes = kBaseBytes + pixels * 16 * 4;  // frames of each renderer and the written copies
-    if (multiphase) e.bytes += pixels * static_cast<uint64_t>(spp) * kMultiphaseBytesPerSample;
-    if (reference) e.bytes += pixels * static_cast<uint64_t>(spp) * kReferenceBytesPerSample;
+    if (multiphase)
+        e.bytes += pixels *
+                   (static_cast<uint64_t>(spp) * kMultiphaseBytesPerSample + kFilterBytesPerPixel);
+    if (reference)
+        e.bytes +=
+            pixels * (static_cast<uint64_t>(spp) * kReferenceBytesPerSample + kFilterBytesPerPixel);
     if (truthSpp > 0)
-        e.bytes += pixels * static_cast<uint64_t>(truthSpp) * kReferenceBytesPerSample;
+        e.bytes += pixels * (static_cast<uint64_t>(truthSpp) * kReferenceBytesPerSample +
+                             kFilterBytesPerPixel);
     e.what = std::to_string(width) + "x" + std::to_string(height) + " pixels at " +
              std::to_string(spp) + " samples" +
              (multiphase && reference ? " (multiphase and reference)"
