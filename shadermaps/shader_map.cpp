@@ -17,34 +17,6 @@ namespace mpshade {
 namespace {
 
 // Per thread: the fill's batches, reused from tile to tile.
-// Background fills run the static shader in runs of this many points, checking between
-// them whether to stop (ShaderMap::fill's `abandon`); with more channels than this, whole.
-constexpr size_t kAbandonPoints = ShaderKernel::kLanes;
-constexpr size_t kMaxChunkedChannels = 64;
-
-// `in` and `out` moved on to point `begin` of their batch.
-void offsetBatch(ShadingInputs& in, ShadingOutputs& out, size_t begin, size_t channels,
-                 const float** inChannels, float** outChannels) {
-    for (const float** p : {in.P, in.N, in.Ng, in.dPdu, in.dPdv, in.I})
-        for (int a = 0; a < 3; ++a)
-            if (p[a]) p[a] += begin;
-    for (const float** p : {&in.u, &in.v, &in.s, &in.t})
-        if (*p) *p += begin;
-    if (in.channels) {
-        for (size_t c = 0; c < channels; ++c)
-            inChannels[c] = in.channels[c] ? in.channels[c] + begin : nullptr;
-        in.channels = inChannels;
-    }
-    for (float** p : {out.Ci, out.Oi})
-        for (int a = 0; a < 3; ++a)
-            if (p[a]) p[a] += begin;
-    if (out.channels) {
-        for (size_t c = 0; c < channels; ++c)
-            outChannels[c] = out.channels[c] ? out.channels[c] + begin : nullptr;
-        out.channels = outChannels;
-    }
-}
-
 struct FillScratch {
     ShadingBatch batch;
     std::vector<ChartPoint> points;
@@ -213,21 +185,9 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                              len > 0.0f ? toP / len : glm::vec3(0.0f, 0.0f, -1.0f));
         }
         ShadingCounters counters;
-        if (!abandon || channels > kMaxChunkedChannels) {
-            kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters);
-        } else {
-            // In runs of kAbandonPoints, so a request to stop is seen within one of them.
-            const float* inChannels[kMaxChunkedChannels];
-            float* outChannels[kMaxChunkedChannels];
-            for (size_t begin = 0; begin < n; begin += kAbandonPoints) {
-                if (abandon->load(std::memory_order_relaxed)) return false;
-                ShadingInputs in = scratch.in;
-                ShadingOutputs out = scratch.out;
-                offsetBatch(in, out, begin, channels, inChannels, outChannels);
-                kernel_.run(uniforms_, in, std::min(kAbandonPoints, n - begin), out, workspace,
-                            counters);
-            }
-        }
+        // A background fill stops within one run of the kernel's lanes when told to.
+        if (!kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters, abandon))
+            return false;
         float* const* channelOut = scratch.out.channels;
         const float inv = 1.0f / static_cast<float>(k * k);
         size_t first = 0;

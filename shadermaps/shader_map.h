@@ -132,9 +132,10 @@ class ShaderMap {
     // so coarser tiles can be built from their children. Returns what this call did.
     // Probes may run alongside (on other threads): a tile appears to them once it is whole,
     // a level at a time. One fill (or evict) of a map runs at a time; others wait.
-    // `abandon` (may be null): checked between runs of the static shader of at most 128
-    // points; once it is set, the level being filled is dropped unpublished (its slots
-    // freed) and the call returns, so whoever set it waits for a fraction of a tile.
+    // `abandon` (may be null): checked between runs of the static shader of
+    // ShaderKernel::kLanes (128) points; once it is set, the level being filled is dropped
+    // unpublished (its slots freed) and the call returns, so whoever set it waits for a
+    // fraction of a tile.
     FillStats fill(std::span<const TileKey> keys, const std::atomic<bool>* abandon = nullptr);
     // Fills every tile of the levels in [first, last] (inclusive) of every chart.
     void fillLevels(int first, int last);

@@ -95,9 +95,9 @@ ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
     for (int v : program.channelOutputs) channelRegs_.push_back(reg[static_cast<size_t>(v)]);
 }
 
-void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in, size_t n,
+bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in, size_t n,
                        const ShadingOutputs& out, std::vector<float>& workspace,
-                       ShadingCounters& counters) const {
+                       ShadingCounters& counters, const std::atomic<bool>* stop) const {
     const size_t need = static_cast<size_t>(registerCount_) * kLanes;
     if (workspace.size() < need) workspace.resize(need);
     float* regs = workspace.data();
@@ -105,6 +105,7 @@ void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
     for (const auto& [r, value] : constants_) std::fill_n(R(r), kLanes, value);
 
     for (size_t start = 0; start < n; start += kLanes) {
+        if (stop && stop->load(std::memory_order_relaxed)) return false;
         const int m = static_cast<int>(std::min<size_t>(kLanes, n - start));
         for (const ExecInst& e : code_) {
             float* o = R(e.out[0]);
@@ -258,6 +259,7 @@ void ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
         counters.instructions += code_.size() * static_cast<uint64_t>(m);
     }
     counters.points += n;
+    return true;
 }
 
 }  // namespace mpshade

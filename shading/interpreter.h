@@ -7,6 +7,7 @@
 // vectorize: no virtual calls, name lookups or allocation per sample.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -87,10 +88,12 @@ class ShaderKernel {
     size_t instructionCount() const { return code_.size(); }
 
     // Runs the program on n points. `workspace` is scratch owned by the caller (one per
-    // thread); it is sized on first use and then reused without allocation.
-    void run(const ShadingUniforms& uniforms, const ShadingInputs& in, size_t n,
-             const ShadingOutputs& out, std::vector<float>& workspace,
-             ShadingCounters& counters) const;
+    // thread); it is sized on first use and then reused without allocation. `stop` (may
+    // be null) is checked before each run of kLanes points: once it is set, the rest are
+    // not run and the call returns false.
+    bool run(const ShadingUniforms& uniforms, const ShadingInputs& in, size_t n,
+             const ShadingOutputs& out, std::vector<float>& workspace, ShadingCounters& counters,
+             const std::atomic<bool>* stop = nullptr) const;
 
   private:
     IrProgram program_;
