@@ -256,8 +256,9 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
         const int r0 = band * kBand, r1 = std::min(height, r0 + kBand);
         std::fill(pixels + static_cast<size_t>(r0) * width * 4,
                   pixels + static_cast<size_t>(r1) * width * 4, 0.0f);
-        // From an even row, so every 2x2 block in reach is met at its top row.
-        for (int qy = std::max(0, r0 - reach) & ~1; qy < std::min(height, r1 + reach); ++qy) {
+        // With blocks, from an even row, so every 2x2 block in reach is met at its top row.
+        const int firstRow = std::max(0, r0 - reach) & (blocks ? ~1 : ~0);
+        for (int qy = firstRow; qy < std::min(height, r1 + reach); ++qy) {
             const int py0 = std::max(r0, qy - reach), py1 = std::min(r1 - 1, qy + reach);
             const int by = qy / 2;
             const bool blockRow = blocks && by >= 1 && 2 * by + 2 < height;
