@@ -278,12 +278,23 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
     if (work.empty()) return {};
     std::stable_sort(work.begin(), work.end(),
                      [](const TileKey& a, const TileKey& b) { return a.level < b.level; });
-    uint64_t abandonedTiles = 0;  // whole, but in a level dropped
+    // Whether a tile of this level may be built from its children: then its level waits for
+    // the one below to be published. Otherwise the levels have nothing to wait for and are
+    // filled in one parallel pass: a pass per level had left a core idle at each level's
+    // last tiles (the vase's fills, 5-7 levels a frame with a few tiles each, kept 1.6-1.9
+    // of 2 cores busy).
+    auto buildsFromChildren = [&](int level) {
+        return level > 0 && options_.prefilter == Prefilter::Box &&
+               (1 << std::min(level, 20)) <= options_.supersampleLimit;
+    };
+    uint64_t abandonedTiles = 0;  // whole, but in a pass dropped
     tbb::enumerable_thread_specific<FillScratch> scratch;
     for (size_t begin = 0; begin < work.size();) {
         size_t end = begin;
-        while (end < work.size() && work[end].level == work[begin].level) ++end;
-        // Slots for this level's tiles, storage grown once; whether each can be built from
+        while (end < work.size() &&
+               (work[end].level == work[begin].level || !buildsFromChildren(work[end].level)))
+            ++end;
+        // Slots for this pass's tiles, storage grown once; whether each can be built from
         // its children (resident now, this batch's finer levels included).
         std::vector<std::pair<int, bool>> plan(end - begin);
         for (size_t w = begin; w < end; ++w) {
@@ -291,8 +302,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
             // From the children only where that is exactly what evaluating it would give
             // (their texel centres are its k x k samples), so what a tile holds does not
             // depend on which tiles happened to be resident.
-            bool children = key.level > 0 && options_.prefilter == Prefilter::Box &&
-                            (1 << std::min<int>(key.level, 20)) <= options_.supersampleLimit;
+            bool children = buildsFromChildren(key.level);
             for (int q = 0; q < 4 && children; ++q) {
                 const int ctx = std::min(2 * key.tx + (q & 1), tilesPerSide(key.level - 1) - 1);
                 const int cty = std::min(2 * key.ty + (q >> 1), tilesPerSide(key.level - 1) - 1);
@@ -303,7 +313,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
             const int slot = pool_->allocate(this, key.packed(), pinned, useStamp());
             plan[w - begin] = {slot, children};
         }
-        // The level's tiles are published once whole (probes may be reading the map); till
+        // The pass's tiles are published once whole (probes may be reading the map); till
         // then their borders find one another here.
         PendingTiles pending;
         for (size_t w = begin; w < end; ++w)
@@ -317,7 +327,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
                 whole.fetch_add(1, std::memory_order_relaxed);
         });
         if (whole.load() < end - begin) {
-            // Abandoned: none of the level is published, so no probe can hold its slots.
+            // Abandoned: none of the pass is published, so no probe can hold its slots.
             for (size_t w = begin; w < end; ++w) pool_->free(plan[w - begin].first);
             abandonedTiles += whole.load();
             break;

@@ -131,9 +131,12 @@ class ShaderMap {
     // Fills the tiles that are not resident yet: batched, in parallel, finest level first
     // so coarser tiles can be built from their children. Returns what this call did.
     // Probes may run alongside (on other threads): a tile appears to them once it is whole,
-    // a level at a time. One fill (or evict) of a map runs at a time; others wait.
+    // with the others of its pass. A pass is every tile asked for, except that a level whose
+    // tiles may be built from their children (Prefilter::Box with supersampleLimit >= 2)
+    // starts a pass of its own, after the level below is published. One fill (or evict) of
+    // a map runs at a time; others wait.
     // `abandon` (may be null): checked between runs of the static shader of
-    // ShaderKernel::kLanes (128) points; once it is set, the level being filled is dropped
+    // ShaderKernel::kLanes (128) points; once it is set, the pass under way is dropped
     // unpublished (its slots freed) and the call returns, so whoever set it waits for a
     // fraction of a tile.
     FillStats fill(std::span<const TileKey> keys, const std::atomic<bool>* abandon = nullptr);

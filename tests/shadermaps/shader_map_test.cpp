@@ -1,5 +1,6 @@
 // Shader maps and probes: exact at texel centres, trilinear exact on linear functions,
 // Feline close to EWA, residency fallback, half precision, degenerate footprints.
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <random>
@@ -598,6 +599,40 @@ TEST(ShaderMap, TilesBuiltFromTheirChildrenAreTheirBoxMean) {
             direct.texel(key, direct.slotOf(key), i, j, b);
             for (int c = 0; c < 3; ++c) ASSERT_NEAR(a[c], b[c], 1e-5f) << i << "," << j;
         }
+}
+
+TEST(ShaderMap, OneFillOfManyLevelsBuildsEachFromTheLevelBelowItFilled) {
+    // Levels 0, 1 and 2 asked for in one call: level 1 waits for level 0 to be published and
+    // is built from it; levels that cannot be built from children (level 2, over the
+    // supersample limit) share a pass with it. The texels are those of separate fills.
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;
+    options.resolution = 64;
+    options.alwaysResidentLevels = 0;
+    options.supersampleLimit = 2;
+    std::vector<TileKey> keys;
+    for (uint16_t level = 0; level < 3; ++level) {
+        const int tiles = std::max(1, (64 >> level) / options.tileSize);
+        for (uint16_t ty = 0; ty < tiles; ++ty)
+            for (uint16_t tx = 0; tx < tiles; ++tx) keys.push_back({0, level, tx, ty});
+    }
+    std::reverse(keys.begin(), keys.end());  // coarsest first: the fill orders them itself
+    ShaderMap once(f.surface, *f.kernel, f.uniforms, options);
+    once.fill(keys);
+    EXPECT_EQ(once.fillStats().tiles, keys.size());
+    EXPECT_EQ(once.fillStats().tilesFromChildren, 4u);  // level 1's four tiles
+    ShaderMap apart(f.surface, *f.kernel, f.uniforms, options);
+    for (int level = 0; level < 3; ++level) apart.fillLevels(level, level);
+    for (int level = 0; level < 3; ++level)
+        for (int j = 0; j < (64 >> level); ++j)
+            for (int i = 0; i < (64 >> level); ++i) {
+                const TileKey key = once.tileOf(0, level, i, j);
+                float a[3], b[3];
+                once.texel(key, once.slotOf(key), i, j, a);
+                apart.texel(key, apart.slotOf(key), i, j, b);
+                for (int c = 0; c < 3; ++c)
+                    ASSERT_NEAR(a[c], b[c], 1e-5f) << level << ": " << i << "," << j;
+            }
 }
 
 TEST(TilePool, MapsShareItAndEvictedSlotsAreReused) {
