@@ -1,5 +1,6 @@
 #include "geometry/ray_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -206,6 +207,34 @@ bool SurfaceRayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float
     ray.mask = 0xFFFFFFFFu;
     rtcOccluded1(scene_, &ctx, &ray);
     return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
+}
+
+void SurfaceRayScene::occluded(const float* const org[3], const float* const dir[3],
+                               const uint8_t* active, int n, float tnear, float tfar,
+                               uint8_t* blocked) const {
+    constexpr int kStream = 64;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    alignas(16) RTCRay rays[kStream];
+    for (int first = 0; first < n; first += kStream) {
+        const int count = std::min(kStream, n - first);
+        for (int k = 0; k < count; ++k) {
+            const int i = first + k;
+            RTCRay& ray = rays[k];
+            ray = RTCRay{};
+            ray.org_x = org[0][i], ray.org_y = org[1][i], ray.org_z = org[2][i];
+            ray.dir_x = dir[0][i], ray.dir_y = dir[1][i], ray.dir_z = dir[2][i];
+            // Inactive: tnear above tfar (Embree's rule for streams).
+            const bool on = !active || active[i];
+            ray.tnear = on ? tnear : 1.0f;
+            ray.tfar = on ? tfar : 0.0f;
+            ray.mask = 0xFFFFFFFFu;
+        }
+        rtcOccluded1M(scene_, &ctx, rays, static_cast<unsigned>(count), sizeof(RTCRay));
+        for (int k = 0; k < count; ++k)
+            blocked[first + k] = (!active || active[first + k]) && rays[k].tfar < 0.0f ? 1 : 0;
+    }
 }
 
 }  // namespace mpshade

@@ -1,5 +1,6 @@
 #include "shading/lighting.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -196,32 +197,56 @@ uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,
         for (int l = 0; l < m; ++l) out[l] = 1.0f;
         return 0;
     }
+    // Ray i of every lane together: neighbouring points (a tile's texels, a band's samples)
+    // send it in nearly one direction from nearly one place, so each such set goes to
+    // Embree as one coherent stream, traced in packets.
+    constexpr int kChunk = 64;
+    float frame[9][kChunk];  // T, B, N per lane, rows
+    float org[3][kChunk], dir[3][kChunk];
+    uint8_t valid[kChunk], blocked[kChunk];
+    int open[kChunk];
+    const float* const orgRows[3] = {org[0], org[1], org[2]};
+    const float* const dirRows[3] = {dir[0], dir[1], dir[2]};
     uint64_t traced = 0;
-    for (int l = 0; l < m; ++l) {
-        const glm::vec3 P(args[0][l], args[1][l], args[2][l]);
-        glm::vec3 N(args[3][l], args[4][l], args[5][l]);
-        const float len = glm::length(N);
-        if (!(len > 0.0f) || !std::isfinite(len) || !std::isfinite(P.x + P.y + P.z)) {
-            out[l] = 1.0f;
-            continue;
+    for (int first = 0; first < m; first += kChunk) {
+        const int count = std::min(kChunk, m - first);
+        int active = 0;
+        for (int k = 0; k < count; ++k) {
+            const int l = first + k;
+            const glm::vec3 P(args[0][l], args[1][l], args[2][l]);
+            glm::vec3 N(args[3][l], args[4][l], args[5][l]);
+            const float len = glm::length(N);
+            valid[k] = (len > 0.0f) && std::isfinite(len) && std::isfinite(P.x + P.y + P.z);
+            open[k] = 0;
+            if (!valid[k]) continue;
+            ++active;
+            N /= len;
+            glm::vec3 T, B;
+            orthonormalBasis(N, T, B);
+            const glm::vec3 origin = P + bias * N;
+            for (int c = 0; c < 3; ++c) {
+                org[c][k] = origin[c];
+                frame[c][k] = T[c], frame[3 + c][k] = B[c], frame[6 + c][k] = N[c];
+            }
         }
-        N /= len;
-        glm::vec3 T, B;
-        orthonormalBasis(N, T, B);
-        const glm::vec3 origin = P + bias * N;
-        int open = 0;
-        for (int i = 0; i < rays; ++i) {
+        for (int i = 0; i < rays && active > 0; ++i) {
             // Hammersley point -> cosine-weighted direction (Malley's method).
             const float u1 = (static_cast<float>(i) + 0.5f) / static_cast<float>(rays);
             const float u2 = radicalInverse2(static_cast<uint32_t>(i));
             const float r = std::sqrt(u1), phi = 2.0f * kPi * u2;
-            const glm::vec3 dir = r * std::cos(phi) * T + r * std::sin(phi) * B +
-                                  std::sqrt(std::fmax(0.0f, 1.0f - u1)) * N;
-            if (!occluder->occluded(origin, dir, 0.0f, std::numeric_limits<float>::infinity()))
-                ++open;
+            const float a = r * std::cos(phi), b = r * std::sin(phi);
+            const float z = std::sqrt(std::fmax(0.0f, 1.0f - u1));
+            for (int k = 0; k < count; ++k)
+                for (int c = 0; c < 3; ++c)
+                    dir[c][k] = a * frame[c][k] + b * frame[3 + c][k] + z * frame[6 + c][k];
+            occluder->occluded(orgRows, dirRows, valid, count, 0.0f,
+                               std::numeric_limits<float>::infinity(), blocked);
+            for (int k = 0; k < count; ++k) open[k] += blocked[k] ? 0 : 1;
         }
-        traced += static_cast<uint64_t>(rays);
-        out[l] = static_cast<float>(open) / static_cast<float>(rays);
+        for (int k = 0; k < count; ++k)
+            out[first + k] =
+                valid[k] ? static_cast<float>(open[k]) / static_cast<float>(rays) : 1.0f;
+        traced += static_cast<uint64_t>(active) * static_cast<uint64_t>(rays);
     }
     return traced;
 }

@@ -6,6 +6,7 @@
 #include <memory>
 #include <random>
 #include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
@@ -180,6 +181,41 @@ TEST(SphereRays, MatchTheAnalyticIntersection) {
         ASSERT_TRUE(rays.intersect(org, dir, 0.0f, 100.0f, hit));
         const float expected = 10.0f - std::sqrt(4.0f - r2);
         EXPECT_NEAR(hit.t, expected, 2e-4f);
+    }
+}
+
+TEST(SphereRays, OcclusionStreamsAnswerEachRayByItsSegment) {
+    // 150 rays (traced in sets of 64) along z at random (x, y): blocked exactly when the
+    // ray's line meets the sphere of radius 2 within its segment [0, tfar], the segment
+    // starting at z = 10 and reaching z = 10 - tfar. Rays marked inactive answer 0.
+    const Surface sphere = Sphere{2.0f};
+    const SurfaceRayScene rays(sphere);
+    constexpr int n = 150;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uni(-2.6f, 2.6f);
+    std::vector<float> ox(n), oy(n), oz(n, 10.0f), dx(n, 0.0f), dy(n, 0.0f), dz(n, -1.0f);
+    std::vector<uint8_t> active(n), blocked(n, 7);
+    for (int i = 0; i < n; ++i) {
+        ox[i] = uni(rng), oy[i] = uni(rng);
+        active[i] = i % 5 != 2;
+    }
+    // Short segments stop at z = 10 - 7.5 = 2.5, above the sphere's top (z = 2): none hit.
+    for (float tfar : {7.5f, 100.0f}) {
+        const float* org[3] = {ox.data(), oy.data(), oz.data()};
+        const float* dir[3] = {dx.data(), dy.data(), dz.data()};
+        rays.occluded(org, dir, active.data(), n, 0.0f, tfar, blocked.data());
+        int hits = 0;
+        for (int i = 0; i < n; ++i) {
+            const float r = std::sqrt(ox[i] * ox[i] + oy[i] * oy[i]);
+            // Away from the silhouette by more than the tessellation's sag.
+            if (std::fabs(r - 2.0f) < 0.01f) continue;
+            const bool expected = active[i] && tfar > 8.0f && r < 2.0f;
+            EXPECT_EQ(blocked[i], expected ? 1 : 0) << "ray " << i << " tfar " << tfar;
+            hits += blocked[i];
+        }
+        if (tfar > 8.0f) {
+            EXPECT_GT(hits, 30);
+        }
     }
 }
 

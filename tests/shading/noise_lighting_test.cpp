@@ -1,7 +1,9 @@
 // Noise is deterministic with documented ranges; lighting and occlusion match their
 // formulas and simple analytic cases.
 #include <cmath>
+#include <limits>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
@@ -167,6 +169,40 @@ TEST(Occlusion, StratifiedDirectionsCountExactlyUnderASphere) {
     float open = -1.0f;
     EXPECT_EQ(occlusionLanes(&rays, 0.0f, 64, args, &open, 1), 64u);
     EXPECT_EQ(open, 48.0f / 64.0f);
+}
+
+TEST(Occlusion, EveryLaneOfALongRunCountsItsOwnRays) {
+    // 150 lanes (rays go to Embree in sets of up to 64 lanes) below the unit sphere at four
+    // distances, with 1 / D^2 = (j + 0.3) / 64: rays 0..j-1 hit, open (64 - j) / 64 exactly
+    // (as in StratifiedDirectionsCountExactlyUnderASphere), and every seventh lane without
+    // a usable normal or point: open 1, no rays traced.
+    const Surface sphere = Sphere{1.0f};
+    const SurfaceRayScene rays(sphere);
+    constexpr int m = 150;
+    const int hits[4] = {4, 10, 16, 22};
+    std::vector<float> in(6 * m, 0.0f);
+    std::vector<float> expected(m);
+    int usable = 0;
+    for (int l = 0; l < m; ++l) {
+        const int j = hits[(l * 3 + l / 5) % 4];
+        in[1 * m + l] = -1.0f / std::sqrt((static_cast<float>(j) + 0.3f) / 64.0f);
+        in[4 * m + l] = 1.0f;
+        expected[l] = static_cast<float>(64 - j) / 64.0f;
+        if (l % 7 == 3) {
+            if (l % 2)
+                in[4 * m + l] = 0.0f;  // zero normal
+            else
+                in[0 * m + l] = std::numeric_limits<float>::quiet_NaN();
+            expected[l] = 1.0f;
+        } else {
+            ++usable;
+        }
+    }
+    const float* args[6];
+    for (int k = 0; k < 6; ++k) args[k] = &in[static_cast<size_t>(k) * m];
+    std::vector<float> open(m, -1.0f);
+    EXPECT_EQ(occlusionLanes(&rays, 0.0f, 64, args, open.data(), m), 64u * usable);
+    for (int l = 0; l < m; ++l) EXPECT_EQ(open[l], expected[l]) << "lane " << l;
 }
 
 TEST(Lighting, EveryLaneOfARunMatchesTheOneLaneFormula) {
