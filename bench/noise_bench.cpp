@@ -1,5 +1,6 @@
 // Procedural noise: fbm3 with six octaves (marble's) and snoise3 over points spread across
-// many lattice cells, as a shader map's fill evaluates them. items/s is points/s.
+// many lattice cells, as a shader map's fill evaluates them, one point at a time and as the
+// interpreter runs them, in lanes. items/s is points/s.
 #include <random>
 #include <vector>
 
@@ -32,6 +33,21 @@ void BM_NoiseOneByOne(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * NoisePoints::kCount);
 }
 BENCHMARK(BM_NoiseOneByOne)->Name("Noise/one_by_one")->Arg(0)->Arg(6);
+
+void BM_NoiseLanes(benchmark::State& state) {
+    NoisePoints p;
+    const int octaves = static_cast<int>(state.range(0));
+    for (auto _ : state) {
+        if (octaves == 0)
+            snoise3Lanes(p.x.data(), p.y.data(), p.z.data(), p.out.data(), NoisePoints::kCount);
+        else
+            fbm3Lanes(p.x.data(), p.y.data(), p.z.data(), octaves, p.out.data(),
+                      NoisePoints::kCount);
+        benchmark::DoNotOptimize(p.out.data());
+    }
+    state.SetItemsProcessed(state.iterations() * NoisePoints::kCount);
+}
+BENCHMARK(BM_NoiseLanes)->Name("Noise/lanes")->Arg(0)->Arg(6);
 
 }  // namespace
 }  // namespace mpshade

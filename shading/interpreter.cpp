@@ -184,6 +184,7 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                         std::fill_n(R(e.out[k]), m,
                                     uniforms.lights[static_cast<size_t>(e.imm)].color[k]);
                     break;
+// clang-format off (it cannot lay out these case-making macros)
 #define MPSHADE_UNARY(X)           \
     case Op::X:                    \
         unaryLoop<Op::X>(o, a, m); \
@@ -195,37 +196,69 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                     MPSHADE_UNARY(Fract)
                     MPSHADE_UNARY(Sqrt)
                     MPSHADE_UNARY(Exp)
-                    MPSHADE_UNARY(Log) MPSHADE_UNARY(Sin) MPSHADE_UNARY(Cos) MPSHADE_UNARY(Tan)
-                        MPSHADE_UNARY(Asin) MPSHADE_UNARY(Acos) MPSHADE_UNARY(Atan) MPSHADE_UNARY(
-                            Sign) MPSHADE_UNARY(Trunc) MPSHADE_UNARY(Not) MPSHADE_UNARY(Bake)
-                            MPSHADE_UNARY(Dynamic)
+                    MPSHADE_UNARY(Log)
+                    MPSHADE_UNARY(Sin)
+                    MPSHADE_UNARY(Cos)
+                    MPSHADE_UNARY(Tan)
+                    MPSHADE_UNARY(Asin)
+                    MPSHADE_UNARY(Acos)
+                    MPSHADE_UNARY(Atan)
+                    MPSHADE_UNARY(Sign)
+                    MPSHADE_UNARY(Trunc)
+                    MPSHADE_UNARY(Not)
+                    MPSHADE_UNARY(Bake)
+                    MPSHADE_UNARY(Dynamic)
 #undef MPSHADE_UNARY
 #define MPSHADE_BINARY(X)              \
     case Op::X:                        \
         binaryLoop<Op::X>(o, a, b, m); \
         break;
-                                MPSHADE_BINARY(Add) MPSHADE_BINARY(Sub) MPSHADE_BINARY(Mul)
-                                    MPSHADE_BINARY(Div) MPSHADE_BINARY(IDiv) MPSHADE_BINARY(Min)
-                                        MPSHADE_BINARY(Max) MPSHADE_BINARY(Mod) MPSHADE_BINARY(Pow)
-                                            MPSHADE_BINARY(Atan2) MPSHADE_BINARY(Step)
-                                                MPSHADE_BINARY(Lt) MPSHADE_BINARY(Le)
-                                                    MPSHADE_BINARY(Gt) MPSHADE_BINARY(Ge)
-                                                        MPSHADE_BINARY(Eq) MPSHADE_BINARY(Ne)
-                                                            MPSHADE_BINARY(And) MPSHADE_BINARY(Or)
+                    MPSHADE_BINARY(Add)
+                    MPSHADE_BINARY(Sub)
+                    MPSHADE_BINARY(Mul)
+                    MPSHADE_BINARY(Div)
+                    MPSHADE_BINARY(IDiv)
+                    MPSHADE_BINARY(Min)
+                    MPSHADE_BINARY(Max)
+                    MPSHADE_BINARY(Mod)
+                    MPSHADE_BINARY(Pow)
+                    MPSHADE_BINARY(Atan2)
+                    MPSHADE_BINARY(Step)
+                    MPSHADE_BINARY(Lt)
+                    MPSHADE_BINARY(Le)
+                    MPSHADE_BINARY(Gt)
+                    MPSHADE_BINARY(Ge)
+                    MPSHADE_BINARY(Eq)
+                    MPSHADE_BINARY(Ne)
+                    MPSHADE_BINARY(And)
+                    MPSHADE_BINARY(Or)
 #undef MPSHADE_BINARY
 #define MPSHADE_TERNARY(X)                 \
     case Op::X:                            \
         ternaryLoop<Op::X>(o, a, b, c, m); \
         break;
-                                                                MPSHADE_TERNARY(Clamp)
-                                                                    MPSHADE_TERNARY(Mix)
-                                                                        MPSHADE_TERNARY(Smoothstep)
-                                                                            MPSHADE_TERNARY(Select)
+                    MPSHADE_TERNARY(Clamp)
+                    MPSHADE_TERNARY(Mix)
+                    MPSHADE_TERNARY(Smoothstep)
+                    MPSHADE_TERNARY(Select)
 #undef MPSHADE_TERNARY
-                                                                                case Op::Noise
-                        : case Op::Snoise : case Op::Cellnoise : case Op::Fbm : case Op::Turbulence
-                        : for (int l = 0; l < m; ++l) o[l] =
-                              scalar::pattern(e.op, e.imm, a[l], b[l], c[l]);
+                    // clang-format on
+                case Op::Snoise:
+                    snoise3Lanes(a, b, c, o, m);
+                    break;
+                case Op::Noise:
+                    snoise3Lanes(a, b, c, o, m);
+                    for (int l = 0; l < m; ++l) o[l] = 0.5f + 0.5f * o[l];  // noise3's
+                    break;
+                case Op::Fbm:
+                    fbm3Lanes(a, b, c, e.imm, o, m);
+                    break;
+                case Op::Turbulence:
+                    turbulence3Lanes(a, b, c, e.imm, o, m);
+                    break;
+                case Op::Cellnoise:
+                    for (int l = 0; l < m; ++l)
+                        o[l] = scalar::pattern(e.op, e.imm, a[l], b[l], c[l]);
                     break;
                 case Op::Diffuse:
                 case Op::Specular:

