@@ -10,8 +10,10 @@
 #include <vector>
 
 #include <OpenImageIO/imageio.h>
+#include <tbb/parallel_invoke.h>
 
 #include "app/output_files.h"
+#include "app/srgb.h"
 #include "geometry/error.h"
 
 namespace mpshade {
@@ -27,11 +29,6 @@ void write(const std::string& path, const char* formatName, const OIIO::ImageSpe
         if (!out->open(temporary, spec) || !out->write_image(format, data) || !out->close())
             throw std::runtime_error(out->geterror());
     });
-}
-
-float linearToSrgb(float c) {
-    c = c > 0.0f ? std::min(c, 1.0f) : 0.0f;  // NaN to 0
-    return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
 }
 
 }  // namespace
@@ -74,17 +71,19 @@ void writeExr(const Image& image, const std::string& path) {
 void writeFrameImages(const Image& image, const std::string& dir, int frame) {
     const std::string base =
         (std::filesystem::path(dir) / fmt::format("frame_{:04d}", frame)).string();
-    writeExr(image, base + ".exr");
-    writePng(image, base + ".png");
+    // Side by side: each is one thread's compression (about 12 and 6 ms at 480x270).
+    tbb::parallel_invoke([&] { writeExr(image, base + ".exr"); },
+                         [&] { writePng(image, base + ".png"); });
 }
 
 void writePng(const Image& image, const std::string& path) {
     std::vector<unsigned char> rgb(static_cast<size_t>(image.width) * image.height * 3);
     for (size_t i = 0; i < static_cast<size_t>(image.width) * image.height; ++i)
-        for (int c = 0; c < 3; ++c)
-            rgb[3 * i + c] = static_cast<unsigned char>(
-                std::lround(255.0f * linearToSrgb(image.rgba[4 * i + c])));
+        for (int c = 0; c < 3; ++c) rgb[3 * i + c] = srgbCode(image.rgba[4 * i + c]);
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+    // zlib's fastest level: a frame's PNG (a preview beside the EXR) 18% larger than at the
+    // default level 6, written in 11 ms less at 480x270.
+    spec.attribute("png:compressionLevel", 1);
     write(path, "png", spec, OIIO::TypeDesc::UINT8, rgb.data());
 }
 
