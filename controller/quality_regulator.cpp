@@ -58,7 +58,7 @@ void QualityRegulator::calibrate(std::span<const double> seconds, double budget)
             current_ = k;
             break;
         }
-    calm_ = 0;
+    calm_ = probeCalm_ = 0;
     lastLevel_ = -1;
 }
 
@@ -80,18 +80,24 @@ void QualityRegulator::update(const FrameStats& stats, double budget) {
     // more): a step down waits for a second one, unless the frame nearly took the budget.
     if (dynamic > options_.dropAt * budget || (dynamic > options_.slowDownAt * budget && wasOver)) {
         current_ = std::min(current_ + 1, levels() - 1);
-        calm_ = 0;
+        calm_ = probeCalm_ = 0;
         return;
     }
-    if (dynamic > options_.slowDownAt * budget) {
-        calm_ = 0;
+    if (dynamic > options_.slowDownAt * budget || current_ == 0) {
+        calm_ = probeCalm_ = 0;
         return;
     }
-    if (current_ == 0) return;
-    if (dynamic * ratioAbove_[static_cast<size_t>(current_)] >= options_.speedUpAt * budget) {
+    const double predicted = dynamic * ratioAbove_[static_cast<size_t>(current_)];
+    if (predicted >= options_.speedUpAt * budget) {
         calm_ = 0;
+        probeCalm_ = predicted < options_.dropAt * budget ? probeCalm_ + 1 : 0;
+        if (probeCalm_ >= options_.probeFrames) {
+            --current_;
+            probeCalm_ = 0;
+        }
         return;
     }
+    probeCalm_ = 0;
     if (++calm_ >= options_.calmFrames) {
         --current_;
         calm_ = 0;

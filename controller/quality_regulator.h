@@ -15,9 +15,10 @@
 // more than `slowDownAt` of the budget on two frames in a row at one step, or more than
 // `dropAt` on one (a single frame over the share is often the machine), and steps up after
 // `calmFrames` frames in a row whose dynamic phase, times the step above's cost ratio,
-// would take less than `speedUpAt`. The ratios are measured: all of them before the first frame
-// (calibrate: one view rendered at every step), then each again whenever two consecutive
-// frames ran on neighbouring steps. The gap between the two shares and the wait keep it
+// would take less than `speedUpAt`, or tries the step above after `probeFrames` calm frames
+// predicting it under `dropAt` (to measure its ratio again). The ratios are measured: all of them
+// before the first frame (calibrate: one view rendered at every step), then each again whenever two
+// consecutive frames ran on neighbouring steps. The gap between the two shares and the wait keep it
 // from flickering between steps.
 #pragma once
 
@@ -40,6 +41,12 @@ struct QualityRegulatorOptions {
     double dropAt = 0.9;      // of the budget: one frame above it steps down
     double speedUpAt = 0.65;  // of the budget: the step above, predicted below it, steps up
     int calmFrames = 8;       // frames in a row that must predict so before stepping up
+    // Frames in a row, calm, whose step above is predicted over speedUpAt but under dropAt,
+    // after which that step is tried once: its cost ratio is measured again. A ratio
+    // measured across a step down is taken on the slow frame that caused it, so it can
+    // overstate the step above for good (a teapot run stayed a mip level coarser for 45 of
+    // 48 frames); predicted under dropAt, the frame tried is on time either way.
+    int probeFrames = 16;
 };
 
 class QualityRegulator {
@@ -70,6 +77,7 @@ class QualityRegulator {
     QualityRegulatorOptions options_;
     int current_ = 0;
     int calm_ = 0;
+    int probeCalm_ = 0;   // frames in a row eligible for trying the step above
     int lastLevel_ = -1;  // the previous frame's, and its dynamic seconds
     double lastDynamic_ = 0.0;
 };

@@ -102,8 +102,8 @@ TEST(QualityRegulator, StepsUpAfterCalmFramesPredictingTheStepAboveFits) {
     r.calibrate(seconds, 1.0);
     ASSERT_EQ(r.level(), 1);
     ASSERT_EQ(r.costRatioAbove(1), 2.0);
-    // 0.25 x 2 is exactly the share: does not fit.
-    for (int k = 0; k < 20; ++k) r.update(frame(0.25), 1.0);
+    // 0.25 x 2 is exactly the share: does not fit (for fewer than probeFrames, 16).
+    for (int k = 0; k < 15; ++k) r.update(frame(0.25), 1.0);
     EXPECT_EQ(r.level(), 1);
     for (int k = 0; k < 7; ++k) r.update(frame(0.24), 1.0);
     EXPECT_EQ(r.level(), 1);
@@ -116,6 +116,46 @@ TEST(QualityRegulator, StepsUpAfterCalmFramesPredictingTheStepAboveFits) {
     r.update(frame(0.6), 1.0);
     EXPECT_EQ(r.level(), 0);
     EXPECT_DOUBLE_EQ(r.costRatioAbove(1), 2.5);
+}
+
+TEST(QualityRegulator, TriesTheStepAboveWhenItsRatioMayBeStale) {
+    // A step down measured on a slow frame: 0.9 at level 0, then 0.3 at level 1, a ratio of
+    // 3 (the true one is 1.25). Predicted 0.3 x 3 = 0.9 >= dropAt: never tried.
+    QualityRegulator r(ShadingRate::Pixel, 1, exactShares());  // four steps
+    r.update(frame(0.9), 1.0);
+    ASSERT_EQ(r.level(), 1);
+    r.update(frame(0.3), 1.0);
+    ASSERT_DOUBLE_EQ(r.costRatioAbove(1), 3.0);
+    for (int k = 0; k < 40; ++k) r.update(frame(0.3), 1.0);
+    EXPECT_EQ(r.level(), 1);
+    // Faster frames predict 0.28 x 3 = 0.84: over speedUpAt, under dropAt. After 16 of them
+    // in a row (one that predicts dropAt or more starts the count again), level 0 is tried.
+    for (int k = 0; k < 15; ++k) r.update(frame(0.28), 1.0);
+    EXPECT_EQ(r.level(), 1);
+    r.update(frame(0.3), 1.0);
+    for (int k = 0; k < 15; ++k) r.update(frame(0.28), 1.0);
+    EXPECT_EQ(r.level(), 1);
+    r.update(frame(0.28), 1.0);
+    EXPECT_EQ(r.level(), 0);
+    // Its true cost, 0.35, measures the ratio again and keeps the step.
+    r.update(frame(0.35), 1.0);
+    EXPECT_DOUBLE_EQ(r.costRatioAbove(1), 0.35 / 0.28);
+    for (int k = 0; k < 20; ++k) r.update(frame(0.35), 1.0);
+    EXPECT_EQ(r.level(), 0);
+}
+
+TEST(QualityRegulator, ATriedStepThatIsTooSlowIsLeftAgain) {
+    QualityRegulator r(ShadingRate::Pixel, 1, exactShares());
+    r.update(frame(0.9), 1.0);
+    r.update(frame(0.4), 1.0);  // ratio 2.25: 0.4 x 2.25 = 0.9, not tried
+    ASSERT_EQ(r.level(), 1);
+    for (int k = 0; k < 16; ++k) r.update(frame(0.375), 1.0);  // 0.84375: tried
+    ASSERT_EQ(r.level(), 0);
+    // Truly 0.8 (over slowDownAt, under dropAt: on time): two such frames step down.
+    r.update(frame(0.8), 1.0);
+    EXPECT_EQ(r.level(), 0);
+    r.update(frame(0.8), 1.0);
+    EXPECT_EQ(r.level(), 1);
 }
 
 TEST(QualityRegulator, AStepDownMeasuresTheRatioOfTheTwoSteps) {
