@@ -78,30 +78,34 @@ void SampleLayout::prepareFilter() {
     const size_t pixels = static_cast<size_t>(width_) * height_;
     centroid_.resize(2 * pixels);
     nearest_.resize(pixels);
-    for (size_t p = 0; p < pixels; ++p) {
-        float sx = 0.0f, sy = 0.0f;
-        for (int k = 0; k < spp_; ++k) {
-            sx += xy_[2 * (p * spp_ + k)];
-            sy += xy_[2 * (p * spp_ + k) + 1];
-        }
-        const float cx = sx / static_cast<float>(spp_), cy = sy / static_cast<float>(spp_);
-        float best = 1e30f;
-        int nearest = 0;
-        for (int k = 0; k < spp_; ++k) {
-            const float dx = xy_[2 * (p * spp_ + k)] - cx, dy = xy_[2 * (p * spp_ + k) + 1] - cy;
-            if (dx * dx + dy * dy < best) {
-                best = dx * dx + dy * dy;
-                nearest = k;
+    tbb::parallel_for(0, height_, [&](int py) {
+        for (size_t p = static_cast<size_t>(py) * width_; p < static_cast<size_t>(py + 1) * width_;
+             ++p) {
+            float sx = 0.0f, sy = 0.0f;
+            for (int k = 0; k < spp_; ++k) {
+                sx += xy_[2 * (p * spp_ + k)];
+                sy += xy_[2 * (p * spp_ + k) + 1];
             }
+            const float cx = sx / static_cast<float>(spp_), cy = sy / static_cast<float>(spp_);
+            float best = 1e30f;
+            int nearest = 0;
+            for (int k = 0; k < spp_; ++k) {
+                const float dx = xy_[2 * (p * spp_ + k)] - cx,
+                            dy = xy_[2 * (p * spp_ + k) + 1] - cy;
+                if (dx * dx + dy * dy < best) {
+                    best = dx * dx + dy * dy;
+                    nearest = k;
+                }
+            }
+            centroid_[2 * p] = cx;
+            centroid_[2 * p + 1] = cy;
+            nearest_[p] = static_cast<uint16_t>(nearest);
         }
-        centroid_[2 * p] = cx;
-        centroid_[2 * p + 1] = cy;
-        nearest_[p] = static_cast<uint16_t>(nearest);
-    }
+    });
     const int qw = width_ / 2, qh = height_ / 2;
     quadCentroid_.resize(2 * static_cast<size_t>(qw) * qh);
     quadNearest_.resize(static_cast<size_t>(qw) * qh);
-    for (int qy = 0; qy < qh; ++qy)
+    tbb::parallel_for(0, qh, [&](int qy) {
         for (int qx = 0; qx < qw; ++qx) {
             float sx = 0.0f, sy = 0.0f;
             for (int py = 2 * qy; py < 2 * qy + 2; ++py)
@@ -128,12 +132,16 @@ void SampleLayout::prepareFilter() {
             quadCentroid_[2 * b + 1] = cy;
             quadNearest_[b] = static_cast<uint16_t>(nearest);
         }
+    });
     fx_.resize(n);
     fy_.resize(n);
-    for (size_t s = 0; s < n; ++s) {
-        fx_[s] = static_cast<int32_t>(std::lround(xy_[2 * s] * 256.0f));
-        fy_[s] = static_cast<int32_t>(std::lround(xy_[2 * s + 1] * 256.0f));
-    }
+    tbb::parallel_for(0, height_, [&](int py) {
+        for (size_t s = index(0, py, 0); s < index(0, py, 0) + static_cast<size_t>(width_) * spp_;
+             ++s) {
+            fx_[s] = static_cast<int32_t>(std::lround(xy_[2 * s] * 256.0f));
+            fy_[s] = static_cast<int32_t>(std::lround(xy_[2 * s + 1] * 256.0f));
+        }
+    });
     // A sample inside pixel q is at distance in (o - 1/2, o + 1/2] from the centre of
     // pixel q + o, so it reaches the pixels with |o| < radius + 1/2.
     reach_ = static_cast<int>(std::ceil(filter_.radius + 0.5f)) - 1;
@@ -160,10 +168,11 @@ void SampleLayout::prepareFilter() {
     });
     // Per pixel, its samples' weights summed, towards each pixel in reach (taps x taps,
     // rows then columns), for pixels whose samples are all alike.
-    pixelWeights_.assign(static_cast<size_t>(width_) * height_ * taps * taps, 0.0f);
+    pixelWeights_.resize(static_cast<size_t>(width_) * height_ * taps * taps);
     tbb::parallel_for(0, height_, [&](int py) {
         for (int px = 0; px < width_; ++px) {
             float* pw = &pixelWeights_[(static_cast<size_t>(py) * width_ + px) * taps * taps];
+            std::fill(pw, pw + taps * taps, 0.0f);
             for (int k = 0; k < spp_; ++k) {
                 const float* w = &weights_[index(px, py, k) * 2 * taps];
                 for (size_t oy = 0; oy < taps; ++oy)
@@ -177,10 +186,11 @@ void SampleLayout::prepareFilter() {
     blockWeights_.clear();
     if (reach_ == 1) {
         const int bw = width_ / 2, bh = height_ / 2;
-        blockWeights_.assign(static_cast<size_t>(bw) * bh * 16, 0.0f);
+        blockWeights_.resize(static_cast<size_t>(bw) * bh * 16);
         tbb::parallel_for(0, bh, [&](int by) {
             for (int bx = 0; bx < bw; ++bx) {
                 float* bwt = &blockWeights_[(static_cast<size_t>(by) * bw + bx) * 16];
+                std::fill(bwt, bwt + 16, 0.0f);
                 for (int dy = 0; dy < 2; ++dy)
                     for (int dx = 0; dx < 2; ++dx) {
                         const float* pw =
@@ -194,7 +204,7 @@ void SampleLayout::prepareFilter() {
             }
         });
     }
-    inverseSum_.assign(static_cast<size_t>(width_) * height_, 0.0f);
+    inverseSum_.resize(static_cast<size_t>(width_) * height_);
     tbb::parallel_for(0, height_, [&](int py) {
         for (int px = 0; px < width_; ++px) {
             double sum = 0.0;

@@ -75,6 +75,22 @@ class SampleLayout {
     void resolve(const float* rgba, const uint8_t* uniform, Image& out, bool quads = false) const;
 
   private:
+    // Resizing leaves the elements unset: every one is written before it is read, and
+    // zeroing tens of megabytes first had been a third of building a layout.
+    template <class T>
+    struct Unset : std::allocator<T> {
+        template <class U>
+        struct rebind {
+            using other = Unset<U>;
+        };
+        template <class U>
+        void construct(U* p) noexcept {
+            ::new (static_cast<void*>(p)) U;
+        }
+    };
+    template <class T>
+    using Buffer = std::vector<T, Unset<T>>;
+
     void prepareFilter();
 
     int width_ = 0, height_ = 0, spp_ = 1;
@@ -82,19 +98,19 @@ class SampleLayout {
     bool stratified_ = false;
     PixelFilter filter_;
     std::vector<float> xy_;
-    std::vector<int32_t> fx_, fy_;
-    std::vector<float> centroid_;        // 2 per pixel
-    std::vector<uint16_t> nearest_;      // per pixel
-    std::vector<float> quadCentroid_;    // 2 per whole 2x2 block
-    std::vector<uint16_t> quadNearest_;  // per whole 2x2 block
+    Buffer<int32_t> fx_, fy_;
+    Buffer<float> centroid_;        // 2 per pixel
+    Buffer<uint16_t> nearest_;      // per pixel
+    Buffer<float> quadCentroid_;    // 2 per whole 2x2 block
+    Buffer<uint16_t> quadNearest_;  // per whole 2x2 block
     // A sample reaches the pixels within `reach_` columns and rows of its own; per sample,
     // taps_ = 2 reach_ + 1 weights across (towards px - reach_ ... px + reach_), then as many
     // down.
     int reach_ = 1, taps_ = 3;
-    std::vector<float> weights_;
-    std::vector<float> pixelWeights_;  // per pixel: taps x taps, its samples' weights summed
-    std::vector<float> blockWeights_;  // per whole 2x2 block (reach 1): 4 x 4, summed
-    std::vector<float> inverseSum_;    // per pixel: 1 / the sum of the weights reaching it
+    Buffer<float> weights_;
+    Buffer<float> pixelWeights_;  // per pixel: taps x taps, its samples' weights summed
+    Buffer<float> blockWeights_;  // per whole 2x2 block (reach 1): 4 x 4, summed
+    Buffer<float> inverseSum_;    // per pixel: 1 / the sum of the weights reaching it
 };
 
 // Per-sample results of one frame, in its layout's order.
