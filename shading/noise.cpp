@@ -116,16 +116,20 @@ float snoise3(float x, float y, float z) {
 
 namespace {
 
-// Eight lanes at a time in vector registers (GCC vector extensions: one AVX2 register, or
-// two SSE ones), each lane computing exactly what snoise3 computes for it, operation for
-// operation, so the values are the same bit for bit. Lanes whose input is not finite or
-// whose lattice cell does not fit an int32 are left to snoise3.
+// Eight lanes at a time in AVX2 registers (GCC vector extensions), each lane computing
+// exactly what snoise3 computes for it, operation for operation, so the values are the
+// same bit for bit. Lanes whose input is not finite or whose lattice cell does not fit an
+// int32 are left to snoise3. Every function passing these vectors is compiled for AVX2
+// (passing them without AVX changes the ABI, which Clang refuses); machines without AVX2
+// take the one-point functions (four lanes in SSE registers had been no faster: the table
+// lookups stay one lane at a time).
+#define MPSHADE_AVX2 [[gnu::always_inline, gnu::target("avx2")]] inline
 using Lanes8 = float __attribute__((vector_size(32)));
 using Ints8 = int32_t __attribute__((vector_size(32)));
 constexpr int kLanes = 8;
 
 // floor(x) for |x| < 2^31 (exact: an integer-valued float) and its low byte.
-[[gnu::always_inline]] inline void latticeLanes(Lanes8 x, Ints8& cell, Lanes8& frac) {
+MPSHADE_AVX2 void latticeLanes(Lanes8 x, Ints8& cell, Lanes8& frac) {
     const Ints8 t = __builtin_convertvector(x, Ints8);  // towards zero
     const Lanes8 tf = __builtin_convertvector(t, Lanes8);
     const Ints8 below = tf > x;  // -1 where truncation rounded up
@@ -135,16 +139,16 @@ constexpr int kLanes = 8;
     cell = f & 255;
 }
 
-[[gnu::always_inline]] inline Lanes8 fadeLanes(Lanes8 t) {
+MPSHADE_AVX2 Lanes8 fadeLanes(Lanes8 t) {
     return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f);
 }
 
-[[gnu::always_inline]] inline Lanes8 lerpLanes(Lanes8 t, Lanes8 a, Lanes8 b) {
+MPSHADE_AVX2 Lanes8 lerpLanes(Lanes8 t, Lanes8 a, Lanes8 b) {
     return a + t * (b - a);
 }
 
 // kGradients' row for each lane's hash, as selects.
-[[gnu::always_inline]] inline Lanes8 gradLanes(Ints8 hash, Lanes8 x, Lanes8 y, Lanes8 z) {
+MPSHADE_AVX2 Lanes8 gradLanes(Ints8 hash, Lanes8 x, Lanes8 y, Lanes8 z) {
     const Ints8 h = hash & 15;
     const Lanes8 one = {1, 1, 1, 1, 1, 1, 1, 1}, zero = {};
     const Lanes8 su = (h & 1) != 0 ? -one : one, sv = (h & 2) != 0 ? -one : one;
@@ -155,7 +159,7 @@ constexpr int kLanes = 8;
     return gx * x + gy * y + gz * z;
 }
 
-[[gnu::always_inline]] inline Lanes8 snoiseLanes(Lanes8 x, Lanes8 y, Lanes8 z) {
+MPSHADE_AVX2 Lanes8 snoiseLanes(Lanes8 x, Lanes8 y, Lanes8 z) {
     Ints8 X, Y, Z;
     latticeLanes(x, X, x);
     latticeLanes(y, Y, y);
@@ -183,7 +187,7 @@ constexpr int kLanes = 8;
 
 // |x| < 2^30, so floor(x) fits an int32 (false for NaN and infinities): the lanes
 // snoiseLanes computes as snoise3 does.
-[[gnu::always_inline]] inline Ints8 inLatticeRange(Lanes8 x) {
+MPSHADE_AVX2 Ints8 inLatticeRange(Lanes8 x) {
     const Ints8 magnitude = (Ints8)x & 0x7fffffff;
     const Lanes8 limit = {0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f};
     return (Lanes8)magnitude < limit;
@@ -191,10 +195,8 @@ constexpr int kLanes = 8;
 
 enum class NoiseSum { Single, Fbm, Turbulence };
 
-__attribute__((target_clones("avx2", "default"))) void noiseLanes(const float* x, const float* y,
-                                                                  const float* z, int octaves,
-                                                                  NoiseSum kind, float* out,
-                                                                  int m) {
+__attribute__((target("avx2"))) void noiseLanesAvx2(const float* x, const float* y, const float* z,
+                                                    int octaves, NoiseSum kind, float* out, int m) {
     const int n = kind == NoiseSum::Single ? 1 : octaves;
     for (int first = 0; first < m; first += kLanes) {
         const int count = std::min(kLanes, m - first);
@@ -225,6 +227,27 @@ __attribute__((target_clones("avx2", "default"))) void noiseLanes(const float* x
             freq *= 2.0f;
         }
         for (int l = 0; l < count; ++l) out[first + l] = sum[l];
+    }
+}
+
+#undef MPSHADE_AVX2
+
+void noiseLanes(const float* x, const float* y, const float* z, int octaves, NoiseSum kind,
+                float* out, int m) {
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    if (avx2) return noiseLanesAvx2(x, y, z, octaves, kind, out, m);
+    for (int l = 0; l < m; ++l) {
+        switch (kind) {
+            case NoiseSum::Single:
+                out[l] = snoise3(x[l], y[l], z[l]);
+                break;
+            case NoiseSum::Fbm:
+                out[l] = fbm3(x[l], y[l], z[l], octaves);
+                break;
+            case NoiseSum::Turbulence:
+                out[l] = turbulence3(x[l], y[l], z[l], octaves);
+                break;
+        }
     }
 }
 

@@ -16,8 +16,8 @@ float fbm3(float x, float y, float z, int octaves);
 float turbulence3(float x, float y, float z, int octaves);
 
 // The same over m lanes (rows of coordinates; out a row of m, not one of them): each lane's
-// value is the one-point function's, bit for bit, eight lanes at a time in vector registers
-// (2-3x the one-point functions' speed).
+// value is the one-point function's, bit for bit: eight lanes at a time in AVX2 registers
+// (about 2x the one-point functions' speed), one at a time on machines without AVX2.
 void snoise3Lanes(const float* x, const float* y, const float* z, float* out, int m);
 void fbm3Lanes(const float* x, const float* y, const float* z, int octaves, float* out, int m);
 void turbulence3Lanes(const float* x, const float* y, const float* z, int octaves, float* out,
