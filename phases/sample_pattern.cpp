@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
+#include <new>
+
+#include <sys/mman.h>
 
 #include <tbb/parallel_for.h>
 
@@ -22,6 +26,26 @@ uint32_t mix32(uint32_t h) {
 }
 
 }  // namespace
+
+void* SampleLayout::allocateLarge(size_t bytes) {
+    constexpr size_t kHuge = size_t{2} << 20;
+    if (bytes < kHuge) {
+        void* p = std::malloc(bytes > 0 ? bytes : 1);
+        if (!p) throw std::bad_alloc();
+        return p;
+    }
+    const size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
+    void* p = std::aligned_alloc(kHuge, rounded);
+    if (!p) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+    madvise(p, rounded, MADV_HUGEPAGE);  // advice only: ignored where unsupported
+#endif
+    return p;
+}
+
+void SampleLayout::freeLarge(void* p, size_t) noexcept {
+    std::free(p);
+}
 
 void samplePosition(uint32_t seed, int px, int py, int k, int spp, float& x, float& y) {
     const int nx = static_cast<int>(std::ceil(std::sqrt(static_cast<float>(spp))));
