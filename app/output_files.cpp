@@ -43,8 +43,9 @@ void writeAtomically(const std::filesystem::path& path,
     }
     std::filesystem::rename(temporary, path, ec);
     if (ec) {
+        const std::string reason = ec.message();  // before the removal resets ec
         std::filesystem::remove(temporary, ec);
-        throw OutputError(path.string(), ec.message());
+        throw OutputError(path.string(), reason);
     }
 }
 

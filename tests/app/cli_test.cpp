@@ -3,8 +3,10 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -234,6 +236,19 @@ TEST(Cli, CompareMeasuresAndDrawsTheDifference) {
                   "/no/such/folder/d.png");
     EXPECT_EQ(bad.exitCode, 2);
     EXPECT_NE(bad.output.find("d.png"), std::string::npos) << bad.output;
+}
+
+TEST(Cli, AFrameThatCannotBeWrittenNamesItsFileAndWhy) {
+    // A folder where frame 0's EXR goes: the finished image cannot be moved into place.
+    const std::string out = tempDir("blocked");
+    std::filesystem::create_directories(out + "/frame_0000.exr/inside");
+    const CliRun run =
+        mpshade("render examples/teapot/scene.json --frames 0:1 --size 16x12 --quiet --out " + out);
+    EXPECT_EQ(run.exitCode, 1) << run.output;
+    EXPECT_NE(run.output.find("frame_0000.exr"), std::string::npos) << run.output;
+    // The reason the rename failed (Linux: EISDIR), not the removal after it.
+    EXPECT_NE(run.output.find(std::strerror(EISDIR)), std::string::npos) << run.output;
+    EXPECT_FALSE(std::filesystem::exists(out + "/.frame_0000.exr.partial"));
 }
 
 TEST(Cli, SppAndSeedOverrideTheScene) {
