@@ -195,20 +195,6 @@ bool SurfaceRayScene::intersect(const glm::vec3& org, const glm::vec3& dir, floa
     return resolveHit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, org, dir, hit);
 }
 
-bool SurfaceRayScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tnear,
-                               float tfar) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    RTCRay ray{};
-    ray.org_x = org.x, ray.org_y = org.y, ray.org_z = org.z;
-    ray.dir_x = dir.x, ray.dir_y = dir.y, ray.dir_z = dir.z;
-    ray.tnear = tnear;
-    ray.tfar = tfar;
-    ray.mask = 0xFFFFFFFFu;
-    rtcOccluded1(scene_, &ctx, &ray);
-    return ray.tfar < 0.0f;  // Embree sets tfar to -inf on a hit
-}
-
 void SurfaceRayScene::occluded(const float* const org[3], const float* const dir[3],
                                const uint8_t* active, int n, float tnear, float tfar,
                                uint8_t* blocked) const {

@@ -52,13 +52,12 @@ class SurfaceRayScene {
     // Nearest hit along org + t dir, t in [tnear, tfar]; object space.
     bool intersect(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar,
                    SurfaceHit& hit) const;
-    // Any hit along the segment (shadow and occlusion rays).
-    bool occluded(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar) const;
-    // The same for n rays at once, origins and directions as rows (x, y, z: 3 x n floats
-    // each), t in [tnear, tfar]; a ray whose `active` entry is 0 is not traced (active may
-    // be null: all). Writes blocked[i] = 1 where ray i hits. Rays given in coherent order
-    // (one direction of a pattern from neighbouring points) are traced as a stream, which
-    // Embree takes in packets: ambient occlusion's rays cost a third less than one by one.
+    // Any hit along each of n segments (shadow and occlusion rays), origins and directions
+    // as rows (x, y, z: 3 x n floats each), t in [tnear, tfar]; a ray whose `active` entry
+    // is 0 is not traced (active may be null: all). Writes blocked[i] = 1 where ray i hits.
+    // Rays given in coherent order (one direction of a pattern from neighbouring points)
+    // are traced as a stream, which Embree takes in packets: ambient occlusion's rays cost
+    // a third less than one by one.
     void occluded(const float* const org[3], const float* const dir[3], const uint8_t* active,
                   int n, float tnear, float tfar, uint8_t* blocked) const;
 
