@@ -8,6 +8,7 @@
 
 #include "geometry/error.h"
 #include "shading/lighting.h"
+#include "shading/noise.h"
 #include "shading/scalar_ops.h"
 
 namespace mpshade {
@@ -247,8 +248,7 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                     snoise3Lanes(a, b, c, o, m);
                     break;
                 case Op::Noise:
-                    snoise3Lanes(a, b, c, o, m);
-                    for (int l = 0; l < m; ++l) o[l] = 0.5f + 0.5f * o[l];  // noise3's
+                    noise3Lanes(a, b, c, o, m);
                     break;
                 case Op::Fbm:
                     fbm3Lanes(a, b, c, e.imm, o, m);
@@ -257,8 +257,7 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                     turbulence3Lanes(a, b, c, e.imm, o, m);
                     break;
                 case Op::Cellnoise:
-                    for (int l = 0; l < m; ++l)
-                        o[l] = scalar::pattern(e.op, e.imm, a[l], b[l], c[l]);
+                    for (int l = 0; l < m; ++l) o[l] = cellnoise3(a[l], b[l], c[l]);
                     break;
                 case Op::Diffuse:
                 case Op::Specular:

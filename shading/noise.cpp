@@ -270,6 +270,11 @@ float noise3(float x, float y, float z) {
     return 0.5f + 0.5f * snoise3(x, y, z);
 }
 
+void noise3Lanes(const float* x, const float* y, const float* z, float* out, int m) {
+    snoise3Lanes(x, y, z, out, m);
+    for (int l = 0; l < m; ++l) out[l] = 0.5f + 0.5f * out[l];
+}
+
 float cellnoise3(float x, float y, float z) {
     if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return 0.0f;
     return static_cast<float>(hash3(cellOf(x), cellOf(y), cellOf(z)) >> 8) * (1.0f / 16777216.0f);

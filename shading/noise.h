@@ -19,6 +19,7 @@ float turbulence3(float x, float y, float z, int octaves);
 // value is the one-point function's, bit for bit: eight lanes at a time in AVX2 registers
 // (about 2x the one-point functions' speed), one at a time on machines without AVX2.
 void snoise3Lanes(const float* x, const float* y, const float* z, float* out, int m);
+void noise3Lanes(const float* x, const float* y, const float* z, float* out, int m);
 void fbm3Lanes(const float* x, const float* y, const float* z, int octaves, float* out, int m);
 void turbulence3Lanes(const float* x, const float* y, const float* z, int octaves, float* out,
                       int m);

@@ -109,6 +109,9 @@ TEST(Noise, LanesAreTheOnePointValuesBitForBit) {
             for (int i = 0; i < m; ++i)
                 ASSERT_TRUE(same(out[i], snoise3(x[i], y[i], z[i])))
                     << scale << " lane " << i << ": " << out[i];
+            noise3Lanes(x.data(), y.data(), z.data(), out.data(), m);
+            for (int i = 0; i < m; ++i)
+                ASSERT_TRUE(same(out[i], noise3(x[i], y[i], z[i]))) << scale << " lane " << i;
             fbm3Lanes(x.data(), y.data(), z.data(), 6, out.data(), m);
             for (int i = 0; i < m; ++i)
                 ASSERT_TRUE(same(out[i], fbm3(x[i], y[i], z[i], 6))) << scale << " lane " << i;
