@@ -71,8 +71,12 @@ struct RasterStats {
 };
 
 struct RasterOptions {
-    int tileSize = 16;  // pixels
-    int layers = 4;     // surfaces kept per sample when some object is translucent
+    // Pixels per side of a tile, the unit of parallel work. Against 16, 32 rasterized the
+    // courtyard, gallery and teapot 3-13% faster (fewer facets binned to two tiles; 240x135
+    // to 1280x720) and the vase within noise; 8 was slower, and 64 no faster than 32 with
+    // fewer tiles to share between threads.
+    int tileSize = 32;
+    int layers = 4;  // surfaces kept per sample when some object is translucent
 };
 
 // Keeps its bins and tile buffers from frame to frame, so a steady frame allocates nothing.

@@ -220,27 +220,32 @@ struct GridFixture {
 
 TEST(FacetRasterizer, SharedEdgesAreWatertight) {
     // Translucent: every facet covering a sample is kept (the k-buffer holds 4), so a
-    // sample covered twice or not at all shows in its count.
+    // sample covered twice or not at all shows in its count. Tiles of several sizes, so
+    // facets straddle tile edges at different places (5: on the grid's own lines too).
     GridFixture g;
-    VisibilityBuffer vis;
-    RasterStats stats;
-    RasterOptions options;
-    options.layers = 4;
-    rasterizeFacets({{&g.mesh, &g.warped, nullptr, false}}, *g.layout, 1e30f, options, vis, stats);
-    ASSERT_EQ(vis.layers, 4);
-    int interior = 0;
-    for (size_t s = 0; s < g.layout->count(); ++s) {
-        const int in = g.inside(s);
-        if (in == 1) {
-            ++interior;
-            ASSERT_EQ(vis.count[s], 1)
-                << "sample at (" << g.layout->x(s) << ", " << g.layout->y(s) << ")";
-        } else if (in == 0) {
-            ASSERT_EQ(vis.count[s], 0);
+    for (int tileSize : {5, 16, 32}) {
+        VisibilityBuffer vis;
+        RasterStats stats;
+        RasterOptions options;
+        options.layers = 4;
+        options.tileSize = tileSize;
+        rasterizeFacets({{&g.mesh, &g.warped, nullptr, false}}, *g.layout, 1e30f, options, vis,
+                        stats);
+        ASSERT_EQ(vis.layers, 4);
+        int interior = 0;
+        for (size_t s = 0; s < g.layout->count(); ++s) {
+            const int in = g.inside(s);
+            if (in == 1) {
+                ++interior;
+                ASSERT_EQ(vis.count[s], 1) << "tiles of " << tileSize << ", sample at ("
+                                           << g.layout->x(s) << ", " << g.layout->y(s) << ")";
+            } else if (in == 0) {
+                ASSERT_EQ(vis.count[s], 0);
+            }
         }
+        EXPECT_GT(interior, 10000);
+        EXPECT_EQ(stats.facetsDegenerate, 0u);
     }
-    EXPECT_GT(interior, 10000);
-    EXPECT_EQ(stats.facetsDegenerate, 0u);
 }
 
 TEST(FacetRasterizer, OpaqueDepthTestCoversTheSameSamples) {
@@ -278,6 +283,7 @@ TEST(FacetRasterizer, SubPixelFacetsCoverEverySampleOnce) {
         RasterStats a, b;
         RasterOptions options;
         options.layers = 4;
+        options.tileSize = spp == 2 ? 7 : 16;  // facets across tile edges at odd places too
         rasterizeFacets({{&g.mesh, &g.warped, nullptr, false}}, *g.layout, 1e30f, options, layered,
                         a);
         rasterizeFacets({{&g.mesh, &g.warped, nullptr, true}}, *g.layout, 1e30f, options, opaque,
