@@ -159,6 +159,26 @@ void facetsPerPixel(benchmark::State& state, const char* path, int representatio
         covered > 0 ? stats.facetsRasterized / covered : 0.0;
 }
 
+// The prefetch prediction `play` runs in a frame's slack (MultiphaseRenderer::predictTiles:
+// the frame 3 ahead at a quarter of 640 x 360, one sample a pixel), over representations
+// built for 640 x 360 with frame 1's tiles filled. Its cost decides how often a frame has
+// room for it; it draws every facet of the full-size representations.
+void predictAhead(benchmark::State& state, const char* path) {
+    FrameFixture f(path);
+    f.options.width = 640;
+    f.options.height = 360;
+    MultiphaseOptions options;
+    f.multi = std::make_unique<MultiphaseRenderer>(f.scene, options);
+    FrameStats stats;
+    f.multi->renderFrame(0, f.options, stats);
+    f.multi->renderFrame(1, f.options, stats);
+    double seconds = 0.0;
+    size_t tiles = 0;
+    for (auto _ : state) tiles = f.multi->predictTiles(4, f.options, 4, seconds).size();
+    state.counters["tiles_predicted"] = static_cast<double>(tiles);
+    state.counters["facets"] = static_cast<double>(stats.facets);
+}
+
 BENCHMARK(warpFixed)->Name("Warp/fixed")->Unit(benchmark::kMillisecond);
 BENCHMARK(warpFloat)->Name("Warp/float")->Unit(benchmark::kMillisecond);
 
@@ -201,6 +221,15 @@ constexpr int kSceneRate = -1, kPerSample = static_cast<int>(ShadingRate::Sample
         ->Name("FacetsPerPixel/" #name "/facets")                                \
         ->Iterations(1)                                                          \
         ->Unit(benchmark::kMillisecond)
+
+BENCHMARK_CAPTURE(predictAhead, vase, "examples/vase/scene.json")
+    ->Name("Predict/vase/640x360")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(predictAhead, courtyard, "examples/courtyard/scene.json")
+    ->Name("Predict/courtyard/640x360")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 MPSHADE_FRAME_BENCH(vase, "examples/vase/scene.json");
 MPSHADE_FRAME_BENCH(teapot, "examples/teapot/scene.json");
