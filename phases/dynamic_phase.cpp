@@ -62,6 +62,7 @@ bool backFacesHidden(const ObjectRepresentation& rep, const Surface& surface,
 }
 
 constexpr size_t kBatch = 1024;  // shading points per run of the dynamic shader
+constexpr uint32_t kNoPoint = ~uint32_t{0};
 
 }  // namespace
 
@@ -74,7 +75,11 @@ struct DynamicPhase::Band {
         std::vector<uint32_t> object, facet;  // per shading point
         std::vector<float> x, y;              // per shading point, pixels
         std::vector<uint32_t> fragmentPoint;  // per visibility slot of the band
-        std::vector<float> color, opacity;    // 3 per shading point
+        // Per pixel of the band, shaded per pixel or per 2x2 pixels: its point, where that
+        // one point is every sample's only fragment (its samples' fragmentPoint then unset);
+        // otherwise kNoPoint. Empty when shaded per sample.
+        std::vector<uint32_t> pixelPoint;
+        std::vector<float> color, opacity;  // 3 per shading point
         // Points are grouped by object: object o's are [objectStart[o], objectStart[o + 1]).
         std::vector<uint32_t> objectStart;
         bool fresh = false;             // no point shaded yet: every point is pending
@@ -263,6 +268,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
         st.objectStart.assign(objects + 1, 0);
         if (options_.shadingRate == ShadingRate::Sample) {
             // A point per fragment, placed by object as it is made (a counting sort).
+            st.pixelPoint.clear();
             for (size_t smp = firstSample; smp < endSample; ++smp)
                 for (int l = 0; l < vis.count[smp]; ++l)
                     ++st.objectStart[vis.object[smp * layers + l] + 1];
@@ -299,6 +305,12 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
                 int count;
             };
             Group groups[64];
+            st.pixelPoint.assign(static_cast<size_t>(row1 - row0) * static_cast<size_t>(width),
+                                 kNoPoint);
+            auto pixelAt = [&](int px, int py) {
+                return static_cast<size_t>(py - row0) * static_cast<size_t>(width) +
+                       static_cast<size_t>(px);
+            };
             // Per pixel, or per block of 2x2 pixels: the block's fragments grouped by
             // surface. member: per (pixel of the block, sample, layer), its group.
             const int block = options_.shadingRate == ShadingRate::Quad ? 2 : 1;
@@ -320,11 +332,9 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
                             const size_t pixel = first / static_cast<size_t>(spp);
                             const size_t nearest =
                                 first + static_cast<size_t>(layout.nearestToCentroid(pixel));
-                            const uint32_t point =
+                            st.pixelPoint[pixelAt(bx, by)] =
                                 addPoint(o, vis.facet[nearest * layers], layout.centroidX(pixel),
                                          layout.centroidY(pixel));
-                            for (int k = 0; k < spp; ++k)
-                                st.fragmentPoint[(first + k) * layers - firstSlot] = point;
                             continue;
                         }
                     }
@@ -349,9 +359,9 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
                             const uint32_t point =
                                 addPoint(o, vis.facet[nearest * layers], layout.quadCentroidX(quad),
                                          layout.quadCentroidY(quad));
-                            for (int q = 0; q < 4; ++q)
-                                for (int k = 0; k < spp; ++k)
-                                    st.fragmentPoint[(firsts[q] + k) * layers - firstSlot] = point;
+                            for (int dy = 0; dy < 2; ++dy)
+                                for (int dx = 0; dx < 2; ++dx)
+                                    st.pixelPoint[pixelAt(bx + dx, by + dy)] = point;
                             continue;
                         }
                     }
@@ -424,11 +434,19 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
                 st.x[at] = s.unsortedX[p];
                 st.y[at] = s.unsortedY[p];
             }
-            for (size_t smp = firstSample; smp < endSample; ++smp)
-                for (int l = 0; l < vis.count[smp]; ++l) {
-                    uint32_t& point = st.fragmentPoint[smp * layers + l - firstSlot];
-                    point = s.permutation[point];
+            const size_t firstPixel = firstSample / static_cast<size_t>(spp);
+            for (size_t pixel = firstPixel; pixel < endSample / spp; ++pixel) {
+                uint32_t& whole = st.pixelPoint[pixel - firstPixel];
+                if (whole != kNoPoint) {
+                    whole = s.permutation[whole];
+                    continue;
                 }
+                for (size_t smp = pixel * spp; smp < (pixel + 1) * spp; ++smp)
+                    for (int l = 0; l < vis.count[smp]; ++l) {
+                        uint32_t& point = st.fragmentPoint[smp * layers + l - firstSlot];
+                        point = s.permutation[point];
+                    }
+            }
         }
         const size_t points = st.object.size();
         st.color.resize(3 * points);
@@ -528,21 +546,35 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     }
 
     // 3. Composite every sample front to back over the background; note the pixels whose
-    //    samples all came out alike (the resolve reads those once).
+    //    samples all came out alike (the resolve reads those once). A pixel one point
+    //    covers whole has all its samples alike: only its first is composited and written,
+    //    the one the resolve reads (at per-pixel shading, three quarters of the samples'
+    //    passes over memory).
     const glm::vec3 background = scene_.settings.background;
-    for (size_t smp = firstSample; smp < endSample; ++smp) {
-        SampleComposite c;
-        for (int l = 0; l < vis.count[smp]; ++l) {
-            const uint32_t p = st.fragmentPoint[smp * layers + l - firstSlot];
-            c.over(&st.color[3 * p], &st.opacity[3 * p]);
+    const size_t firstPixel = firstSample / static_cast<size_t>(spp);
+    for (size_t pixel = firstPixel; pixel < endSample / spp; ++pixel) {
+        const size_t first = pixel * static_cast<size_t>(spp);
+        if (!st.pixelPoint.empty()) {
+            if (const uint32_t p = st.pixelPoint[pixel - firstPixel]; p != kNoPoint) {
+                SampleComposite c;
+                c.over(&st.color[3 * p], &st.opacity[3 * p]);
+                c.finish(background, &samples_.rgba[4 * first]);
+                uniform_[pixel] = 1;
+                continue;
+            }
         }
-        c.finish(background, &samples_.rgba[4 * smp]);
-    }
-    for (size_t pixel = firstSample / spp; pixel < endSample / spp; ++pixel) {
-        const float* first = &samples_.rgba[4 * pixel * spp];
+        for (size_t smp = first; smp < first + spp; ++smp) {
+            SampleComposite c;
+            for (int l = 0; l < vis.count[smp]; ++l) {
+                const uint32_t p = st.fragmentPoint[smp * layers + l - firstSlot];
+                c.over(&st.color[3 * p], &st.opacity[3 * p]);
+            }
+            c.finish(background, &samples_.rgba[4 * smp]);
+        }
+        const float* rgba = &samples_.rgba[4 * first];
         bool same = true;
         for (int k = 1; k < spp && same; ++k)
-            same = std::memcmp(first, first + 4 * k, 4 * sizeof(float)) == 0;
+            same = std::memcmp(rgba, rgba + 4 * k, 4 * sizeof(float)) == 0;
         uniform_[pixel] = same ? 1 : 0;
     }
     for (size_t o = 0; o < objects; ++o)
