@@ -103,6 +103,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
             {"controller_seconds", s.controllerSeconds},
             {"prefetch",
              {{"predicted", s.tilesPredicted},
+              {"abandoned", s.predictionAbandoned},
               {"adjacent", s.tilesAdjacent},
               {"filled", s.tilesPrefetched},
               {"used", s.prefetchUsed},

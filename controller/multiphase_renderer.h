@@ -154,9 +154,16 @@ class MultiphaseRenderer {
     // The tiles frame `frame` will lack, predicted by a low-resolution dynamic phase (the
     // image 1/divisor each way, one sample a pixel, shading per pixel with footprints
     // scaled to the full image's at the current rate) over the objects built; its probes
-    // fall back, never wait. `seconds` receives its cost.
+    // fall back, never wait. `seconds` receives its cost. Past `deadline` the prediction
+    // is abandoned where it is (predictionAbandoned()): rasterization stopped short gives no
+    // tiles, shading stopped short the tiles its finished bands lacked; `seconds` then
+    // keeps the larger of its time and the cost it held (a whole prediction's, as far as
+    // known).
     std::vector<TileRequest> predictTiles(int frame, const RenderOptions& options, int divisor,
-                                          double& seconds);
+                                          double& seconds,
+                                          std::chrono::steady_clock::time_point deadline =
+                                              std::chrono::steady_clock::time_point::max());
+    bool predictionAbandoned() const { return predictionAbandoned_; }
     // The tiles next to those the last frame lacked (the 8 around, same level), not resident.
     std::vector<TileRequest> adjacentTiles() const;
     // Fills those of `tiles` not resident, in order, while the time spent stays within
@@ -259,6 +266,7 @@ class MultiphaseRenderer {
     };
     std::vector<Prefetched> prefetched_;
     std::unique_ptr<DynamicPhase> predictor_;
+    bool predictionAbandoned_ = false;  // the last predictTiles() call
     std::shared_ptr<const SampleLayout> predictLayout_;
     FrameState predictState_;
     std::vector<TileRequest> lacking_;

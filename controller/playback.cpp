@@ -62,6 +62,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
     // filled as far as the cache allows. Then one prediction as the frames make them, so
     // the first frames know what one costs.
     double predictCost = 0.0;  // the last prediction's seconds
+    int framesWithoutPrediction = 0;
     if (options.prefetch) {
         const int ahead =
             static_cast<int>(std::lround(options.prerollPrefetchSeconds * scene.settings.fps));
@@ -100,20 +101,35 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         }
         // Only once the frame's own tiles are all in, within the twentieth of the budget
         // kept for the end of the frame.
-        if (options.prefetch && stats.tilesDeferred == 0 &&
-            0.95 * budget - stats.wallSeconds > predictCost) {
-            const double left = 0.95 * budget - stats.wallSeconds;
+        const double slackLeft = 0.95 * budget - stats.wallSeconds;
+        const bool retry =
+            framesWithoutPrediction >= options.predictRetryFrames && slackLeft > 0.5 * predictCost;
+        ++framesWithoutPrediction;
+        if (options.prefetch && stats.tilesDeferred == 0 && (slackLeft > predictCost || retry)) {
+            framesWithoutPrediction = 0;
+            const double left = slackLeft;
+            // A prediction runs longer than its last at times (twice as long, when the
+            // machine is busy elsewhere): one still running at the end of the slack is
+            // abandoned rather than making the frame late.
+            const auto deadline = std::chrono::steady_clock::now() +
+                                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                      std::chrono::duration<double>(left));
             const int ahead =
                 std::min(options.last - 1,
                          frame + std::max(1, static_cast<int>(std::lround(options.predictSeconds *
                                                                           scene.settings.fps))));
-            std::vector<TileRequest> tiles =
-                renderer.predictTiles(ahead, options.render, options.predictDivisor, predictCost);
+            const auto predicting = std::chrono::steady_clock::now();
+            std::vector<TileRequest> tiles = renderer.predictTiles(
+                ahead, options.render, options.predictDivisor, predictCost, deadline);
+            const double predicted =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - predicting)
+                    .count();
+            stats.predictionAbandoned = renderer.predictionAbandoned();
             stats.tilesPredicted = tiles.size();
             const std::vector<TileRequest> adjacent = renderer.adjacentTiles();
             stats.tilesAdjacent = adjacent.size();
             tiles.insert(tiles.end(), adjacent.begin(), adjacent.end());
-            const double spent = predictCost + renderer.prefetch(tiles, left - predictCost, stats);
+            const double spent = predicted + renderer.prefetch(tiles, left - predicted, stats);
             stats.prefetchSeconds = spent;
             stats.staticSeconds += spent;
             stats.wallSeconds += spent;

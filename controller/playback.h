@@ -47,6 +47,11 @@ struct PlaybackOptions {
     double prerollPrefetchWallSeconds = 2.0;
     double predictSeconds = 0.1;
     int predictDivisor = 4;
+    // A prediction starts when the slack holds its last cost. One still running when the
+    // slack ends is abandoned (the frame stays on time) and its cost kept as at least that
+    // long; after this many frames without one, one starts in half its cost, so that one
+    // slow prediction does not keep every later one away.
+    int predictRetryFrames = 15;
     // Tiles a frame lacked and had no time left to fill go to a worker thread at idle
     // priority, which fills them outside the frames' dynamic phase: while the frame's image
     // is written, a prediction's probes run, and between frames (background_filler.h).

@@ -33,7 +33,8 @@ float footprintPixels(ShadingRate rate, int spp) {
 }  // namespace
 
 std::vector<TileRequest> MultiphaseRenderer::predictTiles(int frame, const RenderOptions& options,
-                                                          int divisor, double& seconds) {
+                                                          int divisor, double& seconds,
+                                                          Clock::time_point deadline) {
     const auto start = Clock::now();
     const ScopedSpan span(options_.trace, "predict tiles", PhaseKind::Static, SpanLevel::Phase, -1,
                           frame);
@@ -63,9 +64,14 @@ std::vector<TileRequest> MultiphaseRenderer::predictTiles(int frame, const Rende
     o.footprintScale = options_.dynamic.footprintScale * footprintPixels(rate, spp) /
                        (0.5f * static_cast<float>(divisor));
     o.shadingRate = ShadingRate::Pixel;
+    o.deadline = deadline;
     predictor_->begin(predictState_, drawn, predictLayout_, o);
-    std::vector<TileRequest> lacking = predictor_->shade(true);
-    seconds = secondsSince(start);
+    // Abandoned in rasterization: no visibility to trust, so nothing predicted. In
+    // shading: the finished bands' tiles stand.
+    std::vector<TileRequest> lacking;
+    if (!predictor_->abandoned()) lacking = predictor_->shade(true);
+    predictionAbandoned_ = predictor_->abandoned();
+    seconds = predictionAbandoned_ ? std::max(seconds, secondsSince(start)) : secondsSince(start);
     return lacking;
 }
 

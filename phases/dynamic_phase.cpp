@@ -1,6 +1,7 @@
 #include "phases/dynamic_phase.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -183,8 +184,10 @@ void DynamicPhase::begin(const FrameState& frame,
                      clusterVisible_[i].data(),
                      rep->kind == Representation::Facets ? &costs_[i].longestEdgePixels : nullptr};
     }
-    rasterizer_.rasterize(raster, *layout_, camera.zFar, options.raster, visibility_,
-                          stats_.raster);
+    RasterOptions rasterOptions = options.raster;
+    rasterOptions.deadline = options.deadline;
+    rasterizer_.rasterize(raster, *layout_, camera.zFar, rasterOptions, visibility_, stats_.raster);
+    abandoned_ = stats_.raster.abandoned;
     stats_.rasterSeconds = secondsSince(start);
     if (options.trace)
         options.trace->span("rasterize", PhaseKind::Dynamic, SpanLevel::Phase, start, Clock::now(),
@@ -208,14 +211,22 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
     const auto start = Clock::now();
     const ScopedSpan span(options_.trace, "shade", PhaseKind::Dynamic, SpanLevel::Phase, -1,
                           frame_->index);
+    if (abandoned_ && stats_.raster.abandoned) return {};
     ++stats_.shadePasses;
     tbb::enumerable_thread_specific<std::vector<TileRequest>> lacking;
+    const bool timed = options_.deadline != Clock::time_point::max();
+    std::atomic<bool> late{false};
     tbb::parallel_for(size_t{0}, bandDone_.size(), [&](size_t b) {
         if (bandDone_[b]) return;
+        if (timed && (late.load(std::memory_order_relaxed) || Clock::now() > options_.deadline)) {
+            late.store(true, std::memory_order_relaxed);
+            return;
+        }
         const ScopedSpan task(options_.trace, "band", PhaseKind::Dynamic, SpanLevel::Task, -1,
                               frame_->index);
         shadeBand(b, acceptFallbacks, lacking.local());
     });
+    abandoned_ = abandoned_ || late.load();
     std::vector<TileRequest> all;
     for (const std::vector<TileRequest>& l : lacking) all.insert(all.end(), l.begin(), l.end());
     sortUniqueTiles(all);

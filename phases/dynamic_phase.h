@@ -18,6 +18,7 @@
 // pixel per pixel, times footprintScale.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -54,6 +55,10 @@ struct DynamicOptions {
     // Where the warp, rasterization, shading bands and resolve report their spans (not
     // owned; null: nowhere).
     PhaseTrace* trace = nullptr;
+    // Past this moment rasterization and shading stop where they are (abandoned()): for a
+    // dynamic phase worth less than a deadline, as a prediction in a frame's slack is
+    // (overrides raster.deadline). Default never.
+    std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 };
 
 // What one object cost this frame.
@@ -97,6 +102,9 @@ class DynamicPhase {
     // otherwise bands that lacked tiles stay undone until a later call.
     std::vector<TileRequest> shade(bool acceptFallbacks = false);
     bool complete() const;
+    // The deadline passed first: rasterization stopped short (the frame cannot be shaded),
+    // or shade() left bands undone.
+    bool abandoned() const { return abandoned_; }
     // The composited samples (after shade() completed every band).
     const SampleBuffer& samples() const { return samples_; }
     // Filters the samples into pixels.
@@ -125,6 +133,7 @@ class DynamicPhase {
     SampleBuffer samples_;
     std::vector<uint8_t> uniform_;  // per pixel: every sample alike
     std::vector<uint8_t> bandDone_;
+    bool abandoned_ = false;
     std::unique_ptr<Band> scratch_;
     DynamicFrameStats stats_;
     std::vector<ObjectFrameCost> costs_;

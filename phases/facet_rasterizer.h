@@ -19,6 +19,7 @@
 // one; with every object opaque, one layer and a plain depth test.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -68,6 +69,7 @@ struct RasterStats {
     uint64_t tilesCoveredWhole = 0;       // facet-tile pairs that skipped the edge tests
     uint64_t fragments = 0;               // sample hits tested against the depth buffer
     uint64_t droppedLayers = 0;           // translucent surfaces beyond the k-buffer's depth
+    bool abandoned = false;  // RasterOptions::deadline passed: the buffer is incomplete
 };
 
 struct RasterOptions {
@@ -77,6 +79,10 @@ struct RasterOptions {
     // fewer tiles to share between threads.
     int tileSize = 32;
     int layers = 4;  // surfaces kept per sample when some object is translucent
+    // Past this moment the chunks not yet binned and the tiles not yet drawn are skipped
+    // and RasterStats::abandoned is set: the visibility buffer is then unusable. For work
+    // that is worth less than a deadline (a prediction in a frame's slack); default never.
+    std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 };
 
 // Keeps its bins and tile buffers from frame to frame, so a steady frame allocates nothing.

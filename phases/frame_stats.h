@@ -106,6 +106,7 @@ struct FrameStats {
     // first (used) and those dropped, or left unread for
     // MultiphaseOptions::prefetchPatienceFrames, unread (wasted).
     uint64_t tilesPredicted = 0, tilesAdjacent = 0, tilesPrefetched = 0;
+    bool predictionAbandoned = false;  // the prediction ran past the slack and was dropped
     uint64_t prefetchUsed = 0, prefetchWasted = 0;
     double prefetchSeconds = 0.0;  // of staticSeconds: predicting and prefetching
     // The background filler (MultiphaseOptions::backgroundFills), since the last frame:

@@ -581,6 +581,7 @@ TEST(Cli, PlayReportsEveryFramesDeadlineAndWritesFramesUnlessAsked) {
         EXPECT_LE(p["filled"].get<uint64_t>(),
                   p["predicted"].get<uint64_t>() + p["adjacent"].get<uint64_t>());
         EXPECT_GE(p["seconds"].get<double>(), 0.0);
+        EXPECT_TRUE(p["abandoned"].is_boolean());
         // The background filler's work since the last frame: what it filled was deferred.
         const nlohmann::json& b = f["background"];
         EXPECT_TRUE(b["filled"].is_number() && b["evicted"].is_number());

@@ -1,6 +1,7 @@
 // The multi-phase pipeline's numerics and coverage: the fixed-point warp against double
 // precision, extreme placements, watertight rasterization, no pinholes over a range of
 // views, and frames against the reference.
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -366,6 +367,34 @@ std::string writeBlobScene(const std::string& name, int frames, std::mt19937& rn
         << test::sourcePath("tests/data/meshes/octahedron.obj")
         << R"(", "scheme": "loop" }, "shader": "white", "range": { "distance_factor": 1.25, "angle": 20 } } ] })";
     return dir + "scene.json";
+}
+
+TEST(FacetRasterizer, WorkPastTheDeadlineIsAbandoned) {
+    // A deadline already past: nothing is binned or drawn and the result says so. One an
+    // hour away: the timed path draws exactly what the untimed one does.
+    GridFixture g;
+    for (bool opaque : {true, false}) {
+        VisibilityBuffer untimed, late, early;
+        RasterStats a, b, c;
+        RasterOptions options;
+        rasterizeFacets({{&g.mesh, &g.warped, nullptr, opaque}}, *g.layout, 1e30f, options, untimed,
+                        a);
+        ASSERT_FALSE(a.abandoned);
+        ASSERT_GT(a.fragments, 10000u);
+        options.deadline = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+        rasterizeFacets({{&g.mesh, &g.warped, nullptr, opaque}}, *g.layout, 1e30f, options, late,
+                        b);
+        EXPECT_TRUE(b.abandoned);
+        EXPECT_EQ(b.facetsBinned, 0u);
+        EXPECT_EQ(b.fragments, 0u);
+        options.deadline = std::chrono::steady_clock::now() + std::chrono::hours(1);
+        rasterizeFacets({{&g.mesh, &g.warped, nullptr, opaque}}, *g.layout, 1e30f, options, early,
+                        c);
+        EXPECT_FALSE(c.abandoned);
+        EXPECT_EQ(c.fragments, a.fragments);
+        EXPECT_EQ(c.facetsBinned, a.facetsBinned);
+        EXPECT_TRUE(std::equal(early.count.begin(), early.count.end(), untimed.count.begin()));
+    }
 }
 
 TEST(MultiphaseRenderer, NoPinholesOverTwoHundredViewsInTheRange) {

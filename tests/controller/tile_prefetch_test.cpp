@@ -2,6 +2,7 @@
 // is not lacked there and counts as used; one no frame reads counts as wasted; the
 // low-resolution prediction names the tiles the full frame will lack.
 #include <algorithm>
+#include <chrono>
 
 #include <gtest/gtest.h>
 
@@ -125,6 +126,30 @@ TEST(TilePrefetch, AGuessNeverDisplacesATileInTheCache) {
     // guess finds no room and fills nothing.
     EXPECT_EQ(slack.tilesEvicted, 0u);
     EXPECT_EQ(slack.tilesPrefetched, 0u);
+}
+
+TEST(TilePrefetch, PredictionPastItsDeadlineIsAbandoned) {
+    // `play` gives a prediction only the frame's slack: past its deadline it names no tile
+    // and says it was abandoned, and the cost it held stands (a planted "seconds = time
+    // spent" would make the next frame start one it has no time for). The next prediction,
+    // with time, is whole again.
+    const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    MultiphaseRenderer renderer(scene, budgeted());
+    FrameStats stats;
+    renderer.renderFrame(0, small(), stats);
+    double seconds = 5.0;
+    const std::vector<TileRequest> late = renderer.predictTiles(
+        16, small(), 1, seconds, std::chrono::steady_clock::now() - std::chrono::seconds(1));
+    EXPECT_TRUE(late.empty());
+    EXPECT_TRUE(renderer.predictionAbandoned());
+    EXPECT_EQ(seconds, 5.0);
+    const std::vector<TileRequest> whole = renderer.predictTiles(
+        16, small(), 1, seconds, std::chrono::steady_clock::now() + std::chrono::hours(1));
+    EXPECT_FALSE(renderer.predictionAbandoned());
+    EXPECT_FALSE(whole.empty());
+    EXPECT_LT(seconds, 5.0);
+    double untimedSeconds = 0.0;
+    EXPECT_EQ(renderer.predictTiles(16, small(), 1, untimedSeconds).size(), whole.size());
 }
 
 TEST(TilePrefetch, NeighboursOfLackedTilesAreAdjacentAndNotResident) {
