@@ -1,9 +1,12 @@
 #include "app/play_command.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <unistd.h>
 #include <nlohmann/json.hpp>
@@ -19,6 +22,36 @@
 #include "scene/scene.h"
 
 namespace mpshade {
+namespace {
+
+// "per pixel, footprint x2, 2 spp": a step as the summary names it.
+std::string describeStep(const QualityStep& step, int spp) {
+    std::string s = step.rate == ShadingRate::Sample  ? "per sample"
+                    : step.rate == ShadingRate::Pixel ? "per pixel"
+                                                      : "per 2x2 pixels";
+    if (step.footprintScale != 1.0f) {
+        char scale[32];
+        std::snprintf(scale, sizeof scale, ", footprint x%g", step.footprintScale);
+        s += scale;
+    }
+    return s + ", " + std::to_string(step.samplesPerPixel > 0 ? step.samplesPerPixel : spp) +
+           " spp";
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+}
+
+// What the summary reports of each frame.
+struct PlayedFrame {
+    double wall, dynamic, raster, shade, resolve, statics, controller;
+    uint64_t probes, fallbacks, prefetched, prefetchUsed;
+};
+
+}  // namespace
 
 int runPlayCommand(const PlayCommandOptions& options) {
     if (!(options.fps >= 0.1 && options.fps <= 1000.0))
@@ -46,10 +79,23 @@ int runPlayCommand(const PlayCommandOptions& options) {
     nlohmann::json frames = nlohmann::json::array();
     int met = 0;
     double preroll = 0.0;
+    std::vector<PlaybackStep> steps;  // frames counted here as they are played
+    std::vector<PlayedFrame> playedFrames;
     // stats.json, rewritten (atomically) after every frame: what a stopped playback
     // finished is always described.
     const auto writeStats = [&](double prerollSeconds) {
         const int played = static_cast<int>(frames.size());
+        nlohmann::json ladder = nlohmann::json::array();
+        for (size_t k = 0; k < steps.size(); ++k) {
+            const QualityStep& q = steps[k].step;
+            ladder.push_back(
+                {{"level", k},
+                 {"shading_rate", shadingRateName(q.rate)},
+                 {"footprint_scale", q.footprintScale},
+                 {"samples_per_pixel", q.samplesPerPixel > 0 ? q.samplesPerPixel : spp},
+                 {"preroll_dynamic_seconds", steps[k].dynamicSeconds},
+                 {"frames", steps[k].frames}});
+        }
         const nlohmann::json doc = {
             {"scene", options.scene},
             {"mode", "play"},
@@ -67,6 +113,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
             {"deadlines_met", met},
             {"deadline_met_fraction", played > 0 ? static_cast<double>(met) / played : 1.0},
             {"peak_resident_mb", peakResidentBytes() >> 20},
+            {"steps", ladder},
             {"frames", frames}};
         writeTextFile(dir / "stats.json", doc.dump(2) + "\n");
     };
@@ -81,6 +128,12 @@ int runPlayCommand(const PlayCommandOptions& options) {
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
         }
         met += s.deadlineMet ? 1 : 0;
+        if (static_cast<size_t>(quality.level) < steps.size())
+            ++steps[static_cast<size_t>(quality.level)].frames;
+        const double dynamic = s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
+        playedFrames.push_back({s.wallSeconds, dynamic, s.rasterSeconds, s.shadeSeconds,
+                                s.resolveSeconds, s.staticSeconds, s.controllerSeconds, s.probes,
+                                s.probeFallbacks, s.tilesPrefetched, s.prefetchUsed});
         nlohmann::json entry = {
             {"index", s.index},
             {"time", s.time},
@@ -122,8 +175,10 @@ int runPlayCommand(const PlayCommandOptions& options) {
         writeStats(preroll);
         return !interrupted();
     };
-    const PlaybackSummary summary =
-        playScene(scene, po, onFrame, [&](double seconds) { preroll = seconds; });
+    const PlaybackSummary summary = playScene(scene, po, onFrame, [&](const PlaybackSummary& s) {
+        preroll = s.prerollSeconds;
+        steps = s.steps;
+    });
     if (tty) std::fprintf(stderr, "\n");
     writeStats(summary.prerollSeconds);
     if (interrupted()) {
@@ -140,6 +195,45 @@ int runPlayCommand(const PlayCommandOptions& options) {
                      summary.deadlinesMet, summary.frames, options.fps,
                      summary.frames > 0 ? 100.0 * summary.deadlinesMet / summary.frames : 100.0,
                      summary.prerollSeconds, (dir / "stats.json").string().c_str());
+    if (!options.quiet && !playedFrames.empty()) {
+        // Where the frame's time went, and what each step costs: why the frames played at
+        // the quality they did.
+        const double slot = 1e3 / options.fps;
+        std::fprintf(stderr,
+                     "  steps, best first: the first frame's dynamic phase at each (measured in "
+                     "the pre-roll; the slot is %.1f ms), and the frames played there\n",
+                     slot);
+        for (const PlaybackStep& p : summary.steps) {
+            const std::string name = describeStep(p.step, spp);
+            if (p.frames > 0)
+                std::fprintf(stderr, "    %-34s %7.1f ms  %d frame(s)\n", name.c_str(),
+                             1e3 * p.dynamicSeconds, p.frames);
+            else
+                std::fprintf(stderr, "    %-34s %7.1f ms\n", name.c_str(), 1e3 * p.dynamicSeconds);
+        }
+        auto med = [&](double PlayedFrame::*field) {
+            std::vector<double> v;
+            for (const PlayedFrame& f : playedFrames) v.push_back(1e3 * (f.*field));
+            return median(std::move(v));
+        };
+        std::fprintf(stderr,
+                     "  median frame: %.1f ms; dynamic phase %.1f (rasterize %.1f, shade %.1f, "
+                     "resolve %.1f), static %.1f, controller %.2f\n",
+                     med(&PlayedFrame::wall), med(&PlayedFrame::dynamic), med(&PlayedFrame::raster),
+                     med(&PlayedFrame::shade), med(&PlayedFrame::resolve),
+                     med(&PlayedFrame::statics), med(&PlayedFrame::controller));
+        uint64_t probes = 0, fallbacks = 0, prefetched = 0, used = 0;
+        for (const PlayedFrame& f : playedFrames) {
+            probes += f.probes, fallbacks += f.fallbacks;
+            prefetched += f.prefetched, used += f.prefetchUsed;
+        }
+        std::fprintf(stderr,
+                     "  probes answered from a coarser level: %.2f%%; tiles prefetched %llu, "
+                     "read by a later frame %llu\n",
+                     probes > 0 ? 100.0 * static_cast<double>(fallbacks) / probes : 0.0,
+                     static_cast<unsigned long long>(prefetched),
+                     static_cast<unsigned long long>(used));
+    }
     return 0;
 }
 

@@ -9,7 +9,7 @@ namespace mpshade {
 
 PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
                           const PlaybackFrameFn& onFrame,
-                          const std::function<void(double)>& onPreroll) {
+                          const std::function<void(const PlaybackSummary&)>& onPreroll) {
     MPSHADE_CHECK(options.fps > 0.0);
     MultiphaseOptions mo;
     // The always-resident levels are filled as each map is made: a missing tile always has
@@ -52,6 +52,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         renderer.renderFrame(options.first, stepOptions(k), s, image);
         stepSeconds[static_cast<size_t>(k)] =
             s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
+        summary.steps.push_back({regulator.step(k), stepSeconds[static_cast<size_t>(k)], 0});
     }
     const double budget = 1.0 / options.fps;
     regulator.calibrate(stepSeconds, budget);
@@ -80,7 +81,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
     }
     summary.prerollSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (onPreroll) onPreroll(summary.prerollSeconds);
+    if (onPreroll) onPreroll(summary);
     renderer.setFrameBudget(budget);
     for (int frame = options.first; frame < options.last; ++frame) {
         const PlaybackQuality quality{regulator.level(), regulator.step()};
@@ -137,6 +138,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         }
         ++summary.frames;
         summary.deadlinesMet += stats.deadlineMet ? 1 : 0;
+        ++summary.steps[static_cast<size_t>(quality.level)].frames;
         const auto regulating = std::chrono::steady_clock::now();
         regulator.update(stats, budget);
         stats.controllerSeconds +=

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <functional>
+#include <vector>
 
 #include "controller/multiphase_renderer.h"
 #include "controller/quality_regulator.h"
@@ -61,9 +62,17 @@ struct PlaybackOptions {
     bool backgroundDuringFrames = false;
 };
 
+// One step of the quality regulator's ladder, as the pre-roll measured it.
+struct PlaybackStep {
+    QualityStep step;
+    double dynamicSeconds = 0.0;  // the first frame's dynamic phase at this step, warm
+    int frames = 0;               // frames played at this step
+};
+
 struct PlaybackSummary {
     double prerollSeconds = 0.0;  // the first frame at constant quality, before the clock
     int frames = 0, deadlinesMet = 0;
+    std::vector<PlaybackStep> steps;  // the ladder, best first (PlaybackQuality::level)
 };
 
 // Plays frames [first, last); after each, onFrame(stats, image, the quality step it used)
@@ -75,9 +84,10 @@ struct PlaybackQuality {
 };
 using PlaybackFrameFn =
     std::function<bool(const FrameStats&, const Image&, const PlaybackQuality&)>;
-// onPreroll(seconds) once the pre-roll is done, before the first frame.
+// onPreroll(summary) once the pre-roll is done, before the first frame: its seconds and
+// the steps with their measured costs (no frame played yet).
 PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
                           const PlaybackFrameFn& onFrame,
-                          const std::function<void(double)>& onPreroll = {});
+                          const std::function<void(const PlaybackSummary&)>& onPreroll = {});
 
 }  // namespace mpshade

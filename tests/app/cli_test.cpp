@@ -566,6 +566,25 @@ TEST(Cli, PlayReportsEveryFramesDeadlineAndWritesFramesUnlessAsked) {
     EXPECT_EQ(stats["mode"], "play");
     EXPECT_EQ(stats["cache_mb"], 8);
     ASSERT_EQ(stats["frames"].size(), 3u);
+    // The regulator's ladder, as the pre-roll measured it: every frame's step is one of
+    // it, and its frame counts add up to the frames played. The summary names the steps.
+    const nlohmann::json& steps = stats["steps"];
+    ASSERT_GE(steps.size(), 2u);
+    int stepFrames = 0;
+    for (size_t k = 0; k < steps.size(); ++k) {
+        EXPECT_EQ(steps[k]["level"].get<size_t>(), k);
+        EXPECT_GT(steps[k]["preroll_dynamic_seconds"].get<double>(), 0.0);
+        stepFrames += steps[k]["frames"].get<int>();
+    }
+    EXPECT_EQ(stepFrames, 3);
+    for (const nlohmann::json& f : stats["frames"]) {
+        const nlohmann::json& step = steps[f["quality"]["level"].get<size_t>()];
+        EXPECT_EQ(step["shading_rate"], f["quality"]["shading_rate"]);
+        EXPECT_EQ(step["samples_per_pixel"], f["quality"]["samples_per_pixel"]);
+        EXPECT_EQ(step["footprint_scale"], f["quality"]["footprint_scale"]);
+    }
+    EXPECT_NE(run.output.find("per sample, 4 spp"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("median frame:"), std::string::npos) << run.output;
     int met = 0;
     for (const nlohmann::json& f : stats["frames"]) {
         ASSERT_TRUE(f["deadline_met"].is_boolean());

@@ -148,6 +148,13 @@ TEST(Playback, PlaysEveryFrameAndRegulatesItsQuality) {
         EXPECT_EQ(q.step.footprintScale, 2.0f);
         EXPECT_EQ(q.step.samplesPerPixel, 1);
     }
+    // The ladder as measured in the pre-roll, and where the frames were played.
+    ASSERT_EQ(summary.steps.size(), 7u);
+    EXPECT_EQ(summary.steps[0].step.rate, ShadingRate::Sample);
+    EXPECT_EQ(summary.steps[6].step.samplesPerPixel, 1);
+    for (const PlaybackStep& p : summary.steps) EXPECT_GT(p.dynamicSeconds, 0.0);
+    EXPECT_EQ(summary.steps[6].frames, 4);
+    for (size_t k = 0; k < 6; ++k) EXPECT_EQ(summary.steps[k].frames, 0);
 }
 
 }  // namespace
