@@ -108,13 +108,12 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         ++framesWithoutPrediction;
         if (options.prefetch && stats.tilesDeferred == 0 && (slackLeft > predictCost || retry)) {
             framesWithoutPrediction = 0;
-            const double left = slackLeft;
             // A prediction runs longer than its last at times (twice as long, when the
             // machine is busy elsewhere): one still running at the end of the slack is
             // abandoned rather than making the frame late.
             const auto deadline = std::chrono::steady_clock::now() +
                                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                      std::chrono::duration<double>(left));
+                                      std::chrono::duration<double>(slackLeft));
             const int ahead =
                 std::min(options.last - 1,
                          frame + std::max(1, static_cast<int>(std::lround(options.predictSeconds *
@@ -130,7 +129,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
             const std::vector<TileRequest> adjacent = renderer.adjacentTiles();
             stats.tilesAdjacent = adjacent.size();
             tiles.insert(tiles.end(), adjacent.begin(), adjacent.end());
-            const double spent = predicted + renderer.prefetch(tiles, left - predicted, stats);
+            const double spent = predicted + renderer.prefetch(tiles, slackLeft - predicted, stats);
             stats.prefetchSeconds = spent;
             stats.staticSeconds += spent;
             stats.wallSeconds += spent;

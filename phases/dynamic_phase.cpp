@@ -211,7 +211,7 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
     const auto start = Clock::now();
     const ScopedSpan span(options_.trace, "shade", PhaseKind::Dynamic, SpanLevel::Phase, -1,
                           frame_->index);
-    if (abandoned_ && stats_.raster.abandoned) return {};
+    if (stats_.raster.abandoned) return {};  // no visibility to shade
     ++stats_.shadePasses;
     tbb::enumerable_thread_specific<std::vector<TileRequest>> lacking;
     const bool timed = options_.deadline != Clock::time_point::max();
