@@ -490,6 +490,43 @@ TEST(Probe, DegenerateFootprintsGiveFiniteResults) {
     }
 }
 
+TEST(Probe, FootprintsWithinASixteenthShareTheLastSetup) {
+    // Feline keeps the last query's setup (level, line, weights) for a footprint within
+    // 1/16 of it: at 1.06 times the footprint the answer is the first query's, bit for
+    // bit, though alone it reads other levels' weights; at 1.07 it is its own. The
+    // footprint sits where two levels blend (lod 3.47: 1.06 moves it to 3.55), so the
+    // three answers differ.
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions options;
+    options.resolution = 256;
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    map.fillLevels(0, map.levels() - 1);
+    const ProbeOptions probe{ProbeFilter::Feline, 2.0f, 0.125f, 1.0f, AnisotropyCap::ShrinkMajor};
+    const float base = std::exp2(3.47f) / 256.0f;
+    auto at = [&](float scale) {
+        return ProbeQuery{0, 0.37f, 0.61f, base * scale, 0.0f, 0.0f, base * scale};
+    };
+    auto probeAlone = [&](float scale, float* out) {
+        const ProbeQuery q = at(scale);
+        probeShaderMap(map, probe, {&q, 1}, out);
+    };
+    float first[3], near[3], far[3];
+    probeAlone(1.0f, first);
+    probeAlone(1.06f, near);
+    probeAlone(1.07f, far);
+    ASSERT_NE(first[0], near[0]);
+    ASSERT_NE(first[0], far[0]);
+    for (float scale : {1.06f, 1.07f}) {
+        const ProbeQuery pair[2] = {at(1.0f), at(scale)};
+        float out[6];
+        probeShaderMap(map, probe, pair, out);
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(out[c], first[c]);
+            EXPECT_EQ(out[3 + c], scale == 1.06f ? first[c] : far[c]) << "at " << scale;
+        }
+    }
+}
+
 TEST(TileTable, FindsWhatWasInsertedAndForgetsWhatWasErased) {
     // Random keys in and out, checked against std::map; erasing from the middle of a
     // probe run must keep the keys after it findable (tombstones), and growing past
