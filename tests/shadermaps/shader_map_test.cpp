@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <random>
 #include <set>
 
@@ -38,6 +39,15 @@ struct MapFixture {
         auto ast = compileShaderText("map.sl", source);
         factored = factorShader(*ast, {}, storeEverything());
         kernel = std::make_unique<ShaderKernel>(factored.staticPart);
+    }
+
+    // A map of every level at `resolution` texels a chart side, all filled.
+    std::unique_ptr<ShaderMap> filledMap(int resolution) const {
+        ShaderMapOptions options;
+        options.resolution = resolution;
+        auto map = std::make_unique<ShaderMap>(surface, *kernel, uniforms, options);
+        map->fillLevels(0, map->levels() - 1);
+        return map;
     }
 
     // The static program at one chart point, directly.
@@ -94,11 +104,9 @@ ProbeQuery query(float u, float v, float du, float dv, float aniso = 1.0f, float
 
 TEST(ShaderMap, ExactAtTexelCentres) {
     MapFixture f(kNoiseShader);
-    ShaderMapOptions options;
-    options.resolution = 64;
-    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
+    const std::unique_ptr<ShaderMap> owned = f.filledMap(64);
+    const ShaderMap& map = *owned;
     ASSERT_EQ(map.channels(), 3);
-    map.fillLevels(0, map.levels() - 1);
     ProbeOptions probe;
     probe.filter = ProbeFilter::Trilinear;
     for (int j = 0; j < 64; j += 7)
@@ -114,10 +122,8 @@ TEST(ShaderMap, ExactAtTexelCentres) {
 
 TEST(ShaderMap, TrilinearIsExactOnLinearFunctions) {
     MapFixture f(kLinearShader);
-    ShaderMapOptions options;
-    options.resolution = 128;
-    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
-    map.fillLevels(0, map.levels() - 1);
+    const std::unique_ptr<ShaderMap> owned = f.filledMap(128);
+    const ShaderMap& map = *owned;
     ProbeOptions probe;
     probe.filter = ProbeFilter::Trilinear;
     std::mt19937 rng(1);
@@ -136,10 +142,8 @@ TEST(ShaderMap, TrilinearIsExactOnLinearFunctions) {
 
 TEST(ShaderMap, FelineStaysCloseToEwa) {
     MapFixture f(kNoiseShader);
-    ShaderMapOptions options;
-    options.resolution = 256;
-    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
-    map.fillLevels(0, map.levels() - 1);
+    const std::unique_ptr<ShaderMap> owned = f.filledMap(256);
+    const ShaderMap& map = *owned;
     ProbeOptions feline, ewa;
     feline.filter = ProbeFilter::Feline;
     ewa.filter = ProbeFilter::EWA;
@@ -300,10 +304,8 @@ TEST(ShaderMap, AnisotropyCapWidensTheMinorAxisOrShortensTheMajor) {
     // (level 3, where a texel spans a whole period: the stripes average out); shortening
     // keeps level 0, where the stripes are resolved.
     MapFixture f("surface s() { Ci = color(bake(sin(u * 6.2831853 * 32)), 0, 0) * (1 + time); }");
-    ShaderMapOptions options;
-    options.resolution = 256;
-    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
-    map.fillLevels(0, map.levels() - 1);
+    const std::unique_ptr<ShaderMap> owned = f.filledMap(256);
+    const ShaderMap& map = *owned;
     for (AnisotropyCap cap : {AnisotropyCap::WidenMinor, AnisotropyCap::ShrinkMajor}) {
         ProbeOptions probe;
         probe.filter = ProbeFilter::Feline;
@@ -469,10 +471,8 @@ TEST(HalfFloat, RoundTripsAndRoundsToNearest) {
 
 TEST(Probe, DegenerateFootprintsGiveFiniteResults) {
     MapFixture f(kNoiseShader);
-    ShaderMapOptions options;
-    options.resolution = 64;
-    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
-    map.fillLevels(0, map.levels() - 1);
+    const std::unique_ptr<ShaderMap> owned = f.filledMap(64);
+    const ShaderMap& map = *owned;
     const float inf = INFINITY, nan = NAN;
     const ProbeQuery cases[] = {
         {0, 0.5f, 0.5f, 0, 0, 0, 0},         {0, 0.5f, 0.5f, nan, 0, 0, nan},
@@ -497,10 +497,8 @@ TEST(Probe, FootprintsWithinASixteenthShareTheLastSetup) {
     // footprint sits where two levels blend (lod 3.47: 1.06 moves it to 3.55), so the
     // three answers differ.
     MapFixture f(kNoiseShader);
-    ShaderMapOptions options;
-    options.resolution = 256;
-    ShaderMap map(f.surface, *f.kernel, f.uniforms, options);
-    map.fillLevels(0, map.levels() - 1);
+    const std::unique_ptr<ShaderMap> owned = f.filledMap(256);
+    const ShaderMap& map = *owned;
     const ProbeOptions probe{ProbeFilter::Feline, 2.0f, 0.125f, 1.0f, AnisotropyCap::ShrinkMajor};
     const float base = std::exp2(3.47f) / 256.0f;
     auto at = [&](float scale) {
