@@ -50,8 +50,8 @@ struct PlaybackOptions {
     int predictDivisor = 4;
     // A prediction starts when the slack holds its last cost. One still running when the
     // slack ends is abandoned (the frame stays on time) and its cost kept as at least that
-    // long; after this many frames without one, one starts in half its cost, so that one
-    // slow prediction does not keep every later one away.
+    // long; after this many frames without one, one starts when half its cost fits, so
+    // that one slow prediction does not keep every later one away.
     int predictRetryFrames = 15;
     // Tiles a frame lacked and had no time left to fill go to a worker thread at idle
     // priority, which fills them outside the frames' dynamic phase: while the frame's image
