@@ -48,7 +48,7 @@ double median(std::vector<double> v) {
 // What the summary reports of each frame.
 struct PlayedFrame {
     double wall, dynamic, raster, shade, resolve, statics, controller;
-    uint64_t probes, fallbacks, prefetched, prefetchUsed;
+    uint64_t probes, fallbacks, prefetched, prefetchUsed, prefetchWasted;
 };
 
 }  // namespace
@@ -133,7 +133,8 @@ int runPlayCommand(const PlayCommandOptions& options) {
         const double dynamic = s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
         playedFrames.push_back({s.wallSeconds, dynamic, s.rasterSeconds, s.shadeSeconds,
                                 s.resolveSeconds, s.staticSeconds, s.controllerSeconds, s.probes,
-                                s.probeFallbacks, s.tilesPrefetched, s.prefetchUsed});
+                                s.probeFallbacks, s.tilesPrefetched, s.prefetchUsed,
+                                s.prefetchWasted});
         nlohmann::json entry = {
             {"index", s.index},
             {"time", s.time},
@@ -222,17 +223,20 @@ int runPlayCommand(const PlayCommandOptions& options) {
                      med(&PlayedFrame::wall), med(&PlayedFrame::dynamic), med(&PlayedFrame::raster),
                      med(&PlayedFrame::shade), med(&PlayedFrame::resolve),
                      med(&PlayedFrame::statics), med(&PlayedFrame::controller));
-        uint64_t probes = 0, fallbacks = 0, prefetched = 0, used = 0;
+        uint64_t probes = 0, fallbacks = 0, prefetched = 0, used = 0, wasted = 0;
         for (const PlayedFrame& f : playedFrames) {
             probes += f.probes, fallbacks += f.fallbacks;
-            prefetched += f.prefetched, used += f.prefetchUsed;
+            prefetched += f.prefetched, used += f.prefetchUsed, wasted += f.prefetchWasted;
         }
+        // Read and wasted count the pre-roll's prefetched tiles too.
         std::fprintf(stderr,
-                     "  probes answered from a coarser level: %.2f%%; tiles prefetched %llu, "
-                     "read by a later frame %llu\n",
+                     "  probes answered from a coarser level: %.2f%%; tiles prefetched while "
+                     "playing %llu; of all prefetched (the pre-roll's too), read by a later "
+                     "frame %llu, wasted %llu\n",
                      probes > 0 ? 100.0 * static_cast<double>(fallbacks) / probes : 0.0,
                      static_cast<unsigned long long>(prefetched),
-                     static_cast<unsigned long long>(used));
+                     static_cast<unsigned long long>(used),
+                     static_cast<unsigned long long>(wasted));
     }
     return 0;
 }
