@@ -1,7 +1,6 @@
 #include "phases/dynamic_phase.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -11,6 +10,7 @@
 #include <glm/geometric.hpp>
 
 #include "phases/compositing.h"
+#include "phases/work_deadline.h"
 
 namespace mpshade {
 namespace {
@@ -214,19 +214,14 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
     if (stats_.raster.abandoned) return {};  // no visibility to shade
     ++stats_.shadePasses;
     tbb::enumerable_thread_specific<std::vector<TileRequest>> lacking;
-    const bool timed = options_.deadline != Clock::time_point::max();
-    std::atomic<bool> late{false};
+    WorkDeadline deadline(options_.deadline);
     tbb::parallel_for(size_t{0}, bandDone_.size(), [&](size_t b) {
-        if (bandDone_[b]) return;
-        if (timed && (late.load(std::memory_order_relaxed) || Clock::now() > options_.deadline)) {
-            late.store(true, std::memory_order_relaxed);
-            return;
-        }
+        if (bandDone_[b] || deadline.passed()) return;
         const ScopedSpan task(options_.trace, "band", PhaseKind::Dynamic, SpanLevel::Task, -1,
                               frame_->index);
         shadeBand(b, acceptFallbacks, lacking.local());
     });
-    abandoned_ = abandoned_ || late.load();
+    abandoned_ = abandoned_ || deadline.missed();
     std::vector<TileRequest> all;
     for (const std::vector<TileRequest>& l : lacking) all.insert(all.end(), l.begin(), l.end());
     sortUniqueTiles(all);
@@ -271,6 +266,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     const size_t firstSample = layout.index(0, row0, 0);
     const size_t endSample = layout.index(0, row1, 0);
     const size_t firstSlot = firstSample * static_cast<size_t>(layers);
+    const size_t firstPixel = firstSample / static_cast<size_t>(spp);
 
     // 1. Shading points, once per frame.
     const size_t objects = objects_.size();
@@ -445,7 +441,6 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
                 st.x[at] = s.unsortedX[p];
                 st.y[at] = s.unsortedY[p];
             }
-            const size_t firstPixel = firstSample / static_cast<size_t>(spp);
             for (size_t pixel = firstPixel; pixel < endSample / spp; ++pixel) {
                 uint32_t& whole = st.pixelPoint[pixel - firstPixel];
                 if (whole != kNoPoint) {
@@ -562,7 +557,6 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     //    the one the resolve reads (at per-pixel shading, three quarters of the samples'
     //    passes over memory).
     const glm::vec3 background = scene_.settings.background;
-    const size_t firstPixel = firstSample / static_cast<size_t>(spp);
     for (size_t pixel = firstPixel; pixel < endSample / spp; ++pixel) {
         const size_t first = pixel * static_cast<size_t>(spp);
         if (!st.pixelPoint.empty()) {

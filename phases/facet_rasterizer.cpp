@@ -1,11 +1,12 @@
 #include "phases/facet_rasterizer.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+
+#include "phases/work_deadline.h"
 
 namespace mpshade {
 
@@ -247,15 +248,7 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
     }
 
     // Checked once per chunk and per tile: a clock read costs far less than either.
-    const bool timed = options.deadline != std::chrono::steady_clock::time_point::max();
-    std::atomic<bool> abandoned{false};
-    auto pastDeadline = [&] {
-        if (!timed) return false;
-        if (abandoned.load(std::memory_order_relaxed)) return true;
-        if (std::chrono::steady_clock::now() <= options.deadline) return false;
-        abandoned.store(true, std::memory_order_relaxed);
-        return true;
-    };
+    WorkDeadline deadline(options.deadline);
 
     // 1. Bin.
     tbb::parallel_for(size_t{0}, chunkCount, [&](size_t ci) {
@@ -268,7 +261,7 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
         c.clipped.clear();
         c.stats = RasterStats{};
         c.longestEdge2 = 0;
-        if (pastDeadline()) {
+        if (deadline.passed()) {
             c.tileStart.assign(tileCount + 1, 0);
             return;
         }
@@ -360,8 +353,8 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
     for (RasterStats& s : st.tileStats) s = RasterStats{};
     const int32_t* fx = samples.fixedX();
     const int32_t* fy = samples.fixedY();
-    tbb::parallel_for(size_t{0}, pastDeadline() ? size_t{0} : tileCount, [&](size_t t) {
-        if (pastDeadline()) return;
+    tbb::parallel_for(size_t{0}, deadline.passed() ? size_t{0} : tileCount, [&](size_t t) {
+        if (deadline.passed()) return;
         RasterStats& s = st.tileStats.local();
         TileScratch& scratch = st.scratch.local();
         const int tx0 = static_cast<int>(t % tilesX) * tile,
@@ -476,7 +469,7 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
         }
     });
     stats = RasterStats{};
-    stats.abandoned = abandoned.load();
+    stats.abandoned = deadline.missed();
     for (const RasterObject& obj : objects)
         if (obj.longestEdgePixels) *obj.longestEdgePixels = 0.0f;
     for (size_t ci = 0; ci < chunkCount; ++ci) {
