@@ -64,16 +64,13 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
         FrameStats stats;
         renderer.renderFrame(frame, options.render, stats, image);
         const size_t k = static_cast<size_t>(frame - options.first);
-        const std::vector<double>& staticSeconds = renderer.lastFrameStaticSeconds();
-        const std::vector<ObjectFrameCost>& dynamic = renderer.lastFrameDynamicCosts();
         for (size_t i = 0; i < n; ++i) {
             ObjectProfile& o = p.objects[i];
-            if (i < staticSeconds.size()) o.staticSecondsPerFrame[k] = staticSeconds[i];
-            if (i < dynamic.size()) {
-                o.shadeSecondsPerFrame[k] = dynamic[i].shadeSeconds;
-                o.shadingPoints += dynamic[i].shadingPoints;
-                o.dynamicInstructions += dynamic[i].instructions;
-            }
+            const ObjectSlot& slot = renderer.slot(i);
+            o.staticSecondsPerFrame[k] = slot.frameStaticSeconds;
+            o.shadeSecondsPerFrame[k] = slot.frameDynamic.shadeSeconds;
+            o.shadingPoints += slot.frameDynamic.shadingPoints;
+            o.dynamicInstructions += slot.frameDynamic.instructions;
         }
         p.frames.push_back(stats);
         if (progress) progress(frame);

@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
 #include <string>
 
 #include <tbb/parallel_for.h>
-#include <glm/geometric.hpp>
-#include <glm/trigonometric.hpp>
+
+#include "controller/static_run_triggers.h"
 
 namespace mpshade {
 namespace {
@@ -17,42 +15,59 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
+// What one frame does, decided before anything is built or shaded.
+struct MultiphaseRenderer::FramePlan {
+    int frame = 0;
+    bool budgeted = false;                    // a frame budget (playback): nothing waits for tiles
+    std::vector<uint8_t> visible;             // per object: in view this frame
+    std::vector<size_t> due;                  // objects whose static phase runs this frame
+    std::vector<ObjectCostInputs> dueInputs;  // their cost estimates' inputs
+    std::vector<const ObjectRepresentation*> drawn;  // per object, null: not drawn
+};
+
 MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptions& options)
     : scene_(scene),
       options_(options),
       resources_(scene, SceneResources::RayScenes::ForOcclusion),
       static_(scene, resources_, options.staticPhase),
       dynamic_(scene),
-      cache_(options.mapMemoryBytes) {
+      cache_(options.mapMemoryBytes),
+      tiles_(static_, cache_),
+      planner_(scene, static_, options.costModel, options.representation),
+      slots_(scene.objects.size()) {
     options_.dynamic.trace = options.trace;
-    const size_t n = scene.objects.size();
-    representations_.resize(n);
-    kinds_.assign(n, Representation::Auto);
-    longestEdge_.assign(n, 0.0f);
-    framesSeen_.assign(n, {});
-    reports_.resize(n);
-    for (size_t i = 0; i < n; ++i) reports_[i].name = scene.objects[i].name;
-    lastBuildSeconds_.assign(n, 0.0);
-    staticInputs_.resize(n);
-    for (size_t i = 0; i < n; ++i) staticInputs_[i] = StaticInputs(factored(i).staticPart);
-    inputSpans_ = staticInputSpans(resources_, staticInputs_);
-    builtInputs_.assign(n, {});
+    std::vector<StaticInputs> inputs(slots_.size());
+    for (size_t i = 0; i < slots_.size(); ++i) {
+        slots_[i].report.name = scene.objects[i].name;
+        inputs[i] = StaticInputs(factored(i).staticPart);
+    }
+    std::vector<std::vector<float>> spans = staticInputSpans(resources_, inputs);
+    for (size_t i = 0; i < slots_.size(); ++i) {
+        slots_[i].staticInputs = std::move(inputs[i]);
+        slots_[i].inputSpans = std::move(spans[i]);
+    }
 }
 
 MultiphaseRenderer::~MultiphaseRenderer() = default;
 
 const ObjectRepresentation* MultiphaseRenderer::representation(size_t object) const {
-    return representations_[object].get();
+    return slots_[object].representation.get();
 }
 
 const FactoredShader& MultiphaseRenderer::factored(size_t object) const {
     return static_.shading(object).factored;
 }
 
-float MultiphaseRenderer::inputsMoved(size_t object) {
-    if (staticInputs_[object].empty()) return 0.0f;
-    staticInputs_[object].read(frame_.uniforms[object], inputScratch_);
-    return staticInputChange(builtInputs_[object], inputScratch_, inputSpans_[object]);
+std::vector<const ObjectRepresentation*> MultiphaseRenderer::representations() const {
+    std::vector<const ObjectRepresentation*> out(slots_.size(), nullptr);
+    for (size_t i = 0; i < slots_.size(); ++i) out[i] = slots_[i].representation.get();
+    return out;
+}
+
+DynamicOptions MultiphaseRenderer::frameDynamicOptions() const {
+    DynamicOptions o = options_.dynamic;
+    o.shadingRate = options_.shadingRate.value_or(scene_.settings.shadingRate);
+    return o;
 }
 
 double MultiphaseRenderer::pauseFiller() {
@@ -71,186 +86,63 @@ void MultiphaseRenderer::discardStaticWork() {
         filler_->pause();
         filler_->submit({});
     }
-    for (auto& rep : representations_) rep.reset();
-    kinds_.assign(kinds_.size(), Representation::Auto);
-    longestEdge_.assign(longestEdge_.size(), 0.0f);
+    for (ObjectSlot& slot : slots_) {
+        slot.representation.reset();
+        slot.kind = Representation::Auto;
+        slot.longestEdge = 0.0f;
+    }
 }
 
 void MultiphaseRenderer::plan(int first, int last, const RenderOptions& options) {
-    planFirst_ = first;
-    layoutWidth_ = options.width > 0 ? options.width : scene_.settings.width;
-    layoutHeight_ = options.height > 0 ? options.height : scene_.settings.height;
-    for (std::vector<int>& seen : framesSeen_)
-        seen.assign(static_cast<size_t>(std::max(0, last - first)), 0);
-    const int w = options.width > 0 ? options.width : scene_.settings.width;
-    const int h = options.height > 0 ? options.height : scene_.settings.height;
-    for (int f = first; f < last; ++f) {
-        const float t = scene_.frameTime(f);
-        const CameraState camera = cameraAt(scene_, t, w, h);
-        for (size_t i = 0; i < scene_.objects.size(); ++i) {
-            const bool seen = objectInView(*scene_.objects[i].surface,
-                                           objectAt(scene_.objects[i], t, camera), camera);
-            framesSeen_[i][static_cast<size_t>(f - first)] =
-                (f > first ? framesSeen_[i][static_cast<size_t>(f - first - 1)] : 0) +
-                (seen ? 1 : 0);
-        }
-    }
+    planner_.plan(first, last, options.width, options.height);
 }
 
-ObjectCostInputs MultiphaseRenderer::costInputs(size_t i, int frame, const ObjectState& state,
-                                                const CameraState& camera, int spp) const {
-    const SceneObject& obj = scene_.objects[i];
-    const ObjectShading& shading = static_.shading(i);
-    const ObjectRepresentation* previous = representations_[i].get();
-    const int tile =
-        options_.staticPhase.shaderMap.tileSize + 2 * options_.staticPhase.shaderMap.border;
-    ObjectCostInputs in;
-    in.charts = chartCount(*obj.surface);
-    // The 32 x 32 level is four 16 x 16 tiles, the five below one each.
-    in.pinnedTiles = static_cast<double>(in.charts) * 9.0;
-    in.pinnedBytes = in.pinnedTiles * tile * tile *
-                     static_cast<double>(shading.factored.staticPart.channelOutputs.size()) *
-                     sizeof(float);
-    in.haveMap = previous && previous->map;
-    in.pinnedUpFront = options_.staticPhase.shaderMap.fillPinnedUpFront;
-    // The screen area: the object's bounding sphere, projected, within the screen.
-    const Bounds3 b = surfaceBounds(*obj.surface);
-    const float ppu = 0.5f * static_cast<float>(camera.height) / camera.tanHalfFovY;
-    const float distance = std::max(glm::length(state.eye - b.center()), 1e-20f);
-    const float radius = 0.5f * b.diagonal();
-    const double projected =
-        distance > radius ? 3.14159265 * std::pow(ppu * radius / distance, 2.0) : 1e30;
-    in.coveredPixels = std::min(static_cast<double>(camera.width) * camera.height, projected);
-    in.frames = std::max(1, framesSeenFrom(i, frame));
-    in.combinedRuns = predictedCombinedRuns(i, frame, state);
-    in.screenPixels = static_cast<double>(camera.width) * camera.height;
-    in.channels = static_cast<int>(shading.factored.staticPart.channelOutputs.size());
-    in.staticCostUnits = shading.factored.staticCost;
-    in.recomputedCostUnits = shading.factored.recomputedStaticCost;
-    in.originalCostUnits = shading.factored.originalCost;
-    in.samplesPerPixel = spp;
-    in.shadingRate = options_.dynamic.shadingRate;
-    in.footprintScale = options_.dynamic.footprintScale;
-    return in;
+void MultiphaseRenderer::setFrameBudget(double seconds) {
+    options_.frameBudgetSeconds = seconds;
+    if (seconds > 0.0) cache_.reserve(static_.tilePools());
 }
 
-Representation MultiphaseRenderer::chooseKind(size_t i, int frame, const ObjectState& state,
-                                              const CameraState& camera, int spp,
-                                              ObjectCostInputs& in) {
-    const SceneObject& obj = scene_.objects[i];
-    Representation asked = options_.representation.value_or(obj.representation);
-    in = costInputs(i, frame, state, camera, spp);
-    if (asked == Representation::Facets)
-        in.combinedFacets = static_.combinedFacets(i, state, camera);
-    if (asked != Representation::Auto) {
-        reports_[i].reason =
-            options_.representation ? "forced by the renderer's options" : "the scene asks for it";
-        std::string tooBig;
-        if (asked == Representation::ShaderMap && !in.haveMap &&
-            !shaderMapFits(in, tooBig, options_.costModel)) {
-            reports_[i].reason += ", but " + tooBig + ": facets instead";
-            return Representation::Facets;
-        }
-        return asked;
-    }
-    in.combinedFacets = static_.combinedFacets(i, state, camera);
-    const RepresentationChoice choice = chooseRepresentation(in, options_.costModel);
-    reports_[i].reason = choice.reason;
-    return choice.kind;
-}
-
-bool MultiphaseRenderer::singlePhasePays(const std::vector<size_t>& stale,
-                                         const std::vector<ObjectCostInputs>& staleInputs,
-                                         const std::vector<uint8_t>& visible, int frame,
-                                         bool leastCost) const {
-    // Over the frames F the new static work would serve: multi-phase pays that work, then
-    // every visible object's dynamic frames; single-phase pays the reference's frames for
-    // every visible object, since a frame rendered single-phase builds nothing and the
-    // next one meets the same choice.
-    int served = 1;
-    for (const ObjectCostInputs& in : staleInputs) served = std::max(served, in.frames);
-    double multi = 0.0, single = 0.0;
-    std::vector<int> staleAt(visible.size(), -1);
-    for (size_t k = 0; k < stale.size(); ++k) staleAt[stale[k]] = static_cast<int>(k);
-    for (size_t i = 0; i < visible.size(); ++i) {
-        if (!visible[i]) continue;
-        const int k = staleAt[i];
-        ObjectCostInputs in =
-            k >= 0 ? staleInputs[static_cast<size_t>(k)]
-                   : costInputs(i, frame, frame_.objects[i], frame_.camera, frame_.spp);
-        if (k < 0)
-            in.combinedFacets = static_cast<double>(representations_[i]->mesh.facetCount());
-        else if (leastCost)
-            // Unsurveyed: facets at a quarter of the 20-50 per covered pixel the survey
-            // usually finds.
-            in.combinedFacets = 5.0 * in.coveredPixels;
-        const RepresentationChoice c = chooseRepresentation(in, options_.costModel);
-        const double frames = std::min(served, std::max(1, in.frames));
-        const double facets =
-            (k >= 0 ? c.facetsStaticSeconds : 0.0) + frames * c.facetsFrameSeconds;
-        const double map = (k >= 0 ? c.mapStaticSeconds : 0.0) + frames * c.mapFrameSeconds;
-        if (k >= 0 && leastCost)
-            multi += std::min(facets, map);  // whichever representation is cheaper
-        else
-            multi += (k >= 0 ? kinds_[i] : representations_[i]->kind) == Representation::Facets
-                         ? facets
-                         : map;
-        single += frames * c.singlePhaseFrameSeconds;
-    }
-    return single < multi;
-}
-
-int MultiphaseRenderer::predictedCombinedRuns(size_t object, int frame,
-                                              const ObjectState& state) const {
-    // Facets diced for the view at P/2 are diced again when the eye comes closer (their
-    // projected edges grow) or leaves the range: count those events along the planned
-    // frames that see the object.
-    const std::vector<int>& seen = framesSeen_[object];
-    if (seen.empty()) return 1;
-    const SceneObject& obj = scene_.objects[object];
-    const Bounds3 b = surfaceBounds(*obj.surface);
-    const glm::vec3 center = b.center();
-    const float radius = 0.5f * b.diagonal();
-    auto distance = [&](const glm::vec3& eye) {
-        return std::max(glm::length(eye - center) - radius, 1e-3f * radius);
-    };
-    float diced = distance(state.eye);
-    glm::vec3 direction = glm::normalize(state.eye - center);
-    int runs = 1;
-    const int last = planFirst_ + static_cast<int>(seen.size());
-    for (int f = std::max(frame + 1, planFirst_); f < last; ++f) {
-        const size_t k = static_cast<size_t>(f - planFirst_);
-        if (seen[k] == (k > 0 ? seen[k - 1] : 0)) continue;  // not seen in frame f
-        const float t = scene_.frameTime(f);
-        const CameraState camera = cameraAt(scene_, t, layoutWidth_, layoutHeight_);
-        const glm::vec3 eye = objectAt(obj, t, camera).eye;
-        const float d = distance(eye);
-        const glm::vec3 dir = glm::normalize(eye - center);
-        if (d < 0.95f * diced || d > obj.range.distanceFactor * diced ||
-            glm::dot(dir, direction) < std::cos(glm::radians(obj.range.angle))) {
-            ++runs;
-            diced = d;
-            direction = dir;
-        }
-    }
-    return runs;
-}
-
-int MultiphaseRenderer::framesSeenFrom(size_t object, int frame) const {
-    const std::vector<int>& seen = framesSeen_[object];
-    if (seen.empty()) return scene_.frameCount() - frame;  // no plan: assume every frame
-    const int first = std::clamp(frame - planFirst_, 0, static_cast<int>(seen.size()) - 1);
-    return seen.back() - (first > 0 ? seen[static_cast<size_t>(first) - 1] : 0);
-}
-
+// One frame, constant quality or within a frame budget (multiphase_renderer.h, steps 1-3).
 void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameStats& stats,
                                 const ProgressFn& progress) {
     const auto start = Clock::now();
+    beginFrame(frame, options, stats);
+    const auto triggersStart = Clock::now();
+    FramePlan plan = planFrame(frame, stats);
+    if (plan.budgeted) deferRebuilds(plan, start, stats);
+    stats.controllerSeconds += secondsSince(triggersStart);
+    const auto staticStart = Clock::now();
+    singlePhaseFrame_ = rendersSinglePhase(plan);
+    if (singlePhaseFrame_) {
+        if (!reference_) reference_ = std::make_unique<ReferenceRenderer>(scene_);
+        const ScopedSpan span(options_.trace, "single-phase frame", PhaseKind::Reference,
+                              SpanLevel::Phase, -1, frame);
+        singlePhaseSamples_ = reference_->renderSamples(frame, options, stats, progress);
+        stats.singlePhase = true;
+        stats.wallSeconds = secondsSince(start);
+        return;
+    }
+    buildDue(plan, stats);
+    stats.staticSeconds = secondsSince(staticStart);
+    if (options_.trace && !plan.due.empty())
+        options_.trace->span("static phase", PhaseKind::Static, SpanLevel::Phase, staticStart,
+                             Clock::now(), -1, frame);
+    if (progress) progress(1, 4);
+    shadeAndFill(plan, stats, progress);
+    recordFrame(plan, stats);
+    stats.wallSeconds = secondsSince(start);
+}
+
+// The frame's state, its costs reset, the background filler held and its work counted,
+// and its sample layout.
+void MultiphaseRenderer::beginFrame(int frame, const RenderOptions& options, FrameStats& stats) {
     stats = FrameStats{};
     frame_ =
         frameStateAt(resources_, frame, options.width, options.height, options.samplesPerPixel);
-    frameStaticSeconds_.assign(scene_.objects.size(), 0.0);
-    frameDynamic_.assign(scene_.objects.size(), ObjectFrameCost{});
+    for (ObjectSlot& slot : slots_) {
+        slot.frameStaticSeconds = 0.0;
+        slot.frameDynamic = ObjectFrameCost{};
+    }
     if (filler_) {
         // Held while this frame's static work runs; no probe runs now either, so the
         // storage of the tiles it dropped meanwhile is free again. The wait (at most the
@@ -262,10 +154,10 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         stats.backgroundSeconds = t.seconds - fillerTotals_.seconds;
         fillerTotals_ = t;
         for (const auto& pool : static_.tilePools().all()) pool->reclaim();
-        for (const auto& rep : representations_)
-            if (rep && rep->map) rep->map->reclaim();
+        for (const ObjectSlot& slot : slots_)
+            if (slot.representation && slot.representation->map)
+                slot.representation->map->reclaim();
     }
-    const CameraState& camera = frame_.camera;
     if (!layout_ ||
         !layout_->matches(frame_.width, frame_.height, frame_.spp, options.seed, options.filter)) {
         // A few layouts are kept: a player switching samples per pixel (its quality
@@ -285,237 +177,211 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
             layouts_.push_back(layout_);
         }
     }
-    DynamicOptions dynamicOptions = options_.dynamic;
-    if (options_.shadingRate)
-        dynamicOptions.shadingRate = *options_.shadingRate;
-    else
-        dynamicOptions.shadingRate = scene_.settings.shadingRate;
-    options_.dynamic.shadingRate = dynamicOptions.shadingRate;
+    dynamicOptions_ = frameDynamicOptions();
+}
 
-    // 1-2. Objects in view, and the static phase for those that need it.
-    const auto triggersStart = Clock::now();
-    const size_t n = scene_.objects.size();
-    std::vector<uint8_t> visible(n, 0);
-    std::vector<size_t> stale;
-    for (size_t i = 0; i < n; ++i) {
+// 1-2. The objects in view, and of them those whose static phase is due, with why.
+MultiphaseRenderer::FramePlan MultiphaseRenderer::planFrame(int frame, FrameStats& stats) {
+    FramePlan plan;
+    plan.frame = frame;
+    plan.budgeted = options_.frameBudgetSeconds > 0.0;
+    plan.visible.assign(slots_.size(), 0);
+    for (size_t i = 0; i < slots_.size(); ++i) {
         const ObjectState& state = frame_.objects[i];
-        visible[i] = objectInView(*scene_.objects[i].surface, state, camera) ? 1 : 0;
-        if (!visible[i]) continue;
-        const ObjectRepresentation* rep = representations_[i].get();
-        const glm::vec3 forward =
-            glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
-        StaticRunDue due;
-        due.object = static_cast<uint32_t>(i);
-        if (!rep) {
-            stats.staticRunsDue.push_back(due);
-            stale.push_back(i);
-            continue;
-        }
-        const ObjectRepresentation::RangeCheck range = rep->checkRange(state.eye, forward);
-        if (range.fiducial != ObjectRepresentation::RangeCheck::None) {
-            due.cause = range.fiducial == ObjectRepresentation::RangeCheck::ViewDirection
-                            ? StaticRunDue::ViewDirection
-                        : range.fiducial == ObjectRepresentation::RangeCheck::Distance
-                            ? StaticRunDue::Distance
-                            : StaticRunDue::AngleAround;
-            due.measured = range.measured;
-            due.threshold = range.threshold;
-        } else if (inputsMoved(i) > options_.staticInputTolerance) {
-            due.cause = StaticRunDue::StaticInput;
-            due.measured = inputsMoved(i);
-            due.threshold = options_.staticInputTolerance;
-        } else if (rep->imageHeight != camera.height) {
-            due.cause = StaticRunDue::ImageSize;
-            due.measured = static_cast<float>(camera.height);
-            due.threshold = static_cast<float>(rep->imageHeight);
-        } else if (rep->kind == Representation::Facets && longestEdge_[i] > rep->maxEdgePixels) {
-            due.cause = StaticRunDue::FacetsTooLong;
-            due.measured = longestEdge_[i];
-            due.threshold = rep->maxEdgePixels;
-        } else {
-            continue;
-        }
-        stats.staticRunsDue.push_back(due);
-        stale.push_back(i);
+        if (!objectInView(*scene_.objects[i].surface, state, frame_.camera)) continue;
+        plan.visible[i] = 1;
+        const std::optional<StaticRunDue> due =
+            staticRunDue(static_cast<uint32_t>(i), slots_[i], state, frame_.camera,
+                         frame_.uniforms[i], options_.staticInputTolerance, inputScratch_);
+        if (!due) continue;
+        stats.staticRunsDue.push_back(*due);
+        plan.due.push_back(i);
     }
-    // A frame budget: what was never built is built; what is due again is rebuilt, cheapest
-    // first, only while its last run, and half as much again (a re-dice of a nearer view
-    // makes more facets), fits the time left after the dynamic phase (as long as the last
-    // frame's) and the twentieth kept for the end of the frame; the others are drawn from
-    // their last representation.
-    const bool budgeted = options_.frameBudgetSeconds > 0.0;
-    if (budgeted && !stale.empty()) {
-        std::vector<size_t> due, again;
-        for (size_t i : stale) (representations_[i] ? again : due).push_back(i);
-        std::sort(again.begin(), again.end(),
-                  [&](size_t a, size_t b) { return lastBuildSeconds_[a] < lastBuildSeconds_[b]; });
-        double left =
-            0.95 * options_.frameBudgetSeconds - secondsSince(start) - lastDynamicSeconds_;
-        for (size_t i : again) {
-            if (1.5 * lastBuildSeconds_[i] <= left) {
-                due.push_back(i);
-                left -= 1.5 * lastBuildSeconds_[i];
-            } else {
-                ++stats.rebuildsDeferred;
-                for (StaticRunDue& d : stats.staticRunsDue)
-                    if (d.object == i) d.deferred = true;
-            }
+    return plan;
+}
+
+// A frame budget: rebuilds only as they fit the time left after the dynamic phase (as long
+// as the last frame's) and the twentieth kept for the end of the frame.
+void MultiphaseRenderer::deferRebuilds(FramePlan& plan, Clock::time_point start,
+                                       FrameStats& stats) {
+    if (plan.due.empty()) return;
+    const double left =
+        0.95 * options_.frameBudgetSeconds - secondsSince(start) - lastDynamicSeconds_;
+    plan.due = admitRebuilds(plan.due, slots_, left, stats.staticRunsDue, stats.rebuildsDeferred);
+}
+
+// 2b. Whether the due static work would not pay for itself, so the frame is rendered by the
+// reference renderer and nothing is built. First a check that needs no dicing survey: with
+// every due object at the least its representations could cost, does single-phase still
+// win? (A cut every frame then costs the reference's frame plus this check.) Else the
+// representations are chosen and the check is made again with their estimates.
+bool MultiphaseRenderer::rendersSinglePhase(FramePlan& plan) {
+    const bool mayRenderSingle = options_.singlePhaseFrames && !plan.budgeted && !plan.due.empty();
+    plan.dueInputs.assign(plan.due.size(), ObjectCostInputs{});
+    if (mayRenderSingle) {
+        for (size_t k = 0; k < plan.due.size(); ++k) {
+            const size_t i = plan.due[k];
+            plan.dueInputs[k] = planner_.costInputs(i, slots_[i], plan.frame, frame_.objects[i],
+                                                    frame_.camera, frame_.spp, dynamicOptions_);
         }
-        std::sort(due.begin(), due.end());
-        stale = due;
+        if (planner_.singlePhasePays(plan.due, plan.dueInputs, plan.visible, slots_, frame_,
+                                     plan.frame, dynamicOptions_, true))
+            return true;
     }
-    stats.controllerSeconds += secondsSince(triggersStart);
-    const auto staticStart = Clock::now();
-    // First a check that needs no dicing survey: with every stale object at the least its
-    // representations could cost, does single-phase still win? (A cut every frame then
-    // costs the reference's frame plus this check.) Else the representations are chosen
-    // and the check is made again with their estimates.
-    std::vector<ObjectCostInputs> staleInputs(stale.size());
-    singlePhaseFrame_ = false;
-    if (options_.singlePhaseFrames && !budgeted && !stale.empty()) {
-        for (size_t k = 0; k < stale.size(); ++k)
-            staleInputs[k] =
-                costInputs(stale[k], frame, frame_.objects[stale[k]], camera, frame_.spp);
-        singlePhaseFrame_ = singlePhasePays(stale, staleInputs, visible, frame, true);
+    std::vector<Representation> previousKinds(plan.due.size());
+    std::vector<std::string> previousReasons(plan.due.size());
+    for (size_t k = 0; k < plan.due.size(); ++k) {
+        ObjectSlot& slot = slots_[plan.due[k]];
+        previousKinds[k] = slot.kind;
+        previousReasons[k] = slot.report.reason;
+        slot.kind = planner_.choose(plan.due[k], slot, plan.frame, frame_.objects[plan.due[k]],
+                                    frame_.camera, frame_.spp, dynamicOptions_, plan.dueInputs[k]);
     }
-    if (!singlePhaseFrame_) {
-        std::vector<Representation> previousKinds = kinds_;
-        std::vector<std::string> previousReasons(stale.size());
-        for (size_t k = 0; k < stale.size(); ++k) {
-            const size_t i = stale[k];
-            previousReasons[k] = reports_[i].reason;
-            kinds_[i] = chooseKind(i, frame, frame_.objects[i], camera, frame_.spp, staleInputs[k]);
-        }
-        singlePhaseFrame_ = options_.singlePhaseFrames && !budgeted && !stale.empty() &&
-                            singlePhasePays(stale, staleInputs, visible, frame, false);
-        if (singlePhaseFrame_) {
-            // Nothing is built: the objects stay as they were; the next frame decides again.
-            kinds_ = previousKinds;
-            for (size_t k = 0; k < stale.size(); ++k)
-                reports_[stale[k]].reason = previousReasons[k];
-        }
+    if (!mayRenderSingle ||
+        !planner_.singlePhasePays(plan.due, plan.dueInputs, plan.visible, slots_, frame_,
+                                  plan.frame, dynamicOptions_, false))
+        return false;
+    // Nothing is built: the objects stay as they were; the next frame decides again.
+    for (size_t k = 0; k < plan.due.size(); ++k) {
+        slots_[plan.due[k]].kind = previousKinds[k];
+        slots_[plan.due[k]].report.reason = previousReasons[k];
     }
-    if (singlePhaseFrame_) {
-        if (!reference_) reference_ = std::make_unique<ReferenceRenderer>(scene_);
-        const ScopedSpan span(options_.trace, "single-phase frame", PhaseKind::Reference,
-                              SpanLevel::Phase, -1, frame);
-        singlePhaseSamples_ = reference_->renderSamples(frame, options, stats, progress);
-        stats.singlePhase = true;
-        stats.wallSeconds = secondsSince(start);
-        return;
-    }
-    std::vector<StaticCosts> costs(stale.size());
-    tbb::parallel_for(size_t{0}, stale.size(), [&](size_t k) {
-        const size_t i = stale[k];
+    return true;
+}
+
+// The static phase of every due object, in parallel over objects.
+void MultiphaseRenderer::buildDue(const FramePlan& plan, FrameStats& stats) {
+    std::vector<StaticCosts> costs(plan.due.size());
+    tbb::parallel_for(size_t{0}, plan.due.size(), [&](size_t k) {
+        const size_t i = plan.due[k];
         const ScopedSpan task(options_.trace, "build", PhaseKind::Static, SpanLevel::Task,
-                              static_cast<int64_t>(i), frame);
-        representations_[i] =
-            static_.build(i, kinds_[i], frame_.objects[i], camera, frame_.uniforms[i],
-                          representations_[i].get(), costs[k]);
-        longestEdge_[i] = 0.0f;
+                              static_cast<int64_t>(i), plan.frame);
+        ObjectSlot& slot = slots_[i];
+        slot.representation =
+            static_.build(i, slot.kind, frame_.objects[i], frame_.camera, frame_.uniforms[i],
+                          slot.representation.get(), costs[k]);
     });
-    for (size_t k = 0; k < stale.size(); ++k) {
-        ObjectReport& r = reports_[stale[k]];
-        r.kind = kinds_[stale[k]];
-        ++r.staticRuns;
-        r.staticCosts.runs += costs[k].runs;
-        r.staticCosts.seconds += costs[k].seconds;
-        frameStaticSeconds_[stale[k]] += costs[k].seconds;
-        lastBuildSeconds_[stale[k]] = costs[k].seconds;
-        staticInputs_[stale[k]].read(frame_.uniforms[stale[k]], builtInputs_[stale[k]]);
-        r.staticCosts.instructions += costs[k].instructions;
-        r.staticCosts.programRuns += costs[k].programRuns;
-        r.staticCosts.tilesFilled += costs[k].tilesFilled;
+    for (size_t k = 0; k < plan.due.size(); ++k) {
+        const size_t i = plan.due[k];
+        recordBuild(i, slots_[i].kind, costs[k], frame_.uniforms[i]);
+        slots_[i].frameStaticSeconds += costs[k].seconds;
         stats.staticInstructions += costs[k].instructions;
         stats.tilesFilled += costs[k].tilesFilled;
         stats.tilesFromChildren += costs[k].tilesFromChildren;
         stats.texelsFilled += costs[k].texelsFilled;
     }
-    stats.staticRuns = static_cast<int>(stale.size());
-    stats.staticSeconds = secondsSince(staticStart);
-    if (options_.trace && !stale.empty())
-        options_.trace->span("static phase", PhaseKind::Static, SpanLevel::Phase, staticStart,
-                             Clock::now(), -1, frame);
-    if (progress) progress(1, 4);
+    stats.staticRuns = static_cast<int>(plan.due.size());
+}
 
-    // 3. The dynamic phase; lacking tiles filled between shading passes.
-    std::vector<const ObjectRepresentation*> drawn(n, nullptr);
-    for (size_t i = 0; i < n; ++i)
-        if (visible[i]) drawn[i] = representations_[i].get();
+void MultiphaseRenderer::recordBuild(size_t i, Representation kind, const StaticCosts& costs,
+                                     const ShadingUniforms& uniforms) {
+    ObjectSlot& slot = slots_[i];
+    slot.kind = kind;
+    slot.longestEdge = 0.0f;
+    slot.lastBuildSeconds = costs.seconds;
+    slot.staticInputs.read(uniforms, slot.builtInputs);
+    ObjectReport& r = slot.report;
+    r.kind = kind;
+    ++r.staticRuns;
+    r.staticCosts.runs += costs.runs;
+    r.staticCosts.seconds += costs.seconds;
+    r.staticCosts.instructions += costs.instructions;
+    r.staticCosts.programRuns += costs.programRuns;
+    r.staticCosts.tilesFilled += costs.tilesFilled;
+}
+
+// 3. The dynamic phase. At constant quality the tiles its probes lacked are filled between
+// shading passes, and only the bands that lacked them are shaded again; within a budget it
+// shades once, with fallbacks, and the tiles lacked are filled after the resolve in the
+// time left (fillWithinBudget).
+void MultiphaseRenderer::shadeAndFill(FramePlan& plan, FrameStats& stats,
+                                      const ProgressFn& progress) {
+    plan.drawn.assign(slots_.size(), nullptr);
+    for (size_t i = 0; i < slots_.size(); ++i)
+        if (plan.visible[i]) plan.drawn[i] = slots_[i].representation.get();
     ++useStamp_;
-    for (const auto& rep : representations_)
-        if (rep && rep->map) rep->map->setUseStamp(useStamp_);
+    for (const ObjectSlot& slot : slots_)
+        if (slot.representation && slot.representation->map)
+            slot.representation->map->setUseStamp(useStamp_);
     if (filler_) {
         // Queued tiles of maps a static run has just replaced are of no use now.
         if (stats.staticRuns > 0)
             filler_->retain([&](const BackgroundJob& job) {
-                const ObjectRepresentation* rep = representations_[job.object].get();
+                const ObjectRepresentation* rep = slots_[job.object].representation.get();
                 return rep && rep->map == job.map;
             });
         if (options_.backgroundDuringFrames) filler_->resume(useStamp_);
     }
-    dynamic_.begin(frame_, drawn, layout_, dynamicOptions);
+    dynamic_.begin(frame_, plan.drawn, layout_, dynamicOptions_);
     if (progress) progress(2, 4);
-    StaticCosts fills;
-    FillTiming fillTiming;
-    fillTiming.trace = options_.trace;
-    fillTiming.frame = frame;
     lacking_.clear();
-    if (budgeted) {
-        // Once, with fallbacks; the tiles lacked are filled after the resolve, in the time
-        // left (fillWithinBudget).
+    if (plan.budgeted) {
         lacking_ = dynamic_.shade(true);
         stats.tilesRequested += lacking_.size();
-        drawn_ = drawn;
+        drawn_ = plan.drawn;
     }
     if (!prefetched_.empty()) settlePrefetched(stats);
-    for (int pass = 0; !budgeted; ++pass) {
+    TileFillResult fills;
+    for (int pass = 0; !plan.budgeted; ++pass) {
         const bool last = pass >= 6;  // a safety net: each pass fills what the last lacked
         const std::vector<TileRequest> lacking = dynamic_.shade(last);
         stats.tilesRequested += lacking.size();
         if (lacking.empty() || last) break;
-        const auto fillStart = Clock::now();
-        // Room for the new tiles first, so the maps' storage never outgrows the budget.
-        size_t incoming = 0;
-        for (const TileRequest& r : lacking) incoming += drawn[r.object]->map->tileBytes();
-        keepMapsInBudget(incoming, stats);
-        static_.fill(lacking, drawn, fills, &fillTiming);
-        stats.fillSeconds += secondsSince(fillStart);
-        if (options_.trace)
-            options_.trace->span("fill", PhaseKind::Static, SpanLevel::Phase, fillStart,
-                                 Clock::now(), -1, frame);
-        for (const TileRequest& r : lacking) ++reports_[r.object].staticCosts.tilesFilled;
+        tiles_.fill(lacking, plan.drawn, fillLimits(CacheRoom::EvictAndExceed, plan.frame), fills);
     }
-    stats.staticSeconds += stats.fillSeconds;
-    stats.staticInstructions += fills.instructions;
-    stats.tilesFilled += fills.tilesFilled;
-    stats.tilesFromChildren += fills.tilesFromChildren;
-    stats.texelsFilled += fills.texelsFilled;
+    countFills(fills, stats);
     if (progress) progress(3, 4);
+}
 
-    for (size_t i = 0; i < fillTiming.objectSeconds.size(); ++i) {
-        frameStaticSeconds_[i] += fillTiming.objectSeconds[i];
-        reports_[i].staticCosts.seconds += fillTiming.objectSeconds[i];
-        reports_[i].staticCosts.instructions += fillTiming.objectInstructions[i];
+FillLimits MultiphaseRenderer::fillLimits(CacheRoom room, int frame) const {
+    FillLimits limits;
+    limits.room = room;
+    limits.useStamp = useStamp_;
+    limits.trace = options_.trace;
+    limits.frame = frame;
+    return limits;
+}
+
+void MultiphaseRenderer::countFills(const TileFillResult& fills, FrameStats& stats) {
+    stats.fillSeconds += fills.seconds;
+    stats.staticSeconds += fills.seconds;
+    stats.controllerSeconds += fills.roomSeconds;
+    stats.tilesEvicted += fills.evicted;
+    stats.staticInstructions += fills.costs.instructions;
+    stats.tilesFilled += fills.costs.tilesFilled;
+    stats.tilesFromChildren += fills.costs.tilesFromChildren;
+    stats.texelsFilled += fills.costs.texelsFilled;
+    for (size_t i = 0; i < fills.objectTiles.size(); ++i)
+        slots_[i].report.staticCosts.tilesFilled += fills.objectTiles[i];
+    for (size_t i = 0; i < fills.timing.objectSeconds.size(); ++i) {
+        slots_[i].frameStaticSeconds += fills.timing.objectSeconds[i];
+        slots_[i].report.staticCosts.seconds += fills.timing.objectSeconds[i];
+        slots_[i].report.staticCosts.instructions += fills.timing.objectInstructions[i];
     }
-    const DynamicFrameStats& d = dynamic_.stats();
+}
+
+// What the frame drew and cost, per object and in all.
+void MultiphaseRenderer::recordFrame(const FramePlan& plan, FrameStats& stats) {
     const std::vector<ObjectFrameCost>& objectCosts = dynamic_.objectCosts();
-    frameDynamic_ = objectCosts;
-    for (size_t i = 0; i < n; ++i) {
-        if (!drawn[i]) continue;
-        longestEdge_[i] = objectCosts[i].longestEdgePixels;
-        ObjectReport& r = reports_[i];
-        r.longestEdgePixels = longestEdge_[i];
+    for (size_t i = 0; i < slots_.size(); ++i) {
+        ObjectSlot& slot = slots_[i];
+        slot.frameDynamic = objectCosts[i];
+        const ObjectRepresentation* drawn = plan.drawn[i];
+        if (!drawn) continue;
+        slot.longestEdge = objectCosts[i].longestEdgePixels;
+        ObjectReport& r = slot.report;
+        r.longestEdgePixels = slot.longestEdge;
         ++r.framesDrawn;
-        r.facets = drawn[i]->mesh.facetCount();
-        r.facetBytes = drawn[i]->bytes();
-        if (drawn[i]->map) {
-            r.residentTiles = drawn[i]->map->residentTiles();
-            r.mapBytes = drawn[i]->map->bytes();
+        r.facets = drawn->mesh.facetCount();
+        r.facetBytes = drawn->bytes();
+        if (drawn->map) {
+            r.residentTiles = drawn->map->residentTiles();
+            r.mapBytes = drawn->map->bytes();
         }
         ++stats.objectsDrawn;
     }
     recordResidency(stats);
+    const DynamicFrameStats& d = dynamic_.stats();
     stats.warpSeconds = d.warpSeconds;
     stats.rasterSeconds = d.rasterSeconds;
     stats.shadeSeconds = d.shadeSeconds;
@@ -530,10 +396,9 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     stats.probes = d.probes;
     stats.probeFallbacks = d.probeFallbacks;
     stats.shadePasses = d.shadePasses;
-    stats.index = frame;
+    stats.index = plan.frame;
     stats.time = frame_.time;
     stats.samples = static_cast<uint64_t>(frame_.width) * frame_.height * frame_.spp;
-    stats.wallSeconds = secondsSince(start);
 }
 
 void MultiphaseRenderer::recordResidency(FrameStats& stats) const {
@@ -543,18 +408,6 @@ void MultiphaseRenderer::recordResidency(FrameStats& stats) const {
         stats.residentBytes += pool->bytesHeld();
         stats.residentPinnedBytes += pool->pinnedBytesHeld();
     }
-}
-
-bool MultiphaseRenderer::keepMapsInBudget(size_t incoming, FrameStats& stats) {
-    const auto start = Clock::now();
-    const bool fits = cache_.makeRoom(static_.tilePools(), incoming, useStamp_, stats.tilesEvicted);
-    stats.controllerSeconds += secondsSince(start);
-    return fits;
-}
-
-void MultiphaseRenderer::setFrameBudget(double seconds) {
-    options_.frameBudgetSeconds = seconds;
-    if (seconds > 0.0) cache_.reserve(static_.tilePools());
 }
 
 Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,

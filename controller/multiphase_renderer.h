@@ -29,7 +29,10 @@
 #include <vector>
 
 #include "controller/background_filler.h"
+#include "controller/object_slot.h"
+#include "controller/representation_planner.h"
 #include "controller/tile_cache.h"
+#include "controller/tile_filler.h"
 #include "phases/dynamic_phase.h"
 #include "phases/reference_renderer.h"
 #include "phases/representation_choice.h"
@@ -97,20 +100,6 @@ struct MultiphaseOptions {
     bool backgroundIdlePriority = true;
 };
 
-// Per object, for stats.json: what the static phase chose and did.
-struct ObjectReport {
-    std::string name;
-    Representation kind = Representation::Auto;  // Auto: not built yet (never seen)
-    std::string reason;
-    int staticRuns = 0;
-    int framesDrawn = 0;
-    uint64_t facets = 0;  // of its current representation
-    uint64_t facetBytes = 0;
-    uint64_t residentTiles = 0, mapBytes = 0;
-    float longestEdgePixels = 0.0f;  // combined: last frame's longest projected facet edge
-    StaticCosts staticCosts;
-};
-
 class MultiphaseRenderer {
   public:
     MultiphaseRenderer(const Scene& scene, const MultiphaseOptions& options = {});
@@ -175,51 +164,50 @@ class MultiphaseRenderer {
     // Sets DynamicOptions::footprintScale for the frames that follow (2: probes read one mip
     // level coarser than the shading points' footprint asks).
     void setFootprintScale(float scale) { options_.dynamic.footprintScale = scale; }
-    const ObjectReport& report(size_t object) const { return reports_[object]; }
+    const ObjectReport& report(size_t object) const { return slots_[object].report; }
     // Tiles queued for the background filler and not filled yet (0 without one).
     size_t backgroundQueued() const { return filler_ ? filler_->queued() : 0; }
     // Whether the background filler can do nothing more before the next frame (true
     // without one): background_filler.h.
     bool backgroundSettled() const { return !filler_ || filler_->settled(); }
-    size_t objectCount() const { return reports_.size(); }
-    // Per object, what the last frame cost: its static work (building, filling tiles), in
-    // seconds summed over threads; and its dynamic work (not drawn: all zero; a frame
-    // rendered single-phase has none).
-    const std::vector<double>& lastFrameStaticSeconds() const { return frameStaticSeconds_; }
-    const std::vector<ObjectFrameCost>& lastFrameDynamicCosts() const { return frameDynamic_; }
+    size_t objectCount() const { return slots_.size(); }
+    // Per object, what the last frame cost it: ObjectSlot::frameStaticSeconds and
+    // frameDynamic.
+    const ObjectSlot& slot(size_t object) const { return slots_[object]; }
 
   private:
+    struct FramePlan;
+    // The steps of a frame, in order (render()).
+    void beginFrame(int frame, const RenderOptions& options, FrameStats& stats);
+    FramePlan planFrame(int frame, FrameStats& stats);
+    void deferRebuilds(FramePlan& plan, std::chrono::steady_clock::time_point start,
+                       FrameStats& stats);
+    bool rendersSinglePhase(FramePlan& plan);
+    void buildDue(const FramePlan& plan, FrameStats& stats);
+    void shadeAndFill(FramePlan& plan, FrameStats& stats, const ProgressFn& progress);
+    void recordFrame(const FramePlan& plan, FrameStats& stats);
     void render(int frame, const RenderOptions& options, FrameStats& stats,
                 const ProgressFn& progress);
+
+    // Records one static run of object i (its slot, its report, the inputs it read).
+    void recordBuild(size_t i, Representation kind, const StaticCosts& costs,
+                     const ShadingUniforms& uniforms);
+    // Adds what a fill did to the frame's stats and to each object's costs.
+    void countFills(const TileFillResult& fills, FrameStats& stats);
+    FillLimits fillLimits(CacheRoom room, int frame) const;
     // With a frame budget: fills this frame's lacking tiles (lacking_) until the budget,
-    // counted from `start`, is spent.
+    // counted from `start`, is spent; queues what is left for the background filler.
     void fillWithinBudget(std::chrono::steady_clock::time_point start, FrameStats& stats);
-    // Makes room in the tile cache for `incoming` more bytes (tile_cache.h), its time
-    // counted as the controller's; returns whether they fit.
-    bool keepMapsInBudget(size_t incoming, FrameStats& stats);
+    void queueForBackground(size_t from);
     // The tiles every map holds now, and their bytes (of them the always-resident levels').
     void recordResidency(FrameStats& stats) const;
     // Of the tiles prefetched, those this frame's probes read (used) and those dropped or
     // left unread too long (wasted), counted in stats and forgotten.
     void settlePrefetched(FrameStats& stats);
-    Representation chooseKind(size_t object, int frame, const ObjectState& state,
-                              const CameraState& camera, int spp, ObjectCostInputs& in);
-    // The cost estimate's inputs that need no dicing survey (combinedFacets is left 0).
-    ObjectCostInputs costInputs(size_t object, int frame, const ObjectState& state,
-                                const CameraState& camera, int spp) const;
-    // Whether this frame's due static work (objects `stale`, with their inputs) costs more,
-    // with the frames it serves, than rendering those frames single-phase. leastCost: the
-    // stale objects are not surveyed yet; each is taken at the least either
-    // representation could cost.
-    bool singlePhasePays(const std::vector<size_t>& stale,
-                         const std::vector<ObjectCostInputs>& staleInputs,
-                         const std::vector<uint8_t>& visible, int frame, bool leastCost) const;
-    int framesSeenFrom(size_t object, int frame) const;
-    // The photometric fiducial of object `object` in this frame (frame_): how far its static
-    // part's animated inputs moved since its last static run (0: they did not, or it has
-    // none).
-    float inputsMoved(size_t object);
-    int predictedCombinedRuns(size_t object, int frame, const ObjectState& state) const;
+    std::vector<const ObjectRepresentation*> representations() const;
+    // The dynamic phase's options for the frames now: the scene's shading rate unless
+    // MultiphaseOptions::shadingRate overrides it.
+    DynamicOptions frameDynamicOptions() const;
 
     const Scene& scene_;
     MultiphaseOptions options_;
@@ -227,36 +215,25 @@ class MultiphaseRenderer {
     StaticPhase static_;
     DynamicPhase dynamic_;
     TileCache cache_;
+    TileFiller tiles_;
+    RepresentationPlanner planner_;
+    std::vector<ObjectSlot> slots_;
     std::shared_ptr<const SampleLayout> layout_;
     std::vector<std::shared_ptr<const SampleLayout>> layouts_;  // the last few made
-    std::vector<std::unique_ptr<ObjectRepresentation>> representations_;
-    std::vector<Representation> kinds_;  // chosen at each static run
-    std::vector<float> longestEdge_;     // last frame's measure (combined)
-    // Per object, over the planned frames from planFirst_: how many of the frames up to
-    // each see it (a running count; empty without a plan).
-    std::vector<std::vector<int>> framesSeen_;
-    int planFirst_ = 0;
-    int layoutWidth_ = 0, layoutHeight_ = 0;  // the planned image size
-    std::vector<ObjectReport> reports_;
     FrameState frame_;
+    DynamicOptions dynamicOptions_;                 // the frame's, its shading rate resolved
     uint32_t useStamp_ = 0;                         // frames rendered: the maps' recency stamp
     std::unique_ptr<ReferenceRenderer> reference_;  // made at the first single-phase frame
     bool singlePhaseFrame_ = false;                 // the last frame was: its samples
     SampleBuffer singlePhaseSamples_;
-    std::vector<double> frameStaticSeconds_;
-    std::vector<ObjectFrameCost> frameDynamic_;
-    // With a frame budget: per object its last static run's seconds; the frame's lacking
-    // tiles; the last frame's dynamic phase (warp to resolve), seconds.
-    std::vector<double> lastBuildSeconds_;
-    // Per object: the animated inputs its static part reads, their spans over the scene,
-    // and their values at its last static run.
-    std::vector<StaticInputs> staticInputs_;
-    std::vector<std::vector<float>> inputSpans_, builtInputs_;
     std::vector<float> inputScratch_;
-    // Prefetching: the last frame's lacking tiles; the tiles prefetched and not yet read
-    // (with the use stamp they were filled at); the low-resolution predictor.
-    std::vector<TileRequest> lastLacking_;
-    double tileSeconds_ = 0.0;  // the most a tile took lately (0: not measured yet)
+    // With a frame budget: the frame's lacking tiles and what drew them; the last frame's
+    // lacking tiles (for adjacentTiles); its dynamic phase (warp to resolve), seconds.
+    std::vector<TileRequest> lacking_, lastLacking_;
+    std::vector<const ObjectRepresentation*> drawn_;
+    double lastDynamicSeconds_ = 0.0;
+    // Prefetching: the tiles prefetched and not yet read (with the use stamp they were
+    // filled at); the low-resolution predictor.
     struct Prefetched {
         uint32_t object;
         const ShaderMap* map;
@@ -269,9 +246,6 @@ class MultiphaseRenderer {
     bool predictionAbandoned_ = false;  // the last predictTiles() call
     std::shared_ptr<const SampleLayout> predictLayout_;
     FrameState predictState_;
-    std::vector<TileRequest> lacking_;
-    std::vector<const ObjectRepresentation*> drawn_;
-    double lastDynamicSeconds_ = 0.0;
     // The background filler (made at the first frame that defers tiles), and its totals at
     // the last frame. Last: destroyed (its worker joined) before anything it uses.
     double pauseFiller();  // returns the seconds it waited for the worker

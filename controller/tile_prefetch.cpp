@@ -8,7 +8,6 @@
 
 #include <cmath>
 
-#include "controller/fill_pacer.h"
 #include "controller/multiphase_renderer.h"
 
 namespace mpshade {
@@ -53,9 +52,10 @@ std::vector<TileRequest> MultiphaseRenderer::predictTiles(int frame, const Rende
     const size_t n = scene_.objects.size();
     std::vector<const ObjectRepresentation*> drawn(n, nullptr);
     for (size_t i = 0; i < n; ++i)
-        if (representations_[i] && objectInView(*scene_.objects[i].surface,
-                                                predictState_.objects[i], predictState_.camera))
-            drawn[i] = representations_[i].get();
+        if (slots_[i].representation &&
+            objectInView(*scene_.objects[i].surface, predictState_.objects[i],
+                         predictState_.camera))
+            drawn[i] = slots_[i].representation.get();
     DynamicOptions o = options_.dynamic;
     o.trace = nullptr;
     // The same world footprint as the full image's points: a low-resolution pixel is
@@ -78,7 +78,7 @@ std::vector<TileRequest> MultiphaseRenderer::predictTiles(int frame, const Rende
 std::vector<TileRequest> MultiphaseRenderer::adjacentTiles() const {
     std::vector<TileRequest> out;
     for (const TileRequest& r : lastLacking_) {
-        const ObjectRepresentation* rep = representations_[r.object].get();
+        const ObjectRepresentation* rep = slots_[r.object].representation.get();
         if (!rep || !rep->map) continue;
         const ShaderMap& map = *rep->map;
         const int side = map.tilesPerSide(r.key.level);
@@ -101,38 +101,20 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
     const ScopedSpan span(options_.trace, "prefetch", PhaseKind::Static, SpanLevel::Phase, -1,
                           stats.index);
     const PausedFiller paused(*this);  // room in the cache is this loop's alone
-    std::vector<const ObjectRepresentation*> maps(representations_.size(), nullptr);
-    for (size_t i = 0; i < representations_.size(); ++i) maps[i] = representations_[i].get();
-    std::vector<TileRequest> batch;
-    StaticCosts costs;
-    size_t next = 0;
-    FillPacer pacer(tileSeconds_);
-    while (next < tiles.size()) {
-        const size_t chunk = pacer.chunk(seconds - secondsSince(start));
-        if (chunk == 0) break;
-        batch.clear();
-        size_t incoming = 0;
-        for (; next < tiles.size() && batch.size() < chunk; ++next) {
-            const TileRequest& r = tiles[next];
-            const ObjectRepresentation* rep = maps[r.object];
-            if (!rep || !rep->map || rep->map->resident(r.key)) continue;
-            batch.push_back(r);
-            incoming += rep->map->tileBytes();
-        }
-        if (batch.empty()) continue;
-        // A guess never displaces a tile in the cache: only room left is used.
-        if (static_.tilePools().bytesHeld() + incoming > options_.mapMemoryBytes) break;
-        const auto began = Clock::now();
-        static_.fill(batch, maps, costs, nullptr);
-        pacer.filled(secondsSince(began), batch.size());
-        for (const TileRequest& r : batch) {
-            const ShaderMap* map = maps[r.object]->map.get();
-            const int slot = map->slotOf(r.key);
-            if (slot >= 0) prefetched_.push_back({r.object, map, r.key, slot, useStamp_});
-        }
+    const std::vector<const ObjectRepresentation*> maps = representations();
+    // A guess never displaces a tile in the cache: only room left is used.
+    FillLimits limits = fillLimits(CacheRoom::RoomLeft, stats.index);
+    limits.trace = nullptr;
+    limits.deadline =
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    TileFillResult fills;
+    tiles_.fill(tiles, maps, limits, fills);
+    for (const TileRequest& r : fills.filled) {
+        const ShaderMap* map = maps[r.object]->map.get();
+        const int slot = map->slotOf(r.key);
+        if (slot >= 0) prefetched_.push_back({r.object, map, r.key, slot, useStamp_});
     }
-    tileSeconds_ = pacer.remembered();
-    stats.tilesPrefetched += costs.tilesFilled;
+    stats.tilesPrefetched += fills.costs.tilesFilled;
     return secondsSince(start);
 }
 
@@ -140,7 +122,7 @@ void MultiphaseRenderer::settlePrefetched(FrameStats& stats) {
     const auto start = Clock::now();
     size_t kept = 0;
     for (const Prefetched& p : prefetched_) {
-        const ObjectRepresentation* rep = representations_[p.object].get();
+        const ObjectRepresentation* rep = slots_[p.object].representation.get();
         // Dropped, or its map replaced by a new static run, before any probe read it.
         const bool gone = !rep || rep->map.get() != p.map || p.map->slotOf(p.key) != p.slot;
         if (gone) {

@@ -1,0 +1,53 @@
+// object_slot.h -- everything the controller keeps for one scene object across frames: its
+// current representation, what its last static run saw (for the re-run triggers,
+// controller/static_run_triggers.h), what the last frame cost it, and its report for
+// stats.json. One slot per object, indexed like Scene::objects.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "phases/dynamic_phase.h"
+#include "phases/object_representation.h"
+#include "phases/static_inputs.h"
+#include "phases/static_phase.h"
+
+namespace mpshade {
+
+// Per object, for stats.json: what the static phase chose and did.
+struct ObjectReport {
+    std::string name;
+    Representation kind = Representation::Auto;  // Auto: not built yet (never seen)
+    std::string reason;
+    int staticRuns = 0;
+    int framesDrawn = 0;
+    uint64_t facets = 0;  // of its current representation
+    uint64_t facetBytes = 0;
+    uint64_t residentTiles = 0, mapBytes = 0;
+    float longestEdgePixels = 0.0f;  // combined: last frame's longest projected facet edge
+    StaticCosts staticCosts;
+};
+
+struct ObjectSlot {
+    // Owned; null until a frame sees the object (or after MultiphaseRenderer::
+    // discardStaticWork). Replaced whole by each static run; the dynamic phase reads it.
+    std::unique_ptr<ObjectRepresentation> representation;
+    Representation kind = Representation::Auto;  // chosen at its last static run
+    // Combined representation: the longest projected facet edge the last frame measured,
+    // pixels (the sampling fiducial; 0 right after a static run).
+    float longestEdge = 0.0f;
+    double lastBuildSeconds = 0.0;  // its last static run, wall seconds
+    // The animated inputs its static part reads, how far each moves over the scene (its
+    // span), and their values at its last static run (the photometric fiducial).
+    StaticInputs staticInputs;
+    std::vector<float> inputSpans, builtInputs;
+    // The last frame: its static work (building, filling its tiles), seconds summed over
+    // threads; its dynamic work (all zero when not drawn or rendered single-phase).
+    double frameStaticSeconds = 0.0;
+    ObjectFrameCost frameDynamic;
+    ObjectReport report;
+};
+
+}  // namespace mpshade

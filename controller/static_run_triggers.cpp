@@ -1,0 +1,74 @@
+#include "controller/static_run_triggers.h"
+
+#include <algorithm>
+
+#include <glm/geometric.hpp>
+
+namespace mpshade {
+
+std::optional<StaticRunDue> staticRunDue(uint32_t object, const ObjectSlot& slot,
+                                         const ObjectState& state, const CameraState& camera,
+                                         const ShadingUniforms& uniforms, float inputTolerance,
+                                         std::vector<float>& scratch) {
+    StaticRunDue due;
+    due.object = object;
+    const ObjectRepresentation* rep = slot.representation.get();
+    if (!rep) return due;  // first seen
+    const glm::vec3 forward =
+        glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
+    const ObjectRepresentation::RangeCheck range = rep->checkRange(state.eye, forward);
+    float inputsMoved = 0.0f;
+    if (range.fiducial == ObjectRepresentation::RangeCheck::None && !slot.staticInputs.empty()) {
+        slot.staticInputs.read(uniforms, scratch);
+        inputsMoved = staticInputChange(slot.builtInputs, scratch, slot.inputSpans);
+    }
+    if (range.fiducial != ObjectRepresentation::RangeCheck::None) {
+        due.cause = range.fiducial == ObjectRepresentation::RangeCheck::ViewDirection
+                        ? StaticRunDue::ViewDirection
+                    : range.fiducial == ObjectRepresentation::RangeCheck::Distance
+                        ? StaticRunDue::Distance
+                        : StaticRunDue::AngleAround;
+        due.measured = range.measured;
+        due.threshold = range.threshold;
+    } else if (inputsMoved > inputTolerance) {
+        due.cause = StaticRunDue::StaticInput;
+        due.measured = inputsMoved;
+        due.threshold = inputTolerance;
+    } else if (rep->imageHeight != camera.height) {
+        due.cause = StaticRunDue::ImageSize;
+        due.measured = static_cast<float>(camera.height);
+        due.threshold = static_cast<float>(rep->imageHeight);
+    } else if (rep->kind == Representation::Facets && slot.longestEdge > rep->maxEdgePixels) {
+        due.cause = StaticRunDue::FacetsTooLong;
+        due.measured = slot.longestEdge;
+        due.threshold = rep->maxEdgePixels;
+    } else {
+        return std::nullopt;
+    }
+    return due;
+}
+
+std::vector<size_t> admitRebuilds(std::span<const size_t> due, std::span<const ObjectSlot> slots,
+                                  double secondsLeft, std::vector<StaticRunDue>& dues,
+                                  int& deferred) {
+    std::vector<size_t> admitted, again;
+    for (size_t i : due) (slots[i].representation ? again : admitted).push_back(i);
+    std::sort(again.begin(), again.end(), [&](size_t a, size_t b) {
+        return slots[a].lastBuildSeconds < slots[b].lastBuildSeconds;
+    });
+    for (size_t i : again) {
+        const double cost = 1.5 * slots[i].lastBuildSeconds;
+        if (cost <= secondsLeft) {
+            admitted.push_back(i);
+            secondsLeft -= cost;
+            continue;
+        }
+        ++deferred;
+        for (StaticRunDue& d : dues)
+            if (d.object == i) d.deferred = true;
+    }
+    std::sort(admitted.begin(), admitted.end());
+    return admitted;
+}
+
+}  // namespace mpshade

@@ -1,0 +1,73 @@
+#include "controller/tile_filler.h"
+
+#include <algorithm>
+
+#include "controller/fill_pacer.h"
+
+namespace mpshade {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+bool TileFiller::makeRoom(size_t incoming, const FillLimits& limits, TileFillResult& result) {
+    const TilePools& pools = statics_.tilePools();
+    if (limits.room == CacheRoom::RoomLeft)
+        return pools.bytesHeld() + incoming <= cache_.budgetBytes();
+    const auto start = Clock::now();
+    const bool fits = cache_.makeRoom(pools, incoming, limits.useStamp, result.evicted);
+    result.roomSeconds += secondsSince(start);
+    return fits || limits.room == CacheRoom::EvictAndExceed;
+}
+
+void TileFiller::fill(std::span<const TileRequest> tiles,
+                      std::span<const ObjectRepresentation* const> representations,
+                      const FillLimits& limits, TileFillResult& result) {
+    const auto start = Clock::now();
+    const bool paced = limits.deadline != Clock::time_point::max();
+    result.timing.trace = limits.trace;
+    result.timing.frame = limits.frame;
+    result.objectTiles.resize(representations.size(), 0);
+    FillPacer pacer(tileSeconds_);
+    size_t next = 0;
+    bool started = false;
+    while (next < tiles.size()) {
+        const size_t chunk =
+            paced
+                ? pacer.chunk(std::chrono::duration<double>(limits.deadline - Clock::now()).count())
+                : tiles.size();
+        if (chunk == 0) break;
+        const size_t first = next;
+        batch_.clear();
+        size_t incoming = 0;
+        for (; next < tiles.size() && batch_.size() < chunk; ++next) {
+            const TileRequest& r = tiles[next];
+            const ObjectRepresentation* rep = representations[r.object];
+            if (!rep || !rep->map || rep->map->resident(r.key)) continue;
+            batch_.push_back(r);
+            incoming += rep->map->tileBytes();
+        }
+        if (batch_.empty()) continue;
+        // Room for the new tiles first, so the maps' storage never outgrows the budget
+        // but where a constant-quality frame needs more.
+        if (!makeRoom(incoming, limits, result)) {
+            next = first;
+            break;
+        }
+        started = true;
+        const auto began = Clock::now();
+        statics_.fill(batch_, representations, result.costs, &result.timing);
+        pacer.filled(secondsSince(began), batch_.size());
+        for (const TileRequest& r : batch_) ++result.objectTiles[r.object];
+        result.filled.insert(result.filled.end(), batch_.begin(), batch_.end());
+    }
+    if (paced) tileSeconds_ = pacer.remembered();
+    result.consumed += next;
+    result.seconds += secondsSince(start);
+    if (limits.trace && started)
+        limits.trace->span("fill", PhaseKind::Static, SpanLevel::Phase, start, Clock::now(), -1,
+                           limits.frame);
+}
+
+}  // namespace mpshade
