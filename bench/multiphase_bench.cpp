@@ -11,6 +11,7 @@
 #include <glm/mat4x4.hpp>
 
 #include "controller/multiphase_renderer.h"
+#include "controller/tile_predictor.h"
 #include "phases/facet_rasterizer.h"
 #include "phases/fixed_point_warp.h"
 #include "phases/reference_renderer.h"
@@ -159,7 +160,7 @@ void facetsPerPixel(benchmark::State& state, const char* path, int representatio
         covered > 0 ? stats.facetsRasterized / covered : 0.0;
 }
 
-// The prefetch prediction `play` runs in a frame's slack (MultiphaseRenderer::predictTiles:
+// The prefetch prediction `play` runs in a frame's slack (TilePredictor::predict:
 // the frame 3 ahead at a quarter of 640 x 360, one sample a pixel), over representations
 // built for 640 x 360 with frame 1's tiles filled. Its cost decides how often a frame has
 // room for it; it draws every facet of the full-size representations.
@@ -172,9 +173,10 @@ void predictAhead(benchmark::State& state, const char* path) {
     FrameStats stats;
     f.multi->renderFrame(0, f.options, stats);
     f.multi->renderFrame(1, f.options, stats);
+    TilePredictor predictor(*f.multi);
     double seconds = 0.0;
     size_t tiles = 0;
-    for (auto _ : state) tiles = f.multi->predictTiles(4, f.options, 4, seconds).size();
+    for (auto _ : state) tiles = predictor.predict(4, f.options, 4, seconds).size();
     state.counters["tiles_predicted"] = static_cast<double>(tiles);
     state.counters["facets"] = static_cast<double>(stats.facets);
 }

@@ -29,7 +29,9 @@
 #include <vector>
 
 #include "controller/background_filler.h"
+#include "controller/multiphase_options.h"
 #include "controller/object_slot.h"
+#include "controller/prefetch_ledger.h"
 #include "controller/representation_planner.h"
 #include "controller/tile_cache.h"
 #include "controller/tile_filler.h"
@@ -40,65 +42,6 @@
 #include "phases/static_phase.h"
 
 namespace mpshade {
-
-// Constant quality fills every tile a frame's probes lack before it shades, so no probe
-// falls back and the maps' always-resident levels are filled only where frames ask for
-// them (on the courtyard's 24 frames, filling them all up front took 1.0 s of 6.3).
-inline StaticPhaseOptions constantQualityStaticPhase() {
-    StaticPhaseOptions o;
-    o.shaderMap.fillPinnedUpFront = false;
-    return o;
-}
-
-struct MultiphaseOptions {
-    StaticPhaseOptions staticPhase = constantQualityStaticPhase();
-    DynamicOptions dynamic;  // its shadingRate is the scene's unless shadingRate is set
-    std::optional<ShadingRate> shadingRate;
-    RepresentationCostModel costModel;
-    // The shader maps' tiles stay under this many bytes: before tiles are filled, the tiles
-    // unused longest are dropped (never the always-resident levels, nor a tile the frame
-    // being rendered has used).
-    size_t mapMemoryBytes = size_t{96} << 20;
-    // Forces every object's representation (tests, benchmarks); unset: the scene's.
-    std::optional<Representation> representation;
-    // A frame whose due static work, with the dynamic frames it would serve, is estimated
-    // to cost more than rendering those frames single-phase is rendered by the reference
-    // renderer instead, and nothing is built (a camera cut every frame, a short request).
-    // Off: every frame is multi-phase.
-    bool singlePhaseFrames = true;
-    // Where every phase reports its spans (phase_trace.h; not owned, must outlive the
-    // renderer). Null: nowhere, and nothing is measured for it.
-    PhaseTrace* trace = nullptr;
-    // Above 0: the frame rate is locked (`mpshade play`). A frame shades once, probes
-    // lacking tiles falling back to the finest coarser level resident; then, in the time left
-    // of this many seconds, the tiles they lacked are filled (coarser levels first: each
-    // serves more of the screen, for less) and the rest left for later frames. An object
-    // whose static phase is due is drawn from its last representation unless its last
-    // static run fits the time left; one never built is always built. 0: constant quality.
-    double frameBudgetSeconds = 0.0;
-    // With a frame budget, the share of it static work gets even when the dynamic phase
-    // took the whole budget: frames late anyway still make progress towards full quality.
-    double minimumStaticShare = 0.1;
-    // The photometric re-run trigger (static_inputs.h): an object whose static part reads
-    // animated inputs (through bake()) runs its static phase again once one of them moved
-    // by more than this share of its span over the scene since the last run.
-    float staticInputTolerance = 0.02f;
-    // A prefetched tile no frame read within this many frames counts as wasted (it stays
-    // resident, an ordinary tile for the cache).
-    int prefetchPatienceFrames = 30;
-    // With a frame budget: the lacking tiles a frame had no time left to fill are queued
-    // for a worker thread that fills them at idle priority (background_filler.h), from the
-    // end of the frame's fills until the next frame starts -- and, with
-    // backgroundDuringFrames, alongside its dynamic phase too. At most backgroundQueue are
-    // queued (the newest frame's, coarser levels first). Off: they wait for a later
-    // frame's slack.
-    bool backgroundFills = false;
-    size_t backgroundQueue = 4096;
-    bool backgroundDuringFrames = false;
-    // The worker at idle priority; false: normal priority (a caller that waits on it while
-    // other processes load the machine, as tests do).
-    bool backgroundIdlePriority = true;
-};
 
 class MultiphaseRenderer {
   public:
@@ -139,20 +82,8 @@ class MultiphaseRenderer {
     // fits in `seconds`. Returns the seconds spent; `built` counts the objects built.
     double buildAhead(int frame, int frames, const RenderOptions& options, double seconds,
                       int& built);
-    // Prefetching, for a caller with time left in a frame (patent claims 10 and 11):
-    // The tiles frame `frame` will lack, predicted by a low-resolution dynamic phase (the
-    // image 1/divisor each way, one sample a pixel, shading per pixel with footprints
-    // scaled to the full image's at the current rate) over the objects built; its probes
-    // fall back, never wait. `seconds` receives its cost. Past `deadline` the prediction
-    // is abandoned where it is (predictionAbandoned()): rasterization stopped short gives no
-    // tiles, shading stopped short the tiles its finished bands lacked; `seconds` then
-    // keeps the larger of its time and the cost it held (a whole prediction's, as far as
-    // known).
-    std::vector<TileRequest> predictTiles(int frame, const RenderOptions& options, int divisor,
-                                          double& seconds,
-                                          std::chrono::steady_clock::time_point deadline =
-                                              std::chrono::steady_clock::time_point::max());
-    bool predictionAbandoned() const { return predictionAbandoned_; }
+    // Prefetching, for a caller with time left in a frame (patent claims 10 and 11; the
+    // tiles a frame ahead will lack come from tile_predictor.h):
     // The tiles next to those the last frame lacked (the 8 around, same level), not resident.
     std::vector<TileRequest> adjacentTiles() const;
     // Fills those of `tiles` not resident, in order, while the time spent stays within
@@ -174,6 +105,12 @@ class MultiphaseRenderer {
     // Per object, what the last frame cost it: ObjectSlot::frameStaticSeconds and
     // frameDynamic.
     const ObjectSlot& slot(size_t object) const { return slots_[object]; }
+    const Scene& scene() const { return scene_; }
+    // The frame states' source (ray scenes for occlusion included), fixed for the render.
+    const SceneResources& resources() const { return resources_; }
+    // The dynamic phase's options for the frames now: the scene's shading rate unless
+    // MultiphaseOptions::shadingRate or setShadingRate() overrides it.
+    DynamicOptions frameDynamicOptions() const;
 
   private:
     struct FramePlan;
@@ -205,9 +142,6 @@ class MultiphaseRenderer {
     // left unread too long (wasted), counted in stats and forgotten.
     void settlePrefetched(FrameStats& stats);
     std::vector<const ObjectRepresentation*> representations() const;
-    // The dynamic phase's options for the frames now: the scene's shading rate unless
-    // MultiphaseOptions::shadingRate overrides it.
-    DynamicOptions frameDynamicOptions() const;
 
     const Scene& scene_;
     MultiphaseOptions options_;
@@ -232,20 +166,7 @@ class MultiphaseRenderer {
     std::vector<TileRequest> lacking_, lastLacking_;
     std::vector<const ObjectRepresentation*> drawn_;
     double lastDynamicSeconds_ = 0.0;
-    // Prefetching: the tiles prefetched and not yet read (with the use stamp they were
-    // filled at); the low-resolution predictor.
-    struct Prefetched {
-        uint32_t object;
-        const ShaderMap* map;
-        TileKey key;
-        int slot;
-        uint32_t stamp;
-    };
-    std::vector<Prefetched> prefetched_;
-    std::unique_ptr<DynamicPhase> predictor_;
-    bool predictionAbandoned_ = false;  // the last predictTiles() call
-    std::shared_ptr<const SampleLayout> predictLayout_;
-    FrameState predictState_;
+    PrefetchLedger prefetched_;  // the tiles prefetched and not yet read
     // The background filler (made at the first frame that defers tiles), and its totals at
     // the last frame. Last: destroyed (its worker joined) before anything it uses.
     double pauseFiller();  // returns the seconds it waited for the worker

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "controller/tile_predictor.h"
 #include "geometry/error.h"
 
 namespace mpshade {
@@ -62,6 +63,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
     // every third frame of the first prerollPrefetchSeconds, predicted at half the size,
     // filled as far as the cache allows. Then one prediction as the frames make them, so
     // the first frames know what one costs.
+    TilePredictor predictor(renderer);
     double predictCost = 0.0;  // the last prediction's seconds
     int framesWithoutPrediction = 0;
     if (options.prefetch) {
@@ -71,13 +73,13 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         for (int f = options.first + 1; f <= std::min(options.last - 1, options.first + ahead);
              f += 3) {
             std::vector<TileRequest> more =
-                renderer.predictTiles(f, stepOptions(regulator.level()), 2, predictCost);
+                predictor.predict(f, stepOptions(regulator.level()), 2, predictCost);
             tiles.insert(tiles.end(), more.begin(), more.end());
         }
         FrameStats warm;
         renderer.prefetch(tiles, options.prerollPrefetchWallSeconds, warm);
-        renderer.predictTiles(options.first, stepOptions(regulator.level()), options.predictDivisor,
-                              predictCost);
+        predictor.predict(options.first, stepOptions(regulator.level()), options.predictDivisor,
+                          predictCost);
     }
     summary.prerollSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -119,12 +121,12 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
                          frame + std::max(1, static_cast<int>(std::lround(options.predictSeconds *
                                                                           scene.settings.fps))));
             const auto predicting = std::chrono::steady_clock::now();
-            std::vector<TileRequest> tiles = renderer.predictTiles(
+            std::vector<TileRequest> tiles = predictor.predict(
                 ahead, options.render, options.predictDivisor, predictCost, deadline);
             const double predicted =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - predicting)
                     .count();
-            stats.predictionAbandoned = renderer.predictionAbandoned();
+            stats.predictionAbandoned = predictor.abandoned();
             stats.tilesPredicted = tiles.size();
             const std::vector<TileRequest> adjacent = renderer.adjacentTiles();
             stats.tilesAdjacent = adjacent.size();

@@ -131,9 +131,7 @@ void DynamicPhase::begin(const FrameState& frame,
     const glm::vec3 ddx = (2.0f * tx / static_cast<float>(camera.width)) * camera.right;
     const glm::vec3 ddy = (-2.0f * ty / static_cast<float>(camera.height)) * camera.up;
     const float footprint =
-        options.footprintScale * (options.shadingRate == ShadingRate::Sample
-                                      ? 1.0f / std::sqrt(static_cast<float>(layout_->spp()))
-                                      : (options.shadingRate == ShadingRate::Pixel ? 0.5f : 1.0f));
+        options.footprintScale * footprintPixels(options.shadingRate, layout_->spp());
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
         const ObjectRepresentation* rep = objects_[i];
         if (!rep) return;

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -60,6 +61,13 @@ struct DynamicOptions {
     // (overrides raster.deadline). Default never.
     std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
 };
+
+// A shading point's probe footprint in pixels at `rate` with `spp` samples per pixel, before
+// DynamicOptions::footprintScale: a sample's stratum, half a pixel, or a pixel.
+inline float footprintPixels(ShadingRate rate, int spp) {
+    return rate == ShadingRate::Sample ? 1.0f / std::sqrt(static_cast<float>(spp))
+                                       : (rate == ShadingRate::Pixel ? 0.5f : 1.0f);
+}
 
 // What one object cost this frame.
 struct ObjectFrameCost {

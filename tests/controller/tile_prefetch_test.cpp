@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "controller/multiphase_renderer.h"
+#include "controller/tile_predictor.h"
 #include "test_support.h"
 
 namespace mpshade {
@@ -49,7 +50,7 @@ TEST(TilePrefetch, PrefetchedTilesAreNotLackedAndCountAsUsed) {
         renderer.renderFrame(0, small(), stats);
         double seconds = 0.0;
         const std::vector<TileRequest> predicted =
-            renderer.predictTiles(16, small(), divisor, seconds);
+            TilePredictor(renderer).predict(16, small(), divisor, seconds);
         ASSERT_FALSE(predicted.empty());
         for (const TileRequest& r : predicted)
             ASSERT_FALSE(renderer.representation(r.object)->map->resident(r.key));
@@ -118,7 +119,8 @@ TEST(TilePrefetch, AGuessNeverDisplacesATileInTheCache) {
     ASSERT_EQ(stats.tilesEvicted, 0u);
     ASSERT_EQ(stats.residentBytes, full);
     double seconds = 0.0;
-    const std::vector<TileRequest> predicted = renderer.predictTiles(16, small(), 1, seconds);
+    const std::vector<TileRequest> predicted =
+        TilePredictor(renderer).predict(16, small(), 1, seconds);
     ASSERT_FALSE(predicted.empty());
     FrameStats slack;
     renderer.prefetch(predicted, 60.0, slack);
@@ -137,19 +139,20 @@ TEST(TilePrefetch, PredictionPastItsDeadlineIsAbandoned) {
     MultiphaseRenderer renderer(scene, budgeted());
     FrameStats stats;
     renderer.renderFrame(0, small(), stats);
+    TilePredictor predictor(renderer);
     double seconds = 5.0;
-    const std::vector<TileRequest> late = renderer.predictTiles(
+    const std::vector<TileRequest> late = predictor.predict(
         16, small(), 1, seconds, std::chrono::steady_clock::now() - std::chrono::seconds(1));
     EXPECT_TRUE(late.empty());
-    EXPECT_TRUE(renderer.predictionAbandoned());
+    EXPECT_TRUE(predictor.abandoned());
     EXPECT_EQ(seconds, 5.0);
-    const std::vector<TileRequest> whole = renderer.predictTiles(
+    const std::vector<TileRequest> whole = predictor.predict(
         16, small(), 1, seconds, std::chrono::steady_clock::now() + std::chrono::hours(1));
-    EXPECT_FALSE(renderer.predictionAbandoned());
+    EXPECT_FALSE(predictor.abandoned());
     EXPECT_FALSE(whole.empty());
     EXPECT_LT(seconds, 5.0);
     double untimedSeconds = 0.0;
-    EXPECT_EQ(renderer.predictTiles(16, small(), 1, untimedSeconds).size(), whole.size());
+    EXPECT_EQ(predictor.predict(16, small(), 1, untimedSeconds).size(), whole.size());
 }
 
 TEST(TilePrefetch, NeighboursOfLackedTilesAreAdjacentAndNotResident) {

@@ -1,0 +1,76 @@
+// multiphase_options.h -- how a MultiphaseRenderer (multiphase_renderer.h) renders: its
+// static and dynamic phases' options, the tile cache's budget, when a frame may be
+// rendered single-phase, and the frame budget of a locked frame rate with what its slack
+// is spent on. Plain data with documented defaults.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+
+#include "phases/dynamic_phase.h"
+#include "phases/phase_trace.h"
+#include "phases/representation_choice.h"
+#include "phases/static_phase.h"
+
+namespace mpshade {
+
+// Constant quality fills every tile a frame's probes lack before it shades, so no probe
+// falls back and the maps' always-resident levels are filled only where frames ask for
+// them (on the courtyard's 24 frames, filling them all up front took 1.0 s of 6.3).
+inline StaticPhaseOptions constantQualityStaticPhase() {
+    StaticPhaseOptions o;
+    o.shaderMap.fillPinnedUpFront = false;
+    return o;
+}
+
+struct MultiphaseOptions {
+    StaticPhaseOptions staticPhase = constantQualityStaticPhase();
+    DynamicOptions dynamic;  // its shadingRate is the scene's unless shadingRate is set
+    std::optional<ShadingRate> shadingRate;
+    RepresentationCostModel costModel;
+    // The shader maps' tiles stay under this many bytes: before tiles are filled, the tiles
+    // unused longest are dropped (never the always-resident levels, nor a tile the frame
+    // being rendered has used).
+    size_t mapMemoryBytes = size_t{96} << 20;
+    // Forces every object's representation (tests, benchmarks); unset: the scene's.
+    std::optional<Representation> representation;
+    // A frame whose due static work, with the dynamic frames it would serve, is estimated
+    // to cost more than rendering those frames single-phase is rendered by the reference
+    // renderer instead, and nothing is built (a camera cut every frame, a short request).
+    // Off: every frame is multi-phase.
+    bool singlePhaseFrames = true;
+    // Where every phase reports its spans (phase_trace.h; not owned, must outlive the
+    // renderer). Null: nowhere, and nothing is measured for it.
+    PhaseTrace* trace = nullptr;
+    // Above 0: the frame rate is locked (`mpshade play`). A frame shades once, probes
+    // lacking tiles falling back to the finest coarser level resident; then, in the time left
+    // of this many seconds, the tiles they lacked are filled (coarser levels first: each
+    // serves more of the screen, for less) and the rest left for later frames. An object
+    // whose static phase is due is drawn from its last representation unless its last
+    // static run fits the time left; one never built is always built. 0: constant quality.
+    double frameBudgetSeconds = 0.0;
+    // With a frame budget, the share of it static work gets even when the dynamic phase
+    // took the whole budget: frames late anyway still make progress towards full quality.
+    double minimumStaticShare = 0.1;
+    // The photometric re-run trigger (static_inputs.h): an object whose static part reads
+    // animated inputs (through bake()) runs its static phase again once one of them moved
+    // by more than this share of its span over the scene since the last run.
+    float staticInputTolerance = 0.02f;
+    // A prefetched tile no frame read within this many frames counts as wasted (it stays
+    // resident, an ordinary tile for the cache).
+    int prefetchPatienceFrames = 30;
+    // With a frame budget: the lacking tiles a frame had no time left to fill are queued
+    // for a worker thread that fills them at idle priority (background_filler.h), from the
+    // end of the frame's fills until the next frame starts -- and, with
+    // backgroundDuringFrames, alongside its dynamic phase too. At most backgroundQueue are
+    // queued (the newest frame's, coarser levels first). Off: they wait for a later
+    // frame's slack.
+    bool backgroundFills = false;
+    size_t backgroundQueue = 4096;
+    bool backgroundDuringFrames = false;
+    // The worker at idle priority; false: normal priority (a caller that waits on it while
+    // other processes load the machine, as tests do).
+    bool backgroundIdlePriority = true;
+};
+
+}  // namespace mpshade
