@@ -35,6 +35,14 @@ BackgroundFiller::~BackgroundFiller() {
     worker_.join();
 }
 
+BackgroundFiller::Hold::Hold(BackgroundFiller* filler, uint32_t stamp)
+    : filler_(filler), stamp_(stamp) {
+    if (!filler_) return;
+    const auto start = std::chrono::steady_clock::now();
+    filler_->pause();
+    seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 void BackgroundFiller::submit(std::vector<BackgroundJob> jobs) {
     std::lock_guard<std::mutex> lock(mutex_);
     jobs_ = std::move(jobs);

@@ -72,6 +72,25 @@ class BackgroundFiller {
     // its queue done or the cache full of tiles it may not drop yet.
     bool settled() const;
 
+    // Holds a filler (null: none) paused for a scope, so the holder's fills and evictions
+    // are the cache's only ones; resumes it at `stamp` on leaving. `seconds`: the wait for
+    // the worker's tile under way.
+    class Hold {
+      public:
+        Hold(BackgroundFiller* filler, uint32_t stamp);
+        ~Hold() {
+            if (filler_) filler_->resume(stamp_);
+        }
+        Hold(const Hold&) = delete;
+        Hold& operator=(const Hold&) = delete;
+        double seconds() const { return seconds_; }
+
+      private:
+        BackgroundFiller* filler_;
+        uint32_t stamp_;
+        double seconds_ = 0.0;
+    };
+
   private:
     void run();
     // Retires the tiles unused longest (last used before stamp - 1) until `wanted` bytes

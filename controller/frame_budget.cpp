@@ -18,7 +18,7 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
                                       double seconds, int& built) {
     const auto start = Clock::now();
     built = 0;
-    const PausedFiller paused(*this);
+    const BackgroundFiller::Hold paused(filler_.get(), useStamp_);
     const size_t n = slots_.size();
     const int last = std::min(scene_.frameCount() - 1, frame + frames);
     const DynamicOptions dynamic = frameDynamicOptions();
@@ -58,8 +58,9 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
         lastLacking_.clear();
         return;
     }
-    const PausedFiller paused(*this);  // the cache's budget is this loop's alone
-    stats.controllerSeconds += paused.seconds;
+    const BackgroundFiller::Hold paused(filler_.get(),
+                                        useStamp_);  // the cache's budget is this loop's alone
+    stats.controllerSeconds += paused.seconds();
     // Coarser levels first: a tile there serves four times the surface of one a level
     // finer, and (built from its children where they are resident) costs no more.
     std::stable_sort(
@@ -77,7 +78,7 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     tiles_.fill(lacking_, drawn_, limits, fills);
     countFills(fills, stats);
     stats.tilesDeferred = lacking_.size() - fills.consumed;
-    recordResidency(stats);
+    recordResidency(static_.tilePools(), stats);
     if (options_.backgroundFills && fills.consumed < lacking_.size())
         queueForBackground(fills.consumed);
     lastLacking_.swap(lacking_);

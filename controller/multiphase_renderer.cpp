@@ -70,17 +70,6 @@ DynamicOptions MultiphaseRenderer::frameDynamicOptions() const {
     return o;
 }
 
-double MultiphaseRenderer::pauseFiller() {
-    if (!filler_) return 0.0;
-    const auto start = Clock::now();
-    filler_->pause();
-    return secondsSince(start);
-}
-
-void MultiphaseRenderer::resumeFiller() {
-    if (filler_) filler_->resume(useStamp_);
-}
-
 void MultiphaseRenderer::discardStaticWork() {
     if (filler_) {
         filler_->pause();
@@ -102,7 +91,25 @@ void MultiphaseRenderer::setFrameBudget(double seconds) {
     if (seconds > 0.0) cache_.reserve(static_.tilePools());
 }
 
-// One frame, constant quality or within a frame budget (multiphase_renderer.h, steps 1-3).
+// A frame, at constant quality or within a frame budget, is these steps in order:
+//   beginFrame          the frame's state and sample layout; the background filler held.
+//   planFrame           the objects in view, and of them those whose static phase is due,
+//                       with why (static_run_triggers.h). Nothing is done for an object
+//                       until a frame sees it.
+//   deferRebuilds       within a budget: rebuilds only as they fit the frame's time.
+//   rendersSinglePhase  representations chosen for the due objects
+//                       (representation_planner.h); if that work would not pay for itself
+//                       over the frames it serves, the reference renderer draws the frame
+//                       and nothing is built.
+//   buildDue            the static phase of the due objects, in parallel.
+//   shadeAndFill        the dynamic phase; at constant quality, the tiles its probes lacked
+//                       are filled (tile_filler.h) and only the bands that lacked them are
+//                       shaded again, so no sample reads a coarser level than its footprint
+//                       asks and the image does not depend on what earlier frames filled.
+//   recordFrame         what the frame drew and cost, per object (object_slot.h) and in all.
+// renderFrame() then resolves pixels and, within a budget, fills the tiles lacked in the
+// time left (frame_budget.cpp). Playback's look-ahead and prefetching are frame_budget.cpp
+// and tile_prefetch.cpp.
 void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameStats& stats,
                                 const ProgressFn& progress) {
     const auto start = Clock::now();
@@ -147,7 +154,9 @@ void MultiphaseRenderer::beginFrame(int frame, const RenderOptions& options, Fra
         // Held while this frame's static work runs; no probe runs now either, so the
         // storage of the tiles it dropped meanwhile is free again. The wait (at most the
         // tile under way) is the controller's time.
-        stats.controllerSeconds += pauseFiller();
+        const auto held = Clock::now();
+        filler_->pause();
+        stats.controllerSeconds += secondsSince(held);
         const BackgroundTotals t = filler_->totals();
         stats.backgroundTilesFilled = t.tilesFilled - fillerTotals_.tilesFilled;
         stats.backgroundTilesEvicted = t.tilesEvicted - fillerTotals_.tilesEvicted;
@@ -380,7 +389,7 @@ void MultiphaseRenderer::recordFrame(const FramePlan& plan, FrameStats& stats) {
         }
         ++stats.objectsDrawn;
     }
-    recordResidency(stats);
+    recordResidency(static_.tilePools(), stats);
     const DynamicFrameStats& d = dynamic_.stats();
     stats.warpSeconds = d.warpSeconds;
     stats.rasterSeconds = d.rasterSeconds;
@@ -399,15 +408,6 @@ void MultiphaseRenderer::recordFrame(const FramePlan& plan, FrameStats& stats) {
     stats.index = plan.frame;
     stats.time = frame_.time;
     stats.samples = static_cast<uint64_t>(frame_.width) * frame_.height * frame_.spp;
-}
-
-void MultiphaseRenderer::recordResidency(FrameStats& stats) const {
-    stats.residentTiles = stats.residentBytes = stats.residentPinnedBytes = 0;
-    for (const auto& pool : static_.tilePools().all()) {
-        stats.residentTiles += pool->tilesHeld();
-        stats.residentBytes += pool->bytesHeld();
-        stats.residentPinnedBytes += pool->pinnedBytesHeld();
-    }
 }
 
 Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,

@@ -1,31 +1,13 @@
-// multiphase_renderer.h -- the controller's frame policy (patent FIG. 2, controller 240):
+// multiphase_renderer.h -- the controller's frame pipeline (patent FIG. 2, controller 240):
 // what drives the static phase (phases/static_phase.h) and the dynamic phase
-// (phases/dynamic_phase.h) frame by frame -- re-run triggers, the tile cache's budget,
-// fills -- at constant quality as `mpshade render` uses it, or within a frame budget as
-// playback (playback.h) uses it.
-//
-// Per frame:
-//   1. Objects out of view are skipped: no static work is done for an object until a
-//      frame sees it.
-//   2. The static phase runs, in parallel over objects, for objects in view that have no
-//      representation yet, whose view left the range, whose image size changed, or
-//      (combined representation) whose facets measured longer than P/2 last frame. Auto
-//      objects get their representation chosen at their first run
-//      (representation_choice.h).
-//   2b. Unless the static work due would not pay for itself: when the estimates
-//      (representation_choice.h) of that work and of the multi-phase frames it serves
-//      exceed the reference renderer's for the same frames, the frame is rendered
-//      single-phase and nothing is built (singlePhaseFrames; stats say so).
-//   3. The dynamic phase warps and rasterizes, then shades; the shader-map tiles its probes
-//      lacked are filled in one batch and only the bands that lacked them are shaded
-//      again, so no sample reads a coarser level than its footprint asks and the image
-//      does not depend on what earlier frames filled. Filled tiles are kept.
+// (phases/dynamic_phase.h) frame by frame, at constant quality as `mpshade render` uses it,
+// or within a frame budget as playback (playback.h) uses it. A frame is a short list of
+// named steps over a FramePlan; multiphase_renderer.cpp lists them above render().
 #pragma once
 
 #include <chrono>
 #include <memory>
-#include <optional>
-#include <string>
+#include <span>
 #include <vector>
 
 #include "controller/background_filler.h"
@@ -37,9 +19,6 @@
 #include "controller/tile_filler.h"
 #include "phases/dynamic_phase.h"
 #include "phases/reference_renderer.h"
-#include "phases/representation_choice.h"
-#include "phases/static_inputs.h"
-#include "phases/static_phase.h"
 
 namespace mpshade {
 
@@ -56,9 +35,8 @@ class MultiphaseRenderer {
     // Renders frame `frame`, running the static phase first for objects that need it.
     Image renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
                       const ProgressFn& progress = {});
-    // The same, into `image`, whose storage is reused when its size is the frame's: a
-    // player's frames then touch no new memory (a fresh 640x360 image took 10 ms of page
-    // faults per frame on the 2-core test machine).
+    // The same, into `image`, whose storage is reused when its size is the frame's (a
+    // fresh 640x360 image cost a player 10 ms of page faults per frame).
     void renderFrame(int frame, const RenderOptions& options, FrameStats& stats, Image& image,
                      const ProgressFn& progress = {});
     SampleBuffer renderSamples(int frame, const RenderOptions& options, FrameStats& stats,
@@ -82,8 +60,7 @@ class MultiphaseRenderer {
     // fits in `seconds`. Returns the seconds spent; `built` counts the objects built.
     double buildAhead(int frame, int frames, const RenderOptions& options, double seconds,
                       int& built);
-    // Prefetching, for a caller with time left in a frame (patent claims 10 and 11; the
-    // tiles a frame ahead will lack come from tile_predictor.h):
+    // Prefetching in a frame's slack (claims 10 and 11; predictions: tile_predictor.h).
     // The tiles next to those the last frame lacked (the 8 around, same level), not resident.
     std::vector<TileRequest> adjacentTiles() const;
     // Fills those of `tiles` not resident, in order, while the time spent stays within
@@ -131,16 +108,12 @@ class MultiphaseRenderer {
                      const ShadingUniforms& uniforms);
     // Adds what a fill did to the frame's stats and to each object's costs.
     void countFills(const TileFillResult& fills, FrameStats& stats);
-    FillLimits fillLimits(CacheRoom room, int frame) const;
+    FillLimits fillLimits(CacheRoom room, int frame) const;  // the cache's, this frame's
     // With a frame budget: fills this frame's lacking tiles (lacking_) until the budget,
     // counted from `start`, is spent; queues what is left for the background filler.
     void fillWithinBudget(std::chrono::steady_clock::time_point start, FrameStats& stats);
     void queueForBackground(size_t from);
-    // The tiles every map holds now, and their bytes (of them the always-resident levels').
-    void recordResidency(FrameStats& stats) const;
-    // Of the tiles prefetched, those this frame's probes read (used) and those dropped or
-    // left unread too long (wasted), counted in stats and forgotten.
-    void settlePrefetched(FrameStats& stats);
+    void settlePrefetched(FrameStats& stats);  // prefetch_ledger.h
     std::vector<const ObjectRepresentation*> representations() const;
 
     const Scene& scene_;
@@ -169,18 +142,6 @@ class MultiphaseRenderer {
     PrefetchLedger prefetched_;  // the tiles prefetched and not yet read
     // The background filler (made at the first frame that defers tiles), and its totals at
     // the last frame. Last: destroyed (its worker joined) before anything it uses.
-    double pauseFiller();  // returns the seconds it waited for the worker
-    void resumeFiller();
-    // Holds the background filler while it lives: the holder's fills and evictions are the
-    // cache's only ones. `seconds`: the wait for the worker's tile under way.
-    struct PausedFiller {
-        explicit PausedFiller(MultiphaseRenderer& r) : renderer(r), seconds(r.pauseFiller()) {}
-        ~PausedFiller() { renderer.resumeFiller(); }
-        PausedFiller(const PausedFiller&) = delete;
-        PausedFiller& operator=(const PausedFiller&) = delete;
-        MultiphaseRenderer& renderer;
-        double seconds;
-    };
     BackgroundTotals fillerTotals_;
     std::unique_ptr<BackgroundFiller> filler_;
 };

@@ -11,6 +11,15 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
+void recordResidency(const TilePools& pools, FrameStats& stats) {
+    stats.residentTiles = stats.residentBytes = stats.residentPinnedBytes = 0;
+    for (const auto& pool : pools.all()) {
+        stats.residentTiles += pool->tilesHeld();
+        stats.residentBytes += pool->bytesHeld();
+        stats.residentPinnedBytes += pool->pinnedBytesHeld();
+    }
+}
+
 bool TileFiller::makeRoom(size_t incoming, const FillLimits& limits, TileFillResult& result) {
     const TilePools& pools = statics_.tilePools();
     if (limits.room == CacheRoom::RoomLeft)

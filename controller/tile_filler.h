@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "controller/tile_cache.h"
+#include "phases/frame_stats.h"
 #include "phases/phase_trace.h"
 #include "phases/static_phase.h"
 
@@ -80,5 +81,9 @@ class TileFiller {
     double tileSeconds_ = 0.0;  // the most a tile took lately (0: not measured yet)
     std::vector<TileRequest> batch_;
 };
+
+// The tiles every pool holds now, and their bytes (of them the always-resident levels'),
+// into stats.residentTiles, residentBytes and residentPinnedBytes.
+void recordResidency(const TilePools& pools, FrameStats& stats);
 
 }  // namespace mpshade

@@ -39,7 +39,8 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
     const auto start = Clock::now();
     const ScopedSpan span(options_.trace, "prefetch", PhaseKind::Static, SpanLevel::Phase, -1,
                           stats.index);
-    const PausedFiller paused(*this);  // room in the cache is this loop's alone
+    const BackgroundFiller::Hold paused(filler_.get(),
+                                        useStamp_);  // room in the cache is this loop's alone
     const std::vector<const ObjectRepresentation*> maps = representations();
     // A guess never displaces a tile in the cache: only room left is used.
     FillLimits limits = fillLimits(CacheRoom::RoomLeft, stats.index);
