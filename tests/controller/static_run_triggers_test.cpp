@@ -1,0 +1,69 @@
+// Which due rebuilds a frame budget admits: never-built objects always, rebuilds cheapest
+// first while 1.5 times their last run fits the time left (at it exactly too), the rest
+// marked deferred.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <vector>
+
+#include "controller/static_run_triggers.h"
+
+namespace mpshade {
+namespace {
+
+// Slots 0..n-1: those with a cost were built before (their last run took it, seconds);
+// those without never were.
+std::vector<ObjectSlot> slots(const std::vector<double>& lastRun) {
+    std::vector<ObjectSlot> out(lastRun.size());
+    for (size_t i = 0; i < lastRun.size(); ++i) {
+        if (lastRun[i] < 0.0) continue;
+        out[i].representation = std::make_unique<ObjectRepresentation>();
+        out[i].lastBuildSeconds = lastRun[i];
+    }
+    return out;
+}
+
+std::vector<StaticRunDue> dues(const std::vector<size_t>& objects) {
+    std::vector<StaticRunDue> out;
+    for (size_t i : objects) {
+        StaticRunDue d;
+        d.object = static_cast<uint32_t>(i);
+        d.cause = StaticRunDue::Distance;
+        out.push_back(d);
+    }
+    return out;
+}
+
+TEST(AdmitRebuilds, CheapestFirstWhileHalfAsMuchAgainFitsAtTheBoundaryToo) {
+    // Object 0 never built; 1, 2, 3 built with last runs of 0.04, 0.01, 0.02 s. With 0.045 s
+    // left: 2 (0.015) then 3 (0.03, leaving exactly 0) fit; 1 (0.06) does not.
+    const std::vector<ObjectSlot> s = slots({-1.0, 0.04, 0.01, 0.02});
+    const std::vector<size_t> due = {0, 1, 2, 3};
+    std::vector<StaticRunDue> d = dues(due);
+    int deferred = 0;
+    const std::vector<size_t> admitted = admitRebuilds(due, s, 0.045, d, deferred);
+    EXPECT_EQ(admitted, (std::vector<size_t>{0, 2, 3}));  // in index order
+    EXPECT_EQ(deferred, 1);
+    EXPECT_FALSE(d[0].deferred);
+    EXPECT_TRUE(d[1].deferred);
+    EXPECT_FALSE(d[2].deferred);
+    EXPECT_FALSE(d[3].deferred);
+}
+
+TEST(AdmitRebuilds, ARebuildJustOverTheTimeLeftIsDeferredButANewObjectIsNot) {
+    const std::vector<ObjectSlot> s = slots({0.02, -1.0});
+    const std::vector<size_t> due = {0, 1};
+    std::vector<StaticRunDue> d = dues(due);
+    int deferred = 0;
+    const std::vector<size_t> admitted = admitRebuilds(due, s, 0.0299, d, deferred);
+    EXPECT_EQ(admitted, (std::vector<size_t>{1}));
+    EXPECT_EQ(deferred, 1);
+    EXPECT_TRUE(d[0].deferred);
+    // No time left at all: the never-built object is still built.
+    std::vector<StaticRunDue> none = dues(due);
+    int deferredNone = 0;
+    EXPECT_EQ(admitRebuilds(due, s, -1.0, none, deferredNone), (std::vector<size_t>{1}));
+}
+
+}  // namespace
+}  // namespace mpshade
