@@ -1,5 +1,7 @@
 #include "app/frame_stats_json.h"
 
+#include "controller/cost_profile.h"
+
 namespace mpshade {
 
 void addMultiphaseFrameJson(const Scene& scene, const FrameStats& stats, nlohmann::json& entry) {
@@ -31,6 +33,110 @@ nlohmann::json staticRunsDueJson(const Scene& scene, const FrameStats& stats) {
         due.push_back(std::move(e));
     }
     return due;
+}
+
+nlohmann::json renderFrameJson(const Scene& scene, const FrameStats& stats, bool multiphase,
+                               const Image& image) {
+    nlohmann::json entry = {{"index", stats.index},
+                            {"time", stats.time},
+                            {"wall_seconds", stats.wallSeconds},
+                            {"samples", stats.samples},
+                            {"rays", stats.rays},
+                            {"occlusion_rays", stats.occlusionRays},
+                            {"shaded_points", stats.shadedPoints},
+                            {"shader_instructions", stats.shaderInstructions},
+                            {"nonfinite_samples", stats.nonFiniteSamples}};
+    if (!multiphase) return entry;
+    double covered = 0.0;
+    for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
+    entry["single_phase"] = stats.singlePhase;
+    addMultiphaseFrameJson(scene, stats, entry);
+    entry["static_instructions"] = stats.staticInstructions;
+    entry["objects_drawn"] = stats.objectsDrawn;
+    entry["facets"] = stats.facets;
+    entry["facet_bytes"] = stats.facetBytes;
+    entry["facets_rasterized"] = stats.facetsRasterized;
+    entry["covered_pixels"] = covered;
+    entry["facets_per_covered_pixel"] =
+        covered > 0.0 ? static_cast<double>(stats.facetsRasterized) / covered : 0.0;
+    entry["fragments"] = stats.fragments;
+    entry["vertices_warped"] = stats.verticesWarped;
+    entry["shade_passes"] = stats.shadePasses;
+    entry["probes"] = stats.probes;
+    entry["probe_fallbacks"] = stats.probeFallbacks;
+    entry["tiles_from_children"] = stats.tilesFromChildren;
+    entry["texels_filled"] = stats.texelsFilled;
+    entry["resident_tiles"] = stats.residentTiles;
+    return entry;
+}
+
+nlohmann::json referenceFrameJson(const FrameStats& multiphase, const FrameStats& reference,
+                                  const ImageError& error) {
+    return {{"wall_seconds", reference.wallSeconds},
+            {"psnr_db", error.psnr},
+            {"rmse", error.rmse},
+            {"max_abs_error", error.maxAbs},
+            {"coverage_difference", error.coverageDiff},
+            {"speedup",
+             multiphase.wallSeconds > 0 ? reference.wallSeconds / multiphase.wallSeconds : 0.0}};
+}
+
+nlohmann::json playFrameJson(const Scene& scene, const FrameStats& s,
+                             const PlaybackQuality& quality, int spp, double writeSeconds) {
+    nlohmann::json entry = {
+        {"index", s.index},
+        {"time", s.time},
+        {"wall_seconds", s.wallSeconds},
+        {"budget_seconds", s.budgetSeconds},
+        {"deadline_met", s.deadlineMet},
+        {"write_seconds", writeSeconds},
+        {"built_ahead", s.builtAhead},
+        {"quality",
+         {{"level", quality.level},
+          {"shading_rate", shadingRateName(quality.step.rate)},
+          {"footprint_scale", quality.step.footprintScale},
+          {"samples_per_pixel",
+           quality.step.samplesPerPixel > 0 ? quality.step.samplesPerPixel : spp},
+          {"probes", s.probes},
+          {"probe_fallbacks", s.probeFallbacks},
+          {"older_representations", s.rebuildsDeferred}}},
+        {"deferred", {{"tiles", s.tilesDeferred}, {"rebuilds", s.rebuildsDeferred}}},
+        {"probe_hits", s.probes - s.probeFallbacks},
+        {"controller_seconds", s.controllerSeconds},
+        {"prefetch",
+         {{"predicted", s.tilesPredicted},
+          {"abandoned", s.predictionAbandoned},
+          {"adjacent", s.tilesAdjacent},
+          {"filled", s.tilesPrefetched},
+          {"used", s.prefetchUsed},
+          {"wasted", s.prefetchWasted},
+          {"seconds", s.prefetchSeconds}}},
+        {"background",
+         {{"filled", s.backgroundTilesFilled},
+          {"evicted", s.backgroundTilesEvicted},
+          {"seconds", s.backgroundSeconds}}},
+        {"shaded_points", s.shadedPoints}};
+    addMultiphaseFrameJson(scene, s, entry);
+    return entry;
+}
+
+nlohmann::json objectReportsJson(const MultiphaseRenderer& renderer) {
+    nlohmann::json objects = nlohmann::json::array();
+    for (size_t i = 0; i < renderer.objectCount(); ++i) {
+        const ObjectReport& r = renderer.report(i);
+        objects.push_back({{"name", r.name},
+                           {"representation", representationName(renderer, i)},
+                           {"reason", r.reason},
+                           {"static_runs", r.staticRuns},
+                           {"static_seconds", r.staticCosts.seconds},
+                           {"frames_drawn", r.framesDrawn},
+                           {"facets", r.facets},
+                           {"longest_edge_pixels", r.longestEdgePixels},
+                           {"facet_bytes", r.facetBytes},
+                           {"resident_tiles", r.residentTiles},
+                           {"map_bytes", r.mapBytes}});
+    }
+    return objects;
 }
 
 }  // namespace mpshade

@@ -135,40 +135,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
                                 s.resolveSeconds, s.staticSeconds, s.controllerSeconds, s.probes,
                                 s.probeFallbacks, s.tilesPrefetched, s.prefetchUsed,
                                 s.prefetchWasted});
-        nlohmann::json entry = {
-            {"index", s.index},
-            {"time", s.time},
-            {"wall_seconds", s.wallSeconds},
-            {"budget_seconds", s.budgetSeconds},
-            {"deadline_met", s.deadlineMet},
-            {"write_seconds", writeSeconds},
-            {"built_ahead", s.builtAhead},
-            {"quality",
-             {{"level", quality.level},
-              {"shading_rate", shadingRateName(quality.step.rate)},
-              {"footprint_scale", quality.step.footprintScale},
-              {"samples_per_pixel",
-               quality.step.samplesPerPixel > 0 ? quality.step.samplesPerPixel : spp},
-              {"probes", s.probes},
-              {"probe_fallbacks", s.probeFallbacks},
-              {"older_representations", s.rebuildsDeferred}}},
-            {"deferred", {{"tiles", s.tilesDeferred}, {"rebuilds", s.rebuildsDeferred}}},
-            {"probe_hits", s.probes - s.probeFallbacks},
-            {"controller_seconds", s.controllerSeconds},
-            {"prefetch",
-             {{"predicted", s.tilesPredicted},
-              {"abandoned", s.predictionAbandoned},
-              {"adjacent", s.tilesAdjacent},
-              {"filled", s.tilesPrefetched},
-              {"used", s.prefetchUsed},
-              {"wasted", s.prefetchWasted},
-              {"seconds", s.prefetchSeconds}}},
-            {"background",
-             {{"filled", s.backgroundTilesFilled},
-              {"evicted", s.backgroundTilesEvicted},
-              {"seconds", s.backgroundSeconds}}},
-            {"shaded_points", s.shadedPoints}};
-        addMultiphaseFrameJson(scene, s, entry);
+        nlohmann::json entry = playFrameJson(scene, s, quality, spp, writeSeconds);
         frames.push_back(std::move(entry));
         if (tty)
             std::fprintf(stderr, "\rframe %d: %.1f ms of %.1f, %d of %zu on time", s.index,

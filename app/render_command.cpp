@@ -168,22 +168,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
             {"frames", frames}};
         if (multi) {
             doc["shading_rate"] = shadingRateName(shadingRate);
-            nlohmann::json objects = nlohmann::json::array();
-            for (size_t i = 0; i < multi->objectCount(); ++i) {
-                const ObjectReport& r = multi->report(i);
-                objects.push_back({{"name", r.name},
-                                   {"representation", representationName(*multi, i)},
-                                   {"reason", r.reason},
-                                   {"static_runs", r.staticRuns},
-                                   {"static_seconds", r.staticCosts.seconds},
-                                   {"frames_drawn", r.framesDrawn},
-                                   {"facets", r.facets},
-                                   {"longest_edge_pixels", r.longestEdgePixels},
-                                   {"facet_bytes", r.facetBytes},
-                                   {"resident_tiles", r.residentTiles},
-                                   {"map_bytes", r.mapBytes}});
-            }
-            doc["objects"] = objects;
+            doc["objects"] = objectReportsJson(*multi);
         }
         writeTextFile(std::filesystem::path(options.outDir) / "stats.json", doc.dump(2) + "\n");
     };
@@ -199,49 +184,12 @@ int runRenderCommand(const RenderCommandOptions& options) {
         else
             image = reference->renderFrame(frame, render, stats, progress);
         writeFrameImages(image, options.outDir, frame);
-        nlohmann::json entry = {{"index", stats.index},
-                                {"time", stats.time},
-                                {"wall_seconds", stats.wallSeconds},
-                                {"samples", stats.samples},
-                                {"rays", stats.rays},
-                                {"occlusion_rays", stats.occlusionRays},
-                                {"shaded_points", stats.shadedPoints},
-                                {"shader_instructions", stats.shaderInstructions},
-                                {"nonfinite_samples", stats.nonFiniteSamples}};
-        if (multiphase) {
-            double covered = 0.0;
-            for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
-            entry["single_phase"] = stats.singlePhase;
-            addMultiphaseFrameJson(scene, stats, entry);
-            entry["static_instructions"] = stats.staticInstructions;
-            entry["objects_drawn"] = stats.objectsDrawn;
-            entry["facets"] = stats.facets;
-            entry["facet_bytes"] = stats.facetBytes;
-            entry["facets_rasterized"] = stats.facetsRasterized;
-            entry["covered_pixels"] = covered;
-            entry["facets_per_covered_pixel"] =
-                covered > 0.0 ? static_cast<double>(stats.facetsRasterized) / covered : 0.0;
-            entry["fragments"] = stats.fragments;
-            entry["vertices_warped"] = stats.verticesWarped;
-            entry["shade_passes"] = stats.shadePasses;
-            entry["probes"] = stats.probes;
-            entry["probe_fallbacks"] = stats.probeFallbacks;
-            entry["tiles_from_children"] = stats.tilesFromChildren;
-            entry["texels_filled"] = stats.texelsFilled;
-            entry["resident_tiles"] = stats.residentTiles;
-        }
+        nlohmann::json entry = renderFrameJson(scene, stats, multiphase, image);
         if (options.compare) {
             FrameStats refStats;
             const Image ref = reference->renderFrame(frame, render, refStats);
             const ImageError err = compareImages(image, ref);
-            entry["reference"] = {
-                {"wall_seconds", refStats.wallSeconds},
-                {"psnr_db", err.psnr},
-                {"rmse", err.rmse},
-                {"max_abs_error", err.maxAbs},
-                {"coverage_difference", err.coverageDiff},
-                {"speedup",
-                 stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0}};
+            entry["reference"] = referenceFrameJson(stats, refStats, err);
             if (options.truthSpp > 0) {
                 // Both renderers against a reference with many more samples: the error
                 // each makes, rather than how far apart they are.
