@@ -113,7 +113,7 @@ EvalRun runEvalConfig(const std::string& scenePath, const EvalConfig& config, in
         EvalFrame e;
         e.index = f;
         e.wallSeconds = stats.wallSeconds;
-        e.staticSeconds = stats.staticSeconds;
+        e.staticSeconds = stats.staticWork.seconds;
         const ImageError error = compareImages(image, t);
         e.rmse = error.rmse;
         e.mse = error.rmse * error.rmse;

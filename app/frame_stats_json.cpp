@@ -5,24 +5,24 @@
 namespace mpshade {
 
 void addMultiphaseFrameJson(const Scene& scene, const FrameStats& stats, nlohmann::json& entry) {
-    entry["static_seconds"] = stats.staticSeconds;
-    entry["fill_seconds"] = stats.fillSeconds;
-    entry["warp_seconds"] = stats.warpSeconds;
-    entry["raster_seconds"] = stats.rasterSeconds;
-    entry["shade_seconds"] = stats.shadeSeconds;
-    entry["resolve_seconds"] = stats.resolveSeconds;
-    entry["static_runs"] = stats.staticRuns;
+    entry["static_seconds"] = stats.staticWork.seconds;
+    entry["fill_seconds"] = stats.staticWork.fillSeconds;
+    entry["warp_seconds"] = stats.dynamic.warpSeconds;
+    entry["raster_seconds"] = stats.dynamic.rasterSeconds;
+    entry["shade_seconds"] = stats.dynamic.shadeSeconds;
+    entry["resolve_seconds"] = stats.dynamic.resolveSeconds;
+    entry["static_runs"] = stats.staticWork.work.runs;
     entry["static_runs_due"] = staticRunsDueJson(scene, stats);
-    entry["tiles_requested"] = stats.tilesRequested;
-    entry["tiles_filled"] = stats.tilesFilled;
-    entry["tiles_evicted"] = stats.tilesEvicted;
-    entry["resident_bytes"] = stats.residentBytes;
-    entry["resident_pinned_bytes"] = stats.residentPinnedBytes;
+    entry["tiles_requested"] = stats.tiles.requested;
+    entry["tiles_filled"] = stats.staticWork.work.tilesFilled;
+    entry["tiles_evicted"] = stats.tiles.evicted;
+    entry["resident_bytes"] = stats.tiles.residentBytes;
+    entry["resident_pinned_bytes"] = stats.tiles.residentPinnedBytes;
 }
 
 nlohmann::json staticRunsDueJson(const Scene& scene, const FrameStats& stats) {
     nlohmann::json due = nlohmann::json::array();
-    for (const StaticRunDue& d : stats.staticRunsDue) {
+    for (const StaticRunDue& d : stats.staticWork.due) {
         nlohmann::json e = {{"object", scene.objects[d.object].name},
                             {"cause", staticRunCauseName(d.cause)},
                             {"deferred", d.deferred || stats.singlePhase}};
@@ -51,22 +51,22 @@ nlohmann::json renderFrameJson(const Scene& scene, const FrameStats& stats, bool
     for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
     entry["single_phase"] = stats.singlePhase;
     addMultiphaseFrameJson(scene, stats, entry);
-    entry["static_instructions"] = stats.staticInstructions;
+    entry["static_instructions"] = stats.staticWork.work.instructions;
     entry["objects_drawn"] = stats.objectsDrawn;
-    entry["facets"] = stats.facets;
-    entry["facet_bytes"] = stats.facetBytes;
-    entry["facets_rasterized"] = stats.facetsRasterized;
+    entry["facets"] = stats.dynamic.facets;
+    entry["facet_bytes"] = stats.dynamic.facetBytes;
+    entry["facets_rasterized"] = stats.dynamic.raster.facetsBinned;
     entry["covered_pixels"] = covered;
     entry["facets_per_covered_pixel"] =
-        covered > 0.0 ? static_cast<double>(stats.facetsRasterized) / covered : 0.0;
-    entry["fragments"] = stats.fragments;
-    entry["vertices_warped"] = stats.verticesWarped;
-    entry["shade_passes"] = stats.shadePasses;
-    entry["probes"] = stats.probes;
-    entry["probe_fallbacks"] = stats.probeFallbacks;
-    entry["tiles_from_children"] = stats.tilesFromChildren;
-    entry["texels_filled"] = stats.texelsFilled;
-    entry["resident_tiles"] = stats.residentTiles;
+        covered > 0.0 ? static_cast<double>(stats.dynamic.raster.facetsBinned) / covered : 0.0;
+    entry["fragments"] = stats.dynamic.raster.fragments;
+    entry["vertices_warped"] = stats.dynamic.verticesWarped;
+    entry["shade_passes"] = stats.dynamic.shadePasses;
+    entry["probes"] = stats.dynamic.probes;
+    entry["probe_fallbacks"] = stats.dynamic.probeFallbacks;
+    entry["tiles_from_children"] = stats.staticWork.work.tilesFromChildren;
+    entry["texels_filled"] = stats.staticWork.work.texelsFilled;
+    entry["resident_tiles"] = stats.tiles.resident;
     return entry;
 }
 
@@ -87,34 +87,34 @@ nlohmann::json playFrameJson(const Scene& scene, const FrameStats& s,
         {"index", s.index},
         {"time", s.time},
         {"wall_seconds", s.wallSeconds},
-        {"budget_seconds", s.budgetSeconds},
-        {"deadline_met", s.deadlineMet},
+        {"budget_seconds", s.budget.seconds},
+        {"deadline_met", s.budget.deadlineMet},
         {"write_seconds", writeSeconds},
-        {"built_ahead", s.builtAhead},
+        {"built_ahead", s.budget.builtAhead},
         {"quality",
          {{"level", quality.level},
           {"shading_rate", shadingRateName(quality.step.rate)},
           {"footprint_scale", quality.step.footprintScale},
           {"samples_per_pixel",
            quality.step.samplesPerPixel > 0 ? quality.step.samplesPerPixel : spp},
-          {"probes", s.probes},
-          {"probe_fallbacks", s.probeFallbacks},
-          {"older_representations", s.rebuildsDeferred}}},
-        {"deferred", {{"tiles", s.tilesDeferred}, {"rebuilds", s.rebuildsDeferred}}},
-        {"probe_hits", s.probes - s.probeFallbacks},
+          {"probes", s.dynamic.probes},
+          {"probe_fallbacks", s.dynamic.probeFallbacks},
+          {"older_representations", s.budget.rebuildsDeferred}}},
+        {"deferred", {{"tiles", s.budget.tilesDeferred}, {"rebuilds", s.budget.rebuildsDeferred}}},
+        {"probe_hits", s.dynamic.probes - s.dynamic.probeFallbacks},
         {"controller_seconds", s.controllerSeconds},
         {"prefetch",
-         {{"predicted", s.tilesPredicted},
-          {"abandoned", s.predictionAbandoned},
-          {"adjacent", s.tilesAdjacent},
-          {"filled", s.tilesPrefetched},
-          {"used", s.prefetchUsed},
-          {"wasted", s.prefetchWasted},
-          {"seconds", s.prefetchSeconds}}},
+         {{"predicted", s.prefetch.predicted},
+          {"abandoned", s.prefetch.abandoned},
+          {"adjacent", s.prefetch.adjacent},
+          {"filled", s.prefetch.filled},
+          {"used", s.prefetch.used},
+          {"wasted", s.prefetch.wasted},
+          {"seconds", s.prefetch.seconds}}},
         {"background",
-         {{"filled", s.backgroundTilesFilled},
-          {"evicted", s.backgroundTilesEvicted},
-          {"seconds", s.backgroundSeconds}}},
+         {{"filled", s.background.tilesFilled},
+          {"evicted", s.background.tilesEvicted},
+          {"seconds", s.background.seconds}}},
         {"shaded_points", s.shadedPoints}};
     addMultiphaseFrameJson(scene, s, entry);
     return entry;

@@ -45,11 +45,55 @@ double median(std::vector<double> v) {
     return *mid;
 }
 
-// What the summary reports of each frame.
-struct PlayedFrame {
-    double wall, dynamic, raster, shade, resolve, statics, controller;
-    uint64_t probes, fallbacks, prefetched, prefetchUsed, prefetchWasted;
-};
+// Where the frames' time went, and what each quality step costs: why the frames played at
+// the quality they did.
+void printPlaySummary(const std::vector<PlaybackStep>& steps, const std::vector<FrameStats>& played,
+                      int spp, double fps) {
+    std::fprintf(stderr,
+                 "  steps, best first: the first frame's dynamic phase at each (measured in "
+                 "the pre-roll; the slot is %.1f ms), and the frames played there\n",
+                 1e3 / fps);
+    for (const PlaybackStep& p : steps) {
+        const std::string name = describeStep(p.step, spp);
+        if (p.frames > 0)
+            std::fprintf(stderr, "    %-34s %7.1f ms  %d frame(s)\n", name.c_str(),
+                         1e3 * p.dynamicSeconds, p.frames);
+        else
+            std::fprintf(stderr, "    %-34s %7.1f ms\n", name.c_str(), 1e3 * p.dynamicSeconds);
+    }
+    auto med = [&](auto field) {
+        std::vector<double> v;
+        for (const FrameStats& s : played) v.push_back(1e3 * field(s));
+        return median(std::move(v));
+    };
+    std::fprintf(stderr,
+                 "  median frame: %.1f ms; dynamic phase %.1f (rasterize %.1f, shade %.1f, resolve "
+                 "%.1f), static %.1f, controller %.2f\n",
+                 med([](const FrameStats& s) { return s.wallSeconds; }),
+                 med([](const FrameStats& s) { return s.dynamic.seconds(); }),
+                 med([](const FrameStats& s) { return s.dynamic.rasterSeconds; }),
+                 med([](const FrameStats& s) { return s.dynamic.shadeSeconds; }),
+                 med([](const FrameStats& s) { return s.dynamic.resolveSeconds; }),
+                 med([](const FrameStats& s) { return s.staticWork.seconds; }),
+                 med([](const FrameStats& s) { return s.controllerSeconds; }));
+    DynamicFrameStats dynamic;
+    PrefetchStats prefetch;
+    for (const FrameStats& s : played) {
+        dynamic += s.dynamic;
+        prefetch += s.prefetch;
+    }
+    // Read and wasted count the pre-roll's prefetched tiles too.
+    std::fprintf(stderr,
+                 "  probes answered from a coarser level: %.2f%%; tiles prefetched while "
+                 "playing %llu; of all prefetched (the pre-roll's too), read by a later "
+                 "frame %llu, wasted %llu\n",
+                 dynamic.probes > 0 ? 100.0 * static_cast<double>(dynamic.probeFallbacks) /
+                                          static_cast<double>(dynamic.probes)
+                                    : 0.0,
+                 static_cast<unsigned long long>(prefetch.filled),
+                 static_cast<unsigned long long>(prefetch.used),
+                 static_cast<unsigned long long>(prefetch.wasted));
+}
 
 }  // namespace
 
@@ -80,7 +124,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
     int met = 0;
     double preroll = 0.0;
     std::vector<PlaybackStep> steps;  // frames counted here as they are played
-    std::vector<PlayedFrame> playedFrames;
+    std::vector<FrameStats> playedFrames;
     // stats.json, rewritten (atomically) after every frame: what a stopped playback
     // finished is always described.
     const auto writeStats = [&](double prerollSeconds) {
@@ -127,19 +171,15 @@ int runPlayCommand(const PlayCommandOptions& options) {
             writeSeconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
         }
-        met += s.deadlineMet ? 1 : 0;
+        met += s.budget.deadlineMet ? 1 : 0;
         if (static_cast<size_t>(quality.level) < steps.size())
             ++steps[static_cast<size_t>(quality.level)].frames;
-        const double dynamic = s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
-        playedFrames.push_back({s.wallSeconds, dynamic, s.rasterSeconds, s.shadeSeconds,
-                                s.resolveSeconds, s.staticSeconds, s.controllerSeconds, s.probes,
-                                s.probeFallbacks, s.tilesPrefetched, s.prefetchUsed,
-                                s.prefetchWasted});
+        playedFrames.push_back(s);
         nlohmann::json entry = playFrameJson(scene, s, quality, spp, writeSeconds);
         frames.push_back(std::move(entry));
         if (tty)
             std::fprintf(stderr, "\rframe %d: %.1f ms of %.1f, %d of %zu on time", s.index,
-                         1e3 * s.wallSeconds, 1e3 * s.budgetSeconds, met, frames.size());
+                         1e3 * s.wallSeconds, 1e3 * s.budget.seconds, met, frames.size());
         writeStats(preroll);
         return !interrupted();
     };
@@ -163,48 +203,8 @@ int runPlayCommand(const PlayCommandOptions& options) {
                      summary.deadlinesMet, summary.frames, options.fps,
                      summary.frames > 0 ? 100.0 * summary.deadlinesMet / summary.frames : 100.0,
                      summary.prerollSeconds, (dir / "stats.json").string().c_str());
-    if (!options.quiet && !playedFrames.empty()) {
-        // Where the frame's time went, and what each step costs: why the frames played at
-        // the quality they did.
-        const double slot = 1e3 / options.fps;
-        std::fprintf(stderr,
-                     "  steps, best first: the first frame's dynamic phase at each (measured in "
-                     "the pre-roll; the slot is %.1f ms), and the frames played there\n",
-                     slot);
-        for (const PlaybackStep& p : summary.steps) {
-            const std::string name = describeStep(p.step, spp);
-            if (p.frames > 0)
-                std::fprintf(stderr, "    %-34s %7.1f ms  %d frame(s)\n", name.c_str(),
-                             1e3 * p.dynamicSeconds, p.frames);
-            else
-                std::fprintf(stderr, "    %-34s %7.1f ms\n", name.c_str(), 1e3 * p.dynamicSeconds);
-        }
-        auto med = [&](double PlayedFrame::*field) {
-            std::vector<double> v;
-            for (const PlayedFrame& f : playedFrames) v.push_back(1e3 * (f.*field));
-            return median(std::move(v));
-        };
-        std::fprintf(stderr,
-                     "  median frame: %.1f ms; dynamic phase %.1f (rasterize %.1f, shade %.1f, "
-                     "resolve %.1f), static %.1f, controller %.2f\n",
-                     med(&PlayedFrame::wall), med(&PlayedFrame::dynamic), med(&PlayedFrame::raster),
-                     med(&PlayedFrame::shade), med(&PlayedFrame::resolve),
-                     med(&PlayedFrame::statics), med(&PlayedFrame::controller));
-        uint64_t probes = 0, fallbacks = 0, prefetched = 0, used = 0, wasted = 0;
-        for (const PlayedFrame& f : playedFrames) {
-            probes += f.probes, fallbacks += f.fallbacks;
-            prefetched += f.prefetched, used += f.prefetchUsed, wasted += f.prefetchWasted;
-        }
-        // Read and wasted count the pre-roll's prefetched tiles too.
-        std::fprintf(stderr,
-                     "  probes answered from a coarser level: %.2f%%; tiles prefetched while "
-                     "playing %llu; of all prefetched (the pre-roll's too), read by a later "
-                     "frame %llu, wasted %llu\n",
-                     probes > 0 ? 100.0 * static_cast<double>(fallbacks) / probes : 0.0,
-                     static_cast<unsigned long long>(prefetched),
-                     static_cast<unsigned long long>(used),
-                     static_cast<unsigned long long>(wasted));
-    }
+    if (!options.quiet && !playedFrames.empty())
+        printPlaySummary(summary.steps, playedFrames, spp, options.fps);
     return 0;
 }
 

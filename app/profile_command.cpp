@@ -39,7 +39,7 @@ int runProfileCommand(const ProfileCommandOptions& options) {
     if (!options.quiet) {
         double staticSeconds = 0.0, wall = 0.0;
         for (const FrameStats& s : profile.frames) {
-            staticSeconds += s.staticSeconds;
+            staticSeconds += s.staticWork.seconds;
             wall += s.wallSeconds;
         }
         std::fprintf(stderr,

@@ -129,15 +129,15 @@ void frameMultiphase(benchmark::State& state, const char* path, int representati
     for (auto _ : state)
         benchmark::DoNotOptimize(steadyFrame(*f.multi, f.options, stats).rgba.data());
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * stats.samples));
-    state.counters["facets"] = static_cast<double>(stats.facets);
-    state.counters["static_runs_in_loop"] = stats.staticRuns;
-    state.counters["warp_ms"] = 1e3 * stats.warpSeconds;
-    state.counters["raster_ms"] = 1e3 * stats.rasterSeconds;
-    state.counters["shade_ms"] = 1e3 * stats.shadeSeconds;
-    state.counters["resolve_ms"] = 1e3 * stats.resolveSeconds;
+    state.counters["facets"] = static_cast<double>(stats.dynamic.facets);
+    state.counters["static_runs_in_loop"] = stats.staticWork.work.runs;
+    state.counters["warp_ms"] = 1e3 * stats.dynamic.warpSeconds;
+    state.counters["raster_ms"] = 1e3 * stats.dynamic.rasterSeconds;
+    state.counters["shade_ms"] = 1e3 * stats.dynamic.shadeSeconds;
+    state.counters["resolve_ms"] = 1e3 * stats.dynamic.resolveSeconds;
     state.counters["shading_points"] = static_cast<double>(stats.shadedPoints);
     state.counters["probes_per_point"] =
-        stats.shadedPoints ? static_cast<double>(stats.probes) / stats.shadedPoints : 0.0;
+        stats.shadedPoints ? static_cast<double>(stats.dynamic.probes) / stats.shadedPoints : 0.0;
 }
 
 // Facets per covered pixel, at the example's own size (a count, not a timing): stored in
@@ -153,11 +153,11 @@ void facetsPerPixel(benchmark::State& state, const char* path, int representatio
     double covered = 0;
     for (size_t i = 3; i < samples.rgba.size(); i += 4) covered += samples.rgba[i];
     covered /= samples.spp;
-    state.counters["facets"] = static_cast<double>(stats.facets);
+    state.counters["facets"] = static_cast<double>(stats.dynamic.facets);
     state.counters["covered_pixels"] = covered;
-    state.counters["facets_per_covered_pixel"] = covered > 0 ? stats.facets / covered : 0.0;
+    state.counters["facets_per_covered_pixel"] = covered > 0 ? stats.dynamic.facets / covered : 0.0;
     state.counters["rasterized_per_covered_pixel"] =
-        covered > 0 ? stats.facetsRasterized / covered : 0.0;
+        covered > 0 ? stats.dynamic.raster.facetsBinned / covered : 0.0;
 }
 
 // The prefetch prediction `play` runs in a frame's slack (TilePredictor::predict:
@@ -178,7 +178,7 @@ void predictAhead(benchmark::State& state, const char* path) {
     size_t tiles = 0;
     for (auto _ : state) tiles = predictor.predict(4, f.options, 4, seconds).size();
     state.counters["tiles_predicted"] = static_cast<double>(tiles);
-    state.counters["facets"] = static_cast<double>(stats.facets);
+    state.counters["facets"] = static_cast<double>(stats.dynamic.facets);
 }
 
 BENCHMARK(warpFixed)->Name("Warp/fixed")->Unit(benchmark::kMillisecond);

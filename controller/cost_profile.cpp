@@ -23,11 +23,6 @@ double mb(uint64_t bytes) {
     return static_cast<double>(bytes) / (1024.0 * 1024.0);
 }
 
-// A frame's dynamic phase on the rendering thread: warp, rasterize, shade, resolve.
-double dynamicSeconds(const FrameStats& s) {
-    return s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
-}
-
 }  // namespace
 
 std::string representationName(const MultiphaseRenderer& renderer, size_t object) {
@@ -122,8 +117,8 @@ std::string profileMarkdown(const CostProfile& p) {
     double staticTotal = 0.0, dynamicTotal = 0.0, wallTotal = 0.0;
     int singlePhase = 0;
     for (const FrameStats& s : p.frames) {
-        staticTotal += s.staticSeconds;
-        dynamicTotal += dynamicSeconds(s);
+        staticTotal += s.staticWork.seconds;
+        dynamicTotal += s.dynamic.seconds();
         wallTotal += s.wallSeconds;
         singlePhase += s.singlePhase ? 1 : 0;
     }
@@ -184,10 +179,11 @@ std::string profileMarkdown(const CostProfile& p) {
         md += format(
             "| %d | %.1f | %.1f | %.2f | %.2f | %.1f | %.2f | %.1f | %d | %llu | %llu | "
             "%.1f |\n",
-            s.index, ms(s.staticSeconds), ms(s.fillSeconds), ms(s.warpSeconds), ms(s.rasterSeconds),
-            ms(s.shadeSeconds), ms(s.resolveSeconds), ms(s.wallSeconds), s.staticRuns,
-            static_cast<unsigned long long>(s.tilesFilled),
-            static_cast<unsigned long long>(s.shadedPoints), mb(s.residentBytes));
+            s.index, ms(s.staticWork.seconds), ms(s.staticWork.fillSeconds),
+            ms(s.dynamic.warpSeconds), ms(s.dynamic.rasterSeconds), ms(s.dynamic.shadeSeconds),
+            ms(s.dynamic.resolveSeconds), ms(s.wallSeconds), s.staticWork.work.runs,
+            static_cast<unsigned long long>(s.staticWork.work.tilesFilled),
+            static_cast<unsigned long long>(s.shadedPoints), mb(s.tiles.residentBytes));
     }
     return md;
 }

@@ -77,7 +77,7 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     TileFillResult fills;
     tiles_.fill(lacking_, drawn_, limits, fills);
     countFills(fills, stats);
-    stats.tilesDeferred = lacking_.size() - fills.consumed;
+    stats.budget.tilesDeferred = lacking_.size() - fills.consumed;
     recordResidency(static_.tilePools(), stats);
     if (options_.backgroundFills && fills.consumed < lacking_.size())
         queueForBackground(fills.consumed);

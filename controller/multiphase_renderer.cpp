@@ -130,7 +130,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
         return;
     }
     buildDue(plan, stats);
-    stats.staticSeconds = secondsSince(staticStart);
+    stats.staticWork.seconds = secondsSince(staticStart);
     if (options_.trace && !plan.due.empty())
         options_.trace->span("static phase", PhaseKind::Static, SpanLevel::Phase, staticStart,
                              Clock::now(), -1, frame);
@@ -158,9 +158,9 @@ void MultiphaseRenderer::beginFrame(int frame, const RenderOptions& options, Fra
         filler_->pause();
         stats.controllerSeconds += secondsSince(held);
         const BackgroundTotals t = filler_->totals();
-        stats.backgroundTilesFilled = t.tilesFilled - fillerTotals_.tilesFilled;
-        stats.backgroundTilesEvicted = t.tilesEvicted - fillerTotals_.tilesEvicted;
-        stats.backgroundSeconds = t.seconds - fillerTotals_.seconds;
+        stats.background = {t.tilesFilled - fillerTotals_.tilesFilled,
+                            t.tilesEvicted - fillerTotals_.tilesEvicted,
+                            t.seconds - fillerTotals_.seconds};
         fillerTotals_ = t;
         for (const auto& pool : static_.tilePools().all()) pool->reclaim();
         for (const ObjectSlot& slot : slots_)
@@ -203,7 +203,7 @@ MultiphaseRenderer::FramePlan MultiphaseRenderer::planFrame(int frame, FrameStat
             staticRunDue(static_cast<uint32_t>(i), slots_[i], state, frame_.camera,
                          frame_.uniforms[i], options_.staticInputTolerance, inputScratch_);
         if (!due) continue;
-        stats.staticRunsDue.push_back(*due);
+        stats.staticWork.due.push_back(*due);
         plan.due.push_back(i);
     }
     return plan;
@@ -216,7 +216,8 @@ void MultiphaseRenderer::deferRebuilds(FramePlan& plan, Clock::time_point start,
     if (plan.due.empty()) return;
     const double left =
         0.95 * options_.frameBudgetSeconds - secondsSince(start) - lastDynamicSeconds_;
-    plan.due = admitRebuilds(plan.due, slots_, left, stats.staticRunsDue, stats.rebuildsDeferred);
+    plan.due =
+        admitRebuilds(plan.due, slots_, left, stats.staticWork.due, stats.budget.rebuildsDeferred);
 }
 
 // 2b. Whether the due static work would not pay for itself, so the frame is rendered by the
@@ -274,12 +275,8 @@ void MultiphaseRenderer::buildDue(const FramePlan& plan, FrameStats& stats) {
         const size_t i = plan.due[k];
         recordBuild(i, slots_[i].kind, costs[k], frame_.uniforms[i]);
         slots_[i].frameStaticSeconds += costs[k].seconds;
-        stats.staticInstructions += costs[k].instructions;
-        stats.tilesFilled += costs[k].tilesFilled;
-        stats.tilesFromChildren += costs[k].tilesFromChildren;
-        stats.texelsFilled += costs[k].texelsFilled;
+        stats.staticWork.work += costs[k];
     }
-    stats.staticRuns = static_cast<int>(plan.due.size());
 }
 
 void MultiphaseRenderer::recordBuild(size_t i, Representation kind, const StaticCosts& costs,
@@ -292,11 +289,7 @@ void MultiphaseRenderer::recordBuild(size_t i, Representation kind, const Static
     ObjectReport& r = slot.report;
     r.kind = kind;
     ++r.staticRuns;
-    r.staticCosts.runs += costs.runs;
-    r.staticCosts.seconds += costs.seconds;
-    r.staticCosts.instructions += costs.instructions;
-    r.staticCosts.programRuns += costs.programRuns;
-    r.staticCosts.tilesFilled += costs.tilesFilled;
+    r.staticCosts += costs;
 }
 
 // 3. The dynamic phase. At constant quality the tiles its probes lacked are filled between
@@ -314,7 +307,7 @@ void MultiphaseRenderer::shadeAndFill(FramePlan& plan, FrameStats& stats,
             slot.representation->map->setUseStamp(useStamp_);
     if (filler_) {
         // Queued tiles of maps a static run has just replaced are of no use now.
-        if (stats.staticRuns > 0)
+        if (stats.staticWork.work.runs > 0)
             filler_->retain([&](const BackgroundJob& job) {
                 const ObjectRepresentation* rep = slots_[job.object].representation.get();
                 return rep && rep->map == job.map;
@@ -326,7 +319,7 @@ void MultiphaseRenderer::shadeAndFill(FramePlan& plan, FrameStats& stats,
     lacking_.clear();
     if (plan.budgeted) {
         lacking_ = dynamic_.shade(true);
-        stats.tilesRequested += lacking_.size();
+        stats.tiles.requested += lacking_.size();
         drawn_ = plan.drawn;
     }
     if (!prefetched_.empty()) settlePrefetched(stats);
@@ -334,7 +327,7 @@ void MultiphaseRenderer::shadeAndFill(FramePlan& plan, FrameStats& stats,
     for (int pass = 0; !plan.budgeted; ++pass) {
         const bool last = pass >= 6;  // a safety net: each pass fills what the last lacked
         const std::vector<TileRequest> lacking = dynamic_.shade(last);
-        stats.tilesRequested += lacking.size();
+        stats.tiles.requested += lacking.size();
         if (lacking.empty() || last) break;
         tiles_.fill(lacking, plan.drawn, fillLimits(CacheRoom::EvictAndExceed, plan.frame), fills);
     }
@@ -352,14 +345,11 @@ FillLimits MultiphaseRenderer::fillLimits(CacheRoom room, int frame) const {
 }
 
 void MultiphaseRenderer::countFills(const TileFillResult& fills, FrameStats& stats) {
-    stats.fillSeconds += fills.seconds;
-    stats.staticSeconds += fills.seconds;
+    stats.staticWork.fillSeconds += fills.seconds;
+    stats.staticWork.seconds += fills.seconds;
+    stats.staticWork.work += fills.costs;
     stats.controllerSeconds += fills.roomSeconds;
-    stats.tilesEvicted += fills.evicted;
-    stats.staticInstructions += fills.costs.instructions;
-    stats.tilesFilled += fills.costs.tilesFilled;
-    stats.tilesFromChildren += fills.costs.tilesFromChildren;
-    stats.texelsFilled += fills.costs.texelsFilled;
+    stats.tiles.evicted += fills.evicted;
     for (size_t i = 0; i < fills.objectTiles.size(); ++i)
         slots_[i].report.staticCosts.tilesFilled += fills.objectTiles[i];
     for (size_t i = 0; i < fills.timing.objectSeconds.size(); ++i) {
@@ -390,21 +380,10 @@ void MultiphaseRenderer::recordFrame(const FramePlan& plan, FrameStats& stats) {
         ++stats.objectsDrawn;
     }
     recordResidency(static_.tilePools(), stats);
-    const DynamicFrameStats& d = dynamic_.stats();
-    stats.warpSeconds = d.warpSeconds;
-    stats.rasterSeconds = d.rasterSeconds;
-    stats.shadeSeconds = d.shadeSeconds;
-    stats.facets = d.facets;
-    stats.verticesWarped = d.verticesWarped;
-    stats.facetBytes = d.facetBytes;
-    stats.facetsRasterized = d.raster.facetsBinned;
-    stats.fragments = d.raster.fragments;
-    stats.shadedPoints = d.shadingPoints;
-    stats.shaderInstructions = d.instructions;
-    stats.nonFiniteSamples = d.nonFinite;
-    stats.probes = d.probes;
-    stats.probeFallbacks = d.probeFallbacks;
-    stats.shadePasses = d.shadePasses;
+    stats.dynamic = dynamic_.stats();
+    stats.shadedPoints = stats.dynamic.shadingPoints;
+    stats.shaderInstructions = stats.dynamic.instructions;
+    stats.nonFiniteSamples = stats.dynamic.nonFinite;
     stats.index = plan.frame;
     stats.time = frame_.time;
     stats.samples = static_cast<uint64_t>(frame_.width) * frame_.height * frame_.spp;
@@ -428,16 +407,15 @@ void MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, Fr
         return;
     }
     dynamic_.resolve(image);
-    stats.resolveSeconds = dynamic_.stats().resolveSeconds;
+    stats.dynamic.resolveSeconds = dynamic_.stats().resolveSeconds;
     if (options_.frameBudgetSeconds > 0.0) {
-        const DynamicFrameStats& d = dynamic_.stats();
-        lastDynamicSeconds_ = d.warpSeconds + d.rasterSeconds + d.shadeSeconds + d.resolveSeconds;
+        lastDynamicSeconds_ = dynamic_.stats().seconds();
         fillWithinBudget(start, stats);
     }
     stats.wallSeconds = secondsSince(start);
     if (options_.frameBudgetSeconds > 0.0) {
-        stats.budgetSeconds = options_.frameBudgetSeconds;
-        stats.deadlineMet = stats.wallSeconds <= options_.frameBudgetSeconds;
+        stats.budget.seconds = options_.frameBudgetSeconds;
+        stats.budget.deadlineMet = stats.wallSeconds <= options_.frameBudgetSeconds;
     }
     if (progress) progress(4, 4);
 }
@@ -448,8 +426,8 @@ SampleBuffer MultiphaseRenderer::renderSamples(int frame, const RenderOptions& o
     render(frame, options, stats, progress);
     if (options_.frameBudgetSeconds > 0.0 && !singlePhaseFrame_) {
         fillWithinBudget(start, stats);
-        stats.budgetSeconds = options_.frameBudgetSeconds;
-        stats.deadlineMet = secondsSince(start) <= options_.frameBudgetSeconds;
+        stats.budget.seconds = options_.frameBudgetSeconds;
+        stats.budget.deadlineMet = secondsSince(start) <= options_.frameBudgetSeconds;
     }
     return singlePhaseFrame_ ? singlePhaseSamples_ : dynamic_.samples();
 }

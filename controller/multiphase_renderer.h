@@ -65,7 +65,7 @@ class MultiphaseRenderer {
     std::vector<TileRequest> adjacentTiles() const;
     // Fills those of `tiles` not resident, in order, while the time spent stays within
     // `seconds` and the cache has room left (a guess never evicts a tile); counts them in
-    // stats.tilesPrefetched. Returns the seconds spent.
+    // stats.prefetch.filled. Returns the seconds spent.
     double prefetch(std::span<const TileRequest> tiles, double seconds, FrameStats& stats);
     // Overrides the scene's shading rate for the frames that follow (unset: the scene's).
     void setShadingRate(std::optional<ShadingRate> rate) { options_.shadingRate = rate; }

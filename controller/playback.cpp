@@ -51,8 +51,7 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         renderer.setFootprintScale(regulator.step(k).footprintScale);
         FrameStats s;
         renderer.renderFrame(options.first, stepOptions(k), s, image);
-        stepSeconds[static_cast<size_t>(k)] =
-            s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
+        stepSeconds[static_cast<size_t>(k)] = s.dynamic.seconds();
         summary.steps.push_back({regulator.step(k), stepSeconds[static_cast<size_t>(k)], 0});
     }
     const double budget = 1.0 / options.fps;
@@ -97,10 +96,10 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
             const int frames =
                 static_cast<int>(std::ceil(options.lookAheadSeconds * scene.settings.fps));
             const double spent =
-                renderer.buildAhead(frame, frames, options.render, slack, stats.builtAhead);
-            stats.staticSeconds += spent;
+                renderer.buildAhead(frame, frames, options.render, slack, stats.budget.builtAhead);
+            stats.staticWork.seconds += spent;
             stats.wallSeconds += spent;
-            stats.deadlineMet = stats.wallSeconds <= budget;
+            stats.budget.deadlineMet = stats.wallSeconds <= budget;
         }
         // Only once the frame's own tiles are all in, within the twentieth of the budget
         // kept for the end of the frame.
@@ -108,7 +107,8 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
         const bool retry =
             framesWithoutPrediction >= options.predictRetryFrames && slackLeft > 0.5 * predictCost;
         ++framesWithoutPrediction;
-        if (options.prefetch && stats.tilesDeferred == 0 && (slackLeft > predictCost || retry)) {
+        if (options.prefetch && stats.budget.tilesDeferred == 0 &&
+            (slackLeft > predictCost || retry)) {
             framesWithoutPrediction = 0;
             // A prediction runs longer than its last at times (twice as long, when the
             // machine is busy elsewhere): one still running at the end of the slack is
@@ -126,19 +126,19 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
             const double predicted =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - predicting)
                     .count();
-            stats.predictionAbandoned = predictor.abandoned();
-            stats.tilesPredicted = tiles.size();
+            stats.prefetch.abandoned = predictor.abandoned();
+            stats.prefetch.predicted = tiles.size();
             const std::vector<TileRequest> adjacent = renderer.adjacentTiles();
-            stats.tilesAdjacent = adjacent.size();
+            stats.prefetch.adjacent = adjacent.size();
             tiles.insert(tiles.end(), adjacent.begin(), adjacent.end());
             const double spent = predicted + renderer.prefetch(tiles, slackLeft - predicted, stats);
-            stats.prefetchSeconds = spent;
-            stats.staticSeconds += spent;
+            stats.prefetch.seconds = spent;
+            stats.staticWork.seconds += spent;
             stats.wallSeconds += spent;
-            stats.deadlineMet = stats.wallSeconds <= budget;
+            stats.budget.deadlineMet = stats.wallSeconds <= budget;
         }
         ++summary.frames;
-        summary.deadlinesMet += stats.deadlineMet ? 1 : 0;
+        summary.deadlinesMet += stats.budget.deadlineMet ? 1 : 0;
         ++summary.steps[static_cast<size_t>(quality.level)].frames;
         const auto regulating = std::chrono::steady_clock::now();
         regulator.update(stats, budget);

@@ -19,10 +19,6 @@ double pointsPerPixel(ShadingRate rate, int spp) {
     return 1.0;
 }
 
-double dynamicSeconds(const FrameStats& s) {
-    return s.warpSeconds + s.rasterSeconds + s.shadeSeconds + s.resolveSeconds;
-}
-
 }  // namespace
 
 QualityRegulator::QualityRegulator(ShadingRate sceneRate, int spp,
@@ -63,7 +59,7 @@ void QualityRegulator::calibrate(std::span<const double> seconds, double budget)
 }
 
 void QualityRegulator::update(const FrameStats& stats, double budget) {
-    const double dynamic = dynamicSeconds(stats);
+    const double dynamic = stats.dynamic.seconds();
     // Neighbouring steps on consecutive frames: their ratio, measured on nearly one view.
     if (lastLevel_ >= 0 && dynamic > 0.0 && lastDynamic_ > 0.0) {
         const int below = std::max(lastLevel_, current_);

@@ -12,11 +12,11 @@ using Clock = std::chrono::steady_clock;
 }  // namespace
 
 void recordResidency(const TilePools& pools, FrameStats& stats) {
-    stats.residentTiles = stats.residentBytes = stats.residentPinnedBytes = 0;
+    stats.tiles.resident = stats.tiles.residentBytes = stats.tiles.residentPinnedBytes = 0;
     for (const auto& pool : pools.all()) {
-        stats.residentTiles += pool->tilesHeld();
-        stats.residentBytes += pool->bytesHeld();
-        stats.residentPinnedBytes += pool->pinnedBytesHeld();
+        stats.tiles.resident += pool->tilesHeld();
+        stats.tiles.residentBytes += pool->bytesHeld();
+        stats.tiles.residentPinnedBytes += pool->pinnedBytesHeld();
     }
 }
 

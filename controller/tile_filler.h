@@ -83,7 +83,7 @@ class TileFiller {
 };
 
 // The tiles every pool holds now, and their bytes (of them the always-resident levels'),
-// into stats.residentTiles, residentBytes and residentPinnedBytes.
+// into stats.tiles.
 void recordResidency(const TilePools& pools, FrameStats& stats);
 
 }  // namespace mpshade

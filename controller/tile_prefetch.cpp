@@ -51,14 +51,14 @@ double MultiphaseRenderer::prefetch(std::span<const TileRequest> tiles, double s
     tiles_.fill(tiles, maps, limits, fills);
     for (const TileRequest& r : fills.filled)
         prefetched_.record(r.object, *maps[r.object]->map, r.key, useStamp_);
-    stats.tilesPrefetched += fills.costs.tilesFilled;
+    stats.prefetch.filled += fills.costs.tilesFilled;
     return secondsSince(start);
 }
 
 void MultiphaseRenderer::settlePrefetched(FrameStats& stats) {
     const auto start = Clock::now();
-    prefetched_.settle(slots_, useStamp_, options_.prefetchPatienceFrames, stats.prefetchUsed,
-                       stats.prefetchWasted);
+    prefetched_.settle(slots_, useStamp_, options_.prefetchPatienceFrames, stats.prefetch.used,
+                       stats.prefetch.wasted);
     stats.controllerSeconds += secondsSince(start);
 }
 

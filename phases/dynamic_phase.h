@@ -84,13 +84,38 @@ struct ObjectFrameCost {
     float longestEdgePixels = 0.0f;
 };
 
+// What the dynamic phase did in a frame: its stages' wall times, the facets of the drawn
+// objects' representations (count, vertices warped, bytes of facets and attributes), the
+// rasterizer's counts, and the shading passes (shade() calls) with the points shaded, the
+// dynamic shader's instructions (times lanes), the results that were not finite and were
+// zeroed, and the bilinear probes, of them answered from a coarser level.
 struct DynamicFrameStats {
     double warpSeconds = 0.0, rasterSeconds = 0.0, shadeSeconds = 0.0, resolveSeconds = 0.0;
-    int shadePasses = 0;  // shade() calls this frame
+    int shadePasses = 0;
     uint64_t facets = 0, verticesWarped = 0, facetBytes = 0;
     RasterStats raster;
     uint64_t shadingPoints = 0, instructions = 0, nonFinite = 0;
     uint64_t probes = 0, probeFallbacks = 0;
+
+    // The phase's wall time on the rendering thread: warp, rasterize, shade, resolve.
+    double seconds() const { return warpSeconds + rasterSeconds + shadeSeconds + resolveSeconds; }
+    DynamicFrameStats& operator+=(const DynamicFrameStats& o) {
+        warpSeconds += o.warpSeconds;
+        rasterSeconds += o.rasterSeconds;
+        shadeSeconds += o.shadeSeconds;
+        resolveSeconds += o.resolveSeconds;
+        shadePasses += o.shadePasses;
+        facets += o.facets;
+        verticesWarped += o.verticesWarped;
+        facetBytes += o.facetBytes;
+        raster += o.raster;
+        shadingPoints += o.shadingPoints;
+        instructions += o.instructions;
+        nonFinite += o.nonFinite;
+        probes += o.probes;
+        probeFallbacks += o.probeFallbacks;
+        return *this;
+    }
 };
 
 class DynamicPhase {

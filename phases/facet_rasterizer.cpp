@@ -478,20 +478,9 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
                 *longest,
                 static_cast<float>(std::sqrt(static_cast<double>(st.chunks[ci].longestEdge2))) /
                     256.0f);
-        const RasterStats& s = st.chunks[ci].stats;
-        stats.facets += s.facets;
-        stats.facetsCulled += s.facetsCulled;
-        stats.facetsClipped += s.facetsClipped;
-        stats.facetsDegenerate += s.facetsDegenerate;
-        stats.facetsBackFacing += s.facetsBackFacing;
-        stats.facetsInCulledClusters += s.facetsInCulledClusters;
+        stats += st.chunks[ci].stats;
     }
-    for (const RasterStats& s : st.tileStats) {
-        stats.facetsBinned += s.facetsBinned;
-        stats.tilesCoveredWhole += s.tilesCoveredWhole;
-        stats.fragments += s.fragments;
-        stats.droppedLayers += s.droppedLayers;
-    }
+    for (const RasterStats& s : st.tileStats) stats += s;
 }
 
 void rasterizeFacets(const std::vector<RasterObject>& objects, const SampleLayout& samples,

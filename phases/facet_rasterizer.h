@@ -70,6 +70,21 @@ struct RasterStats {
     uint64_t fragments = 0;               // sample hits tested against the depth buffer
     uint64_t droppedLayers = 0;           // translucent surfaces beyond the k-buffer's depth
     bool abandoned = false;  // RasterOptions::deadline passed: the buffer is incomplete
+
+    RasterStats& operator+=(const RasterStats& o) {
+        facets += o.facets;
+        facetsCulled += o.facetsCulled;
+        facetsClipped += o.facetsClipped;
+        facetsDegenerate += o.facetsDegenerate;
+        facetsBackFacing += o.facetsBackFacing;
+        facetsInCulledClusters += o.facetsInCulledClusters;
+        facetsBinned += o.facetsBinned;
+        tilesCoveredWhole += o.tilesCoveredWhole;
+        fragments += o.fragments;
+        droppedLayers += o.droppedLayers;
+        abandoned = abandoned || o.abandoned;
+        return *this;
+    }
 };
 
 struct RasterOptions {

@@ -4,6 +4,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "phases/dynamic_phase.h"
+#include "phases/static_phase.h"
+
 namespace mpshade {
 
 // Why an object's static phase was due this frame, with the fiducial that said so (Lengyel
@@ -46,6 +49,98 @@ inline const char* staticRunCauseName(StaticRunDue::Cause cause) {
     return "unknown";
 }
 
+// Static work within a frame: the builds of objects whose static phase was due and the
+// shader-map tiles filled, as the static phase counted them (`work`: runs, instructions,
+// tiles and texels; `work.seconds` sums the tasks' own times), with the frame's wall time
+// spent on it.
+struct StaticFrameStats {
+    StaticCosts work;
+    double seconds = 0.0;           // of FrameStats::wallSeconds
+    double fillSeconds = 0.0;       // of seconds: shader-map tile fills
+    std::vector<StaticRunDue> due;  // every object whose static phase was due
+
+    StaticFrameStats& operator+=(const StaticFrameStats& o) {
+        work += o.work;
+        seconds += o.seconds;
+        fillSeconds += o.fillSeconds;
+        due.insert(due.end(), o.due.begin(), o.due.end());
+        return *this;
+    }
+};
+
+// The shader maps' tiles: the distinct tiles this frame's probes asked for that were not
+// resident (over every shading pass), those dropped to keep the maps under their memory
+// budget, and what stays resident after the frame (tiles and bytes, all maps; a snapshot,
+// so a sum of frames keeps the last).
+struct TileStats {
+    uint64_t requested = 0;
+    uint64_t evicted = 0;
+    uint64_t resident = 0;
+    uint64_t residentBytes = 0;
+    uint64_t residentPinnedBytes = 0;  // of residentBytes: the always-resident levels'
+
+    TileStats& operator+=(const TileStats& o) {
+        requested += o.requested;
+        evicted += o.evicted;
+        resident = o.resident;
+        residentBytes = o.residentBytes;
+        residentPinnedBytes = o.residentPinnedBytes;
+        return *this;
+    }
+};
+
+// A frame budget (MultiphaseOptions::frameBudgetSeconds; `mpshade play`): the budget,
+// whether the frame's work fit it, the tiles its probes lacked that were left for later
+// frames, and the objects whose static phase was due but put off (they were drawn from
+// their last representation).
+struct BudgetStats {
+    double seconds = 0.0;
+    bool deadlineMet = true;
+    uint64_t tilesDeferred = 0;
+    int rebuildsDeferred = 0;
+    int builtAhead = 0;  // objects built in this frame's slack for frames ahead that see them
+};
+
+// Prefetching in the frame's slack (playback.h): tiles predicted by a low-resolution look
+// at a frame ahead (claim 11) and next to tiles lacked (claim 10), those filled; and of the
+// tiles prefetched before, those this frame's probes read first (used) and those dropped,
+// or left unread for MultiphaseOptions::prefetchPatienceFrames, unread (wasted).
+struct PrefetchStats {
+    uint64_t predicted = 0, adjacent = 0, filled = 0;
+    bool abandoned = false;  // the prediction ran past the slack and was dropped
+    uint64_t used = 0, wasted = 0;
+    double seconds = 0.0;  // of StaticFrameStats::seconds: predicting and prefetching
+
+    PrefetchStats& operator+=(const PrefetchStats& o) {
+        predicted += o.predicted;
+        adjacent += o.adjacent;
+        filled += o.filled;
+        abandoned = abandoned || o.abandoned;
+        used += o.used;
+        wasted += o.wasted;
+        seconds += o.seconds;
+        return *this;
+    }
+};
+
+// The background filler (MultiphaseOptions::backgroundFills), since the last frame: tiles
+// it filled and dropped, and its worker's wall time (alongside the frames, not within
+// wallSeconds).
+struct BackgroundStats {
+    uint64_t tilesFilled = 0, tilesEvicted = 0;
+    double seconds = 0.0;
+
+    BackgroundStats& operator+=(const BackgroundStats& o) {
+        tilesFilled += o.tilesFilled;
+        tilesEvicted += o.tilesEvicted;
+        seconds += o.seconds;
+        return *this;
+    }
+};
+
+// What one frame cost. The first group is every renderer's; the nested groups are the
+// multi-phase renderer's (zero for the reference renderer), each counted where its work is
+// done and copied here whole.
 struct FrameStats {
     int index = 0;
     float time = 0.0f;         // scene time, seconds
@@ -56,68 +151,21 @@ struct FrameStats {
     uint64_t shadedPoints = 0;        // shader invocations
     uint64_t shaderInstructions = 0;  // interpreter instructions executed, times lanes
     uint64_t nonFiniteSamples = 0;    // shader results that were NaN/Inf and were zeroed
-
-    // Multi-phase rendering only (zero for the reference renderer).
-    int staticRuns = 0;               // objects (re)processed by the static phase this frame
-    double staticSeconds = 0.0;       // of wallSeconds: static phase (dicing, tile fills)
-    double fillSeconds = 0.0;         // of staticSeconds: shader-map tile fills
-    double warpSeconds = 0.0;         // dynamic TSI: fixed-point warp, culling
-    double rasterSeconds = 0.0;       // dynamic TSI: binning and rasterization
-    double shadeSeconds = 0.0;        // interpolation, probes, the dynamic shader, compositing
-    double resolveSeconds = 0.0;      // the pixel filter
-    uint64_t staticInstructions = 0;  // static shader instructions, times lanes
-    uint64_t facets = 0;              // facets of the drawn objects' representations
-    uint64_t facetsRasterized = 0;    // facet-tile pairs rasterized
-    uint64_t fragments = 0;           // facet-sample hits tested against the depth buffer
-    uint64_t verticesWarped = 0;
-    uint64_t facetBytes = 0;    // memory of the drawn objects' facets and attributes
-    uint64_t objectsDrawn = 0;  // objects in view this frame
-    // Shader maps: distinct tiles this frame's probes asked for that were not resident,
-    // tiles filled (of them, built from their children), texels filled, and what stays
-    // resident after the frame (tiles and bytes, all maps).
-    uint64_t tilesRequested = 0;
-    uint64_t tilesFilled = 0;
-    uint64_t tilesFromChildren = 0;
-    uint64_t texelsFilled = 0;
-    uint64_t residentTiles = 0;
-    uint64_t residentBytes = 0;
-    uint64_t residentPinnedBytes = 0;  // of residentBytes: the always-resident levels'
-    uint64_t tilesEvicted = 0;         // dropped to keep the maps under their memory budget
-    uint64_t probes = 0;               // bilinear probes
-    uint64_t probeFallbacks = 0;  // answered from a coarser level (zero when render fills first)
-    int shadePasses = 0;          // shading passes: 1, plus one per round of fills
     // The frame was rendered single-phase (by the reference renderer): the static work it
     // needed was estimated to cost more than shading the frames it would serve from scratch
     // (multiphase_renderer.h). Every figure above is then the reference's.
     bool singlePhase = false;
+    uint64_t objectsDrawn = 0;  // objects in view this frame
 
-    // A frame budget (MultiphaseOptions::frameBudgetSeconds; `mpshade play`): the budget,
-    // whether the frame's work fit it, the tiles its probes lacked that were left for later
-    // frames, and the objects whose static phase was due but put off (they were drawn from
-    // their last representation).
-    double budgetSeconds = 0.0;
-    bool deadlineMet = true;
-    uint64_t tilesDeferred = 0;
-    int rebuildsDeferred = 0;
-    int builtAhead = 0;  // objects built in this frame's slack for frames ahead that see them
-    // Prefetching in the frame's slack (MultiphaseRenderer::prefetch): tiles predicted by a
-    // low-resolution look at a frame ahead (claim 11) and next to tiles lacked (claim 10),
-    // those filled; and of the tiles prefetched before, those this frame's probes read
-    // first (used) and those dropped, or left unread for
-    // MultiphaseOptions::prefetchPatienceFrames, unread (wasted).
-    uint64_t tilesPredicted = 0, tilesAdjacent = 0, tilesPrefetched = 0;
-    bool predictionAbandoned = false;  // the prediction ran past the slack and was dropped
-    uint64_t prefetchUsed = 0, prefetchWasted = 0;
-    double prefetchSeconds = 0.0;  // of staticSeconds: predicting and prefetching
-    // The background filler (MultiphaseOptions::backgroundFills), since the last frame:
-    // tiles it filled and dropped, and its worker's wall time (alongside the frames, not
-    // within wallSeconds).
-    uint64_t backgroundTilesFilled = 0, backgroundTilesEvicted = 0;
-    double backgroundSeconds = 0.0;
+    StaticFrameStats staticWork;
+    DynamicFrameStats dynamic;  // warp, rasterization, shading passes, probes, the resolve
+    TileStats tiles;
+    BudgetStats budget;
+    PrefetchStats prefetch;
+    BackgroundStats background;
     // The controller's own work, within wallSeconds: re-run triggers and deferrals, cache
     // bookkeeping (eviction, prefetch accounting), the regulator.
     double controllerSeconds = 0.0;
-    std::vector<StaticRunDue> staticRunsDue;  // every object whose static phase was due
 };
 
 }  // namespace mpshade

@@ -268,12 +268,7 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
         rep->map = std::make_shared<ShaderMap>(
             surface, *obj.staticKernel, uniforms, mapOptions,
             pools_.forTileBytes(ShaderMap::tileBytesFor(mapOptions, static_cast<int>(channels))));
-        const FillStats& f = rep->map->fillStats();
-        costs.tilesFilled += f.tiles;
-        costs.tilesFromChildren += f.tilesFromChildren;
-        costs.texelsFilled += f.texels;
-        costs.programRuns += f.programRuns;
-        costs.instructions += f.programRuns * obj.staticKernel->instructionCount();
+        costs.addFill(rep->map->fillStats(), obj.staticKernel->instructionCount());
     }
     ++costs.runs;
     costs.seconds += std::chrono::duration<double>(Clock::now() - start).count();
@@ -319,14 +314,10 @@ void StaticPhase::fill(std::span<const TileRequest> requests,
     if (timing)
         for (const Work& w : work) timing->objectSeconds[w.object] += w.seconds;
     for (size_t w = 0; w < work.size(); ++w) {
-        const FillStats& d = done[w];
-        const uint64_t instructions = d.programRuns * work[w].instructionsPerRun;
-        costs.instructions += instructions;
-        if (timing) timing->objectInstructions[work[w].object] += instructions;
-        costs.tilesFilled += d.tiles;
-        costs.tilesFromChildren += d.tilesFromChildren;
-        costs.texelsFilled += d.texels;
-        costs.programRuns += d.programRuns;
+        costs.addFill(done[w], work[w].instructionsPerRun);
+        if (timing)
+            timing->objectInstructions[work[w].object] +=
+                done[w].programRuns * work[w].instructionsPerRun;
     }
     costs.seconds += std::chrono::duration<double>(Clock::now() - start).count();
 }

@@ -48,6 +48,25 @@ struct StaticCosts {
     double seconds = 0.0;
     uint64_t instructions = 0;  // static shader instructions, times lanes
     uint64_t tilesFilled = 0, tilesFromChildren = 0, texelsFilled = 0, programRuns = 0;
+
+    // A map's fill, whose static program costs `instructionsPerRun` per evaluation.
+    void addFill(const FillStats& f, uint64_t instructionsPerRun) {
+        tilesFilled += f.tiles;
+        tilesFromChildren += f.tilesFromChildren;
+        texelsFilled += f.texels;
+        programRuns += f.programRuns;
+        instructions += f.programRuns * instructionsPerRun;
+    }
+    StaticCosts& operator+=(const StaticCosts& o) {
+        runs += o.runs;
+        seconds += o.seconds;
+        instructions += o.instructions;
+        tilesFilled += o.tilesFilled;
+        tilesFromChildren += o.tilesFromChildren;
+        texelsFilled += o.texelsFilled;
+        programRuns += o.programRuns;
+        return *this;
+    }
 };
 
 // Where a fill's work went: each map's fill reported as a span on the thread that ran it,

@@ -48,13 +48,15 @@ TEST(CostProfile, PhasesNestInTheirFramesAndObjectsCarryTheirOwnWork) {
                 EXPECT_GE(sp.beginUs, frame->beginUs) << sp.name;
                 EXPECT_LE(sp.endUs, frame->endUs) << sp.name;
             }
-        EXPECT_NEAR(staticUs, 1e6 * s.staticSeconds, 0.02 * 1e6 * s.staticSeconds + 200.0);
-        EXPECT_NEAR(shadeUs, 1e6 * s.shadeSeconds, 0.02 * 1e6 * s.shadeSeconds + 200.0);
+        EXPECT_NEAR(staticUs, 1e6 * s.staticWork.seconds,
+                    0.02 * 1e6 * s.staticWork.seconds + 200.0);
+        EXPECT_NEAR(shadeUs, 1e6 * s.dynamic.shadeSeconds,
+                    0.02 * 1e6 * s.dynamic.shadeSeconds + 200.0);
         // Every band of 4 rows shaded at least once.
         EXPECT_GE(bands, (68 + 3) / 4);
     }
     // The first frame built both objects; later frames only filled.
-    EXPECT_EQ(p.frames[0].staticRuns, 2);
+    EXPECT_EQ(p.frames[0].staticWork.work.runs, 2);
     for (const ObjectProfile& o : p.objects) {
         SCOPED_TRACE(o.name);
         EXPECT_EQ(o.staticRuns, 1);
@@ -68,7 +70,8 @@ TEST(CostProfile, PhasesNestInTheirFramesAndObjectsCarryTheirOwnWork) {
         for (size_t k = 0; k < 3; ++k) {
             EXPECT_GT(o.shadeSecondsPerFrame[k], 0.0);
             // Summed over threads: at most every thread busy for the whole shading phase.
-            EXPECT_LE(o.shadeSecondsPerFrame[k], p.threads * p.frames[k].shadeSeconds + 1e-4);
+            EXPECT_LE(o.shadeSecondsPerFrame[k],
+                      p.threads * p.frames[k].dynamic.shadeSeconds + 1e-4);
         }
     }
     // The points shaded are the frames' own.

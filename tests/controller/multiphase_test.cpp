@@ -408,7 +408,7 @@ TEST(MultiphaseRenderer, NoPinholesOverTwoHundredViewsInTheRange) {
         FrameStats rs, ms;
         const SampleBuffer ref = reference.renderSamples(f, {}, rs);
         const SampleBuffer got = multi.renderSamples(f, {}, ms);
-        staticRuns += ms.staticRuns;
+        staticRuns += ms.staticWork.work.runs;
         // Inside the silhouette: covered in the reference, with every sample of the
         // neighbouring pixels covered too (the silhouette's edge differs by the facets'
         // chord sag, a fraction of a pixel).
@@ -452,9 +452,9 @@ TEST(MultiphaseRenderer, ReDicesWhenTheViewLeavesTheRange) {
     multi.renderSamples(0, {}, s0);
     multi.renderSamples(0, {}, s1);
     multi.renderSamples(1, {}, s2);
-    EXPECT_EQ(s0.staticRuns, 1);
-    EXPECT_EQ(s1.staticRuns, 0);
-    EXPECT_EQ(s2.staticRuns, 1);
+    EXPECT_EQ(s0.staticWork.work.runs, 1);
+    EXPECT_EQ(s1.staticWork.work.runs, 0);
+    EXPECT_EQ(s2.staticWork.work.runs, 1);
 }
 
 TEST(MultiphaseRenderer, ExamplesMatchTheReference) {
@@ -480,7 +480,7 @@ TEST(MultiphaseRenderer, ExamplesMatchTheReference) {
             EXPECT_GT(mp, rp + 0.5) << path << " frame " << frame;
             EXPECT_LT(e.coverageDiff, 0.01) << path << " frame " << frame;
             EXPECT_EQ(ms.nonFiniteSamples, 0u);
-            EXPECT_GT(ms.facets, 0u);
+            EXPECT_GT(ms.dynamic.facets, 0u);
             std::printf(
                 "%s frame %d: against the reference %.2f dB; against 16 spp %.2f dB, "
                 "the reference %.2f dB\n",
@@ -606,7 +606,7 @@ TEST(MultiphaseRenderer, StaticWorkThatWouldNotPayGoesSinglePhase) {
     FrameStats s;
     const Image got = oneFrame.renderFrame(3, options, s);
     EXPECT_TRUE(s.singlePhase);
-    EXPECT_EQ(s.staticRuns, 0);
+    EXPECT_EQ(s.staticWork.work.runs, 0);
     EXPECT_EQ(oneFrame.representation(0), nullptr);
     ASSERT_EQ(got.rgba.size(), ref.rgba.size());
     EXPECT_EQ(got.rgba, ref.rgba);
@@ -616,14 +616,14 @@ TEST(MultiphaseRenderer, StaticWorkThatWouldNotPayGoesSinglePhase) {
     FrameStats w;
     whole.renderFrame(0, options, w);
     EXPECT_FALSE(w.singlePhase);
-    EXPECT_EQ(w.staticRuns, 2);
+    EXPECT_EQ(w.staticWork.work.runs, 2);
 
     MultiphaseRenderer forced(scene, machineryOnly());
     forced.plan(3, 4, options);
     FrameStats f;
     forced.renderFrame(3, options, f);
     EXPECT_FALSE(f.singlePhase);
-    EXPECT_EQ(f.staticRuns, 2);
+    EXPECT_EQ(f.staticWork.work.runs, 2);
 }
 
 TEST(MultiphaseRenderer, DiscardedStaticWorkIsBuiltAgain) {
@@ -636,11 +636,11 @@ TEST(MultiphaseRenderer, DiscardedStaticWorkIsBuiltAgain) {
     FrameStats a, b, c;
     const Image first = multi.renderFrame(1, options, a);
     multi.renderFrame(2, options, b);
-    EXPECT_EQ(b.staticRuns, 0);
+    EXPECT_EQ(b.staticWork.work.runs, 0);
     multi.discardStaticWork();
     EXPECT_EQ(multi.representation(0), nullptr);
     const Image again = multi.renderFrame(1, options, c);
-    EXPECT_EQ(c.staticRuns, 2);
+    EXPECT_EQ(c.staticWork.work.runs, 2);
     EXPECT_EQ(again.rgba, first.rgba);
 }
 

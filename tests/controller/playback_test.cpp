@@ -44,14 +44,14 @@ TEST(Playback, WithTimeEnoughAFrameIsTheConstantQualityFrame) {
     const Image coarse = play.renderFrame(3, small(), first);
     // The first frame fell back (its maps held only their coarsest levels), then filled
     // every tile it lacked in the time left.
-    EXPECT_GT(first.probeFallbacks, 0u);
-    EXPECT_GT(first.tilesRequested, 0u);
-    EXPECT_EQ(first.tilesDeferred, 0u);
-    EXPECT_TRUE(first.deadlineMet);
-    EXPECT_EQ(first.budgetSeconds, 60.0);
+    EXPECT_GT(first.dynamic.probeFallbacks, 0u);
+    EXPECT_GT(first.tiles.requested, 0u);
+    EXPECT_EQ(first.budget.tilesDeferred, 0u);
+    EXPECT_TRUE(first.budget.deadlineMet);
+    EXPECT_EQ(first.budget.seconds, 60.0);
     const Image fine = play.renderFrame(3, small(), second);
-    EXPECT_EQ(second.probeFallbacks, 0u);
-    EXPECT_EQ(second.tilesRequested, 0u);
+    EXPECT_EQ(second.dynamic.probeFallbacks, 0u);
+    EXPECT_EQ(second.tiles.requested, 0u);
 
     MultiphaseOptions constant;
     constant.singlePhaseFrames = false;
@@ -70,18 +70,18 @@ TEST(Playback, NoTimeLeftDefersTilesAndRebuildsButDrawsEveryFrame) {
     MultiphaseRenderer play(scene, budgeted(1e-6, 0.0));
     FrameStats stats;
     play.renderFrame(3, small(), stats);
-    EXPECT_EQ(stats.staticRuns, 2);  // never built: built whatever the budget
-    EXPECT_FALSE(stats.deadlineMet);
+    EXPECT_EQ(stats.staticWork.work.runs, 2);  // never built: built whatever the budget
+    EXPECT_FALSE(stats.budget.deadlineMet);
     for (int frame : {4, 40}) {  // 40: the camera has orbited out of the vase's range
         SCOPED_TRACE(frame);
         const Image image = play.renderFrame(frame, small(), stats);
-        EXPECT_EQ(stats.staticRuns, 0);
-        EXPECT_EQ(stats.tilesFilled, 0u);
-        EXPECT_GT(stats.tilesRequested, 0u);
-        EXPECT_EQ(stats.tilesDeferred, stats.tilesRequested);
-        EXPECT_GT(stats.probeFallbacks, 0u);
+        EXPECT_EQ(stats.staticWork.work.runs, 0);
+        EXPECT_EQ(stats.staticWork.work.tilesFilled, 0u);
+        EXPECT_GT(stats.tiles.requested, 0u);
+        EXPECT_EQ(stats.budget.tilesDeferred, stats.tiles.requested);
+        EXPECT_GT(stats.dynamic.probeFallbacks, 0u);
         if (frame == 40) {
-            EXPECT_GE(stats.rebuildsDeferred, 1);
+            EXPECT_GE(stats.budget.rebuildsDeferred, 1);
         }
         for (float v : image.rgba) ASSERT_TRUE(std::isfinite(v));
         EXPECT_GT(coverage(image), 0.3);
@@ -100,16 +100,16 @@ TEST(Playback, DeferredTilesAreFilledInTheBackgroundForTheNextFrames) {
     FrameStats stats;
     play.renderFrame(3, small(), stats);
     play.renderFrame(4, small(), stats);
-    const uint64_t deferred = stats.tilesDeferred;
+    const uint64_t deferred = stats.budget.tilesDeferred;
     ASSERT_GT(deferred, 20u);
     for (int wait = 0; wait < 6000 && play.backgroundQueued() > 0; ++wait)
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
     ASSERT_EQ(play.backgroundQueued(), 0u);
     const Image image = play.renderFrame(4, small(), stats);
     // At least those (the worker may also have filled some of frame 3's queue meanwhile).
-    EXPECT_GE(stats.backgroundTilesFilled, deferred);
-    EXPECT_EQ(stats.tilesRequested, 0u);
-    EXPECT_EQ(stats.probeFallbacks, 0u);
+    EXPECT_GE(stats.background.tilesFilled, deferred);
+    EXPECT_EQ(stats.tiles.requested, 0u);
+    EXPECT_EQ(stats.dynamic.probeFallbacks, 0u);
     MultiphaseOptions constant;
     constant.singlePhaseFrames = false;
     MultiphaseRenderer reference(scene, constant);
@@ -131,7 +131,7 @@ TEST(Playback, PlaysEveryFrameAndRegulatesItsQuality) {
     const PlaybackSummary summary = playScene(
         scene, options, [&](const FrameStats& s, const Image& image, const PlaybackQuality& q) {
             EXPECT_EQ(s.index, options.first + frames);
-            EXPECT_DOUBLE_EQ(s.budgetSeconds, 1e-6);
+            EXPECT_DOUBLE_EQ(s.budget.seconds, 1e-6);
             EXPECT_EQ(image.width, 96);
             steps.push_back(q);
             ++frames;
@@ -185,7 +185,7 @@ std::string writePanScene() {
 
 int firstSeenFrame(const std::vector<FrameStats>& frames, uint32_t object) {
     for (const FrameStats& s : frames)
-        for (const StaticRunDue& d : s.staticRunsDue)
+        for (const StaticRunDue& d : s.staticWork.due)
             if (d.object == object && d.cause == StaticRunDue::FirstSeen) return s.index;
     return -1;
 }
@@ -216,14 +216,14 @@ TEST(Playback, AnObjectEnteringTheViewIsBuiltBeforeItsFirstFrame) {
     EXPECT_EQ(firstSeenFrame(with, 1), -1);  // never due: it was ready
     int builtBefore = 0;
     for (const FrameStats& s : with)
-        if (s.index < enters) builtBefore += s.builtAhead;
+        if (s.index < enters) builtBefore += s.budget.builtAhead;
     EXPECT_EQ(builtBefore, 1);
     // At its first frame nothing was built, and it was drawn: the frame shaded as many
     // points as the one that built it then (its representative view differs a little, so
     // its silhouette may cover a few samples more or less).
     const size_t k = static_cast<size_t>(enters - options.first);
-    EXPECT_EQ(with[k].staticRuns, 0);
-    EXPECT_GT(without[k].staticRuns, 0);
+    EXPECT_EQ(with[k].staticWork.work.runs, 0);
+    EXPECT_GT(without[k].staticWork.work.runs, 0);
     EXPECT_NEAR(static_cast<double>(with[k].shadedPoints),
                 static_cast<double>(without[k].shadedPoints), 0.05 * without[k].shadedPoints);
 }
@@ -260,8 +260,8 @@ TEST(Playback, AnObjectEnteringTheViewHasItsTilesBeforeItsFrames) {
     // serve it), measured 19 tiles lacked with prefetching against 87 without.
     uint64_t lackedWith = 0, lackedWithout = 0;
     for (size_t f = k; f < with.size(); ++f) {
-        lackedWith += with[f].tilesRequested;
-        lackedWithout += without[f].tilesRequested;
+        lackedWith += with[f].tiles.requested;
+        lackedWithout += without[f].tiles.requested;
     }
     RecordProperty("lacked", std::to_string(lackedWith) + " with, " +
                                  std::to_string(lackedWithout) + " without prefetching");
@@ -297,9 +297,9 @@ TEST(Playback, TheBackgroundFillerEvictsUnderTheFramesProbesWithinTheCache) {
     for (int frame = 0; frame < 16; ++frame) {
         FrameStats s;
         const Image image = play.renderFrame(frame, r, s);
-        filled += s.backgroundTilesFilled;
-        evicted += s.backgroundTilesEvicted;
-        EXPECT_LE(s.residentBytes - s.residentPinnedBytes, o.mapMemoryBytes) << frame;
+        filled += s.background.tilesFilled;
+        evicted += s.background.tilesEvicted;
+        EXPECT_LE(s.tiles.residentBytes - s.tiles.residentPinnedBytes, o.mapMemoryBytes) << frame;
         for (float v : image.rgba) ASSERT_TRUE(std::isfinite(v)) << frame;
         EXPECT_GT(coverage(image), 0.3);
         for (int wait = 0; wait < 6000 && !play.backgroundSettled(); ++wait)
@@ -326,9 +326,10 @@ TEST(Playback, AOneMegabyteCacheHoldsEveryFrameAndStillDrawsThem) {
     uint64_t deferred = 0;
     playScene(scene, options, [&](const FrameStats& s, const Image& image, const PlaybackQuality&) {
         ++frames;
-        EXPECT_LE(s.residentBytes - s.residentPinnedBytes, options.cacheBytes) << s.index;
-        EXPECT_LE(s.residentPinnedBytes, s.residentBytes);
-        deferred += s.tilesDeferred;
+        EXPECT_LE(s.tiles.residentBytes - s.tiles.residentPinnedBytes, options.cacheBytes)
+            << s.index;
+        EXPECT_LE(s.tiles.residentPinnedBytes, s.tiles.residentBytes);
+        deferred += s.budget.tilesDeferred;
         double covered = 0.0;
         size_t nonFinite = 0;
         for (size_t p = 3; p < image.rgba.size(); p += 4) {

@@ -8,10 +8,10 @@ namespace {
 // A frame whose dynamic phase took `rest` seconds outside shading and `shade` shading.
 FrameStats frame(double rest, double shade = 0.0) {
     FrameStats s;
-    s.warpSeconds = 0.25 * rest;
-    s.rasterSeconds = 0.5 * rest;
-    s.resolveSeconds = 0.25 * rest;
-    s.shadeSeconds = shade;
+    s.dynamic.warpSeconds = 0.25 * rest;
+    s.dynamic.rasterSeconds = 0.5 * rest;
+    s.dynamic.resolveSeconds = 0.25 * rest;
+    s.dynamic.shadeSeconds = shade;
     return s;
 }
 

@@ -34,15 +34,15 @@ TEST(RerunTriggers, AnOrbitWithinTheRangeRunsNothingAfterTheFirstFrame) {
     MultiphaseRenderer renderer(scene, everyFrame());
     FrameStats stats;
     renderer.renderFrame(0, tiny(), stats);
-    ASSERT_EQ(stats.staticRunsDue.size(), 2u);
-    for (const StaticRunDue& d : stats.staticRunsDue) {
+    ASSERT_EQ(stats.staticWork.due.size(), 2u);
+    for (const StaticRunDue& d : stats.staticWork.due) {
         EXPECT_EQ(d.cause, StaticRunDue::FirstSeen);
         EXPECT_FALSE(d.deferred);
     }
     for (int frame = 1; frame <= 5; ++frame) {
         renderer.renderFrame(frame, tiny(), stats);
-        EXPECT_EQ(stats.staticRuns, 0) << frame;
-        EXPECT_TRUE(stats.staticRunsDue.empty()) << frame;
+        EXPECT_EQ(stats.staticWork.work.runs, 0) << frame;
+        EXPECT_TRUE(stats.staticWork.due.empty()) << frame;
     }
 }
 
@@ -54,12 +54,12 @@ TEST(RerunTriggers, LeavingTheRangeRunsExactlyTheObjectsThatLeftItAndSaysWhy) {
     for (int frame = 0; frame <= 6; ++frame) renderer.renderFrame(frame, tiny(), stats);
     // Frame 6: the floor's view direction has turned past 10 degrees from frame 0's; the
     // vase, 30 degrees, stays.
-    ASSERT_EQ(stats.staticRunsDue.size(), 1u);
-    const StaticRunDue& d = stats.staticRunsDue[0];
+    ASSERT_EQ(stats.staticWork.due.size(), 1u);
+    const StaticRunDue& d = stats.staticWork.due[0];
     EXPECT_EQ(d.object, static_cast<uint32_t>(floorIndex));
     EXPECT_EQ(d.cause, StaticRunDue::ViewDirection);
     EXPECT_EQ(d.threshold, 10.0f);
-    EXPECT_EQ(stats.staticRuns, 1);
+    EXPECT_EQ(stats.staticWork.work.runs, 1);
     const glm::vec3 f0 = cameraAt(scene, scene.frameTime(0), 64, 36).forward;
     const glm::vec3 f6 = cameraAt(scene, scene.frameTime(6), 64, 36).forward;
     const float turned = glm::degrees(std::acos(glm::dot(f0, f6)));
@@ -67,7 +67,7 @@ TEST(RerunTriggers, LeavingTheRangeRunsExactlyTheObjectsThatLeftItAndSaysWhy) {
     EXPECT_NEAR(d.measured, turned, 0.05f);
     // The floor was re-run at frame 6: frame 7 is in its new range.
     renderer.renderFrame(7, tiny(), stats);
-    EXPECT_TRUE(stats.staticRunsDue.empty());
+    EXPECT_TRUE(stats.staticWork.due.empty());
 }
 
 TEST(RerunTriggers, ANewImageHeightIsDueWithBothHeights) {
@@ -78,8 +78,8 @@ TEST(RerunTriggers, ANewImageHeightIsDueWithBothHeights) {
     RenderOptions taller = tiny();
     taller.height = 48;
     renderer.renderFrame(1, taller, stats);
-    ASSERT_EQ(stats.staticRunsDue.size(), 2u);
-    for (const StaticRunDue& d : stats.staticRunsDue) {
+    ASSERT_EQ(stats.staticWork.due.size(), 2u);
+    for (const StaticRunDue& d : stats.staticWork.due) {
         EXPECT_EQ(d.cause, StaticRunDue::ImageSize);
         EXPECT_EQ(d.measured, 48.0f);
         EXPECT_EQ(d.threshold, 36.0f);
@@ -141,16 +141,16 @@ TEST(RerunTriggers, ABakedAnimatedInputThatMovesRunsTheStaticPhaseAgain) {
     MultiphaseRenderer renderer(scene, everyFrame());
     FrameStats stats;
     renderer.renderFrame(0, tiny(), stats);
-    ASSERT_EQ(stats.staticRunsDue.size(), 2u);  // both first seen
+    ASSERT_EQ(stats.staticWork.due.size(), 2u);  // both first seen
     renderer.renderFrame(1, tiny(), stats);
     // k moved 0.1 of its span over the frames (t = 0 .. 0.9: 0.9): 0.111 > 0.02.
-    ASSERT_EQ(stats.staticRunsDue.size(), 1u);
-    const StaticRunDue& d = stats.staticRunsDue[0];
+    ASSERT_EQ(stats.staticWork.due.size(), 1u);
+    const StaticRunDue& d = stats.staticWork.due[0];
     EXPECT_EQ(d.object, 0u);
     EXPECT_EQ(d.cause, StaticRunDue::StaticInput);
     EXPECT_NEAR(d.measured, 0.1f / 0.9f, 1e-4f);
     EXPECT_EQ(d.threshold, 0.02f);
-    EXPECT_EQ(stats.staticRuns, 1);
+    EXPECT_EQ(stats.staticWork.work.runs, 1);
     // The baked ball follows k: at frame 7 it is as bright as the reference renderer's.
     const Image image = renderer.renderFrame(7, tiny(), stats);
     ReferenceRenderer reference(scene);
@@ -170,13 +170,13 @@ TEST(RerunTriggers, AnInputMovingWithinTheToleranceRunsNothing) {
     for (int frame = 0; frame <= 4; ++frame) {
         renderer.renderFrame(frame, tiny(), stats);
         if (frame > 0) {
-            EXPECT_TRUE(stats.staticRunsDue.empty()) << frame;
+            EXPECT_TRUE(stats.staticWork.due.empty()) << frame;
         }
     }
     renderer.renderFrame(5, tiny(), stats);  // 0.5 / 0.9 = 0.56 of the span
-    ASSERT_EQ(stats.staticRunsDue.size(), 1u);
-    EXPECT_EQ(stats.staticRunsDue[0].cause, StaticRunDue::StaticInput);
-    EXPECT_NEAR(stats.staticRunsDue[0].measured, 0.5f / 0.9f, 1e-4f);
+    ASSERT_EQ(stats.staticWork.due.size(), 1u);
+    EXPECT_EQ(stats.staticWork.due[0].cause, StaticRunDue::StaticInput);
+    EXPECT_NEAR(stats.staticWork.due[0].measured, 0.5f / 0.9f, 1e-4f);
 }
 
 }  // namespace
@@ -214,26 +214,26 @@ TEST(RerunTriggers, ACameraCutRunsOnlyWhatTheNewViewNeeds) {
     MultiphaseRenderer renderer(scene, everyFrame());
     FrameStats stats;
     renderer.renderFrame(0, tiny(), stats);
-    ASSERT_EQ(stats.staticRunsDue.size(), 1u);
-    EXPECT_EQ(stats.staticRunsDue[0].object, 0u);  // the second ball is not seen: not built
+    ASSERT_EQ(stats.staticWork.due.size(), 1u);
+    EXPECT_EQ(stats.staticWork.due[0].object, 0u);  // the second ball is not seen: not built
     EXPECT_EQ(renderer.representation(1), nullptr);
     for (int frame = 1; frame < 10; ++frame) {
         renderer.renderFrame(frame, tiny(), stats);
-        EXPECT_TRUE(stats.staticRunsDue.empty()) << frame;
+        EXPECT_TRUE(stats.staticWork.due.empty()) << frame;
     }
     renderer.renderFrame(10, tiny(), stats);  // the cut: only the second ball, first seen
-    ASSERT_EQ(stats.staticRunsDue.size(), 1u);
-    EXPECT_EQ(stats.staticRunsDue[0].object, 1u);
-    EXPECT_EQ(stats.staticRunsDue[0].cause, StaticRunDue::FirstSeen);
-    EXPECT_EQ(stats.staticRuns, 1);
+    ASSERT_EQ(stats.staticWork.due.size(), 1u);
+    EXPECT_EQ(stats.staticWork.due[0].object, 1u);
+    EXPECT_EQ(stats.staticWork.due[0].cause, StaticRunDue::FirstSeen);
+    EXPECT_EQ(stats.staticWork.work.runs, 1);
     for (int frame = 11; frame < 20; ++frame) {
         renderer.renderFrame(frame, tiny(), stats);
-        EXPECT_TRUE(stats.staticRunsDue.empty()) << frame;
+        EXPECT_TRUE(stats.staticWork.due.empty()) << frame;
     }
     // Back to the first view: the first ball's representation still holds for it.
     renderer.renderFrame(20, tiny(), stats);
-    EXPECT_TRUE(stats.staticRunsDue.empty());
-    EXPECT_EQ(stats.staticRuns, 0);
+    EXPECT_TRUE(stats.staticWork.due.empty());
+    EXPECT_EQ(stats.staticWork.work.runs, 0);
     EXPECT_EQ(stats.objectsDrawn, 1u);
 }
 

@@ -34,7 +34,7 @@ uint64_t tilesLacked(const Scene& scene, int frame) {
     FrameStats stats;
     renderer.renderFrame(0, small(), stats);
     renderer.renderFrame(frame, small(), stats);
-    return stats.tilesRequested;
+    return stats.tiles.requested;
 }
 
 TEST(TilePrefetch, PrefetchedTilesAreNotLackedAndCountAsUsed) {
@@ -56,18 +56,18 @@ TEST(TilePrefetch, PrefetchedTilesAreNotLackedAndCountAsUsed) {
             ASSERT_FALSE(renderer.representation(r.object)->map->resident(r.key));
         FrameStats slack;
         renderer.prefetch(predicted, 60.0, slack);
-        EXPECT_EQ(slack.tilesPrefetched, predicted.size());
+        EXPECT_EQ(slack.prefetch.filled, predicted.size());
         FrameStats ahead;
         renderer.renderFrame(16, small(), ahead);
         RecordProperty(
             "lacked_after_prediction_" + std::to_string(divisor),
-            std::to_string(ahead.tilesRequested) + " of " + std::to_string(lackedWithout));
+            std::to_string(ahead.tiles.requested) + " of " + std::to_string(lackedWithout));
         // The frame shades per sample at 4 samples: the same footprint as the prediction's
         // per-pixel points (half a pixel), so it lacks little of what was predicted.
-        EXPECT_LT(ahead.tilesRequested * (divisor == 1 ? 4 : 2), lackedWithout) << divisor;
-        EXPECT_GT(ahead.prefetchUsed, slack.tilesPrefetched / 2) << divisor;
-        EXPECT_LE(ahead.prefetchUsed, slack.tilesPrefetched);
-        EXPECT_EQ(ahead.prefetchWasted, 0u);
+        EXPECT_LT(ahead.tiles.requested * (divisor == 1 ? 4 : 2), lackedWithout) << divisor;
+        EXPECT_GT(ahead.prefetch.used, slack.prefetch.filled / 2) << divisor;
+        EXPECT_LE(ahead.prefetch.used, slack.prefetch.filled);
+        EXPECT_EQ(ahead.prefetch.wasted, 0u);
     }
 }
 
@@ -86,13 +86,13 @@ TEST(TilePrefetch, ATileNoFrameReadsIsWastedAfterThePatience) {
     const TileRequest unread{static_cast<uint32_t>(vase), corner};
     FrameStats slack;
     renderer.prefetch(std::span<const TileRequest>(&unread, 1), 60.0, slack);
-    ASSERT_EQ(slack.tilesPrefetched, 1u);
+    ASSERT_EQ(slack.prefetch.filled, 1u);
     uint64_t wasted = 0, used = 0;
     for (int f = 1; f <= 3; ++f) {
         renderer.renderFrame(f, small(), stats);
-        wasted += stats.prefetchWasted;
-        used += stats.prefetchUsed;
-        EXPECT_EQ(stats.prefetchWasted, f == 3 ? 1u : 0u) << f;
+        wasted += stats.prefetch.wasted;
+        used += stats.prefetch.used;
+        EXPECT_EQ(stats.prefetch.wasted, f == 3 ? 1u : 0u) << f;
     }
     EXPECT_EQ(used, 0u);
     EXPECT_EQ(wasted, 1u);
@@ -108,7 +108,7 @@ TEST(TilePrefetch, AGuessNeverDisplacesATileInTheCache) {
         FrameStats stats;
         roomy.renderFrame(0, small(), stats);
         roomy.renderFrame(8, small(), stats);
-        full = stats.residentBytes;
+        full = stats.tiles.residentBytes;
     }
     MultiphaseOptions o = budgeted();
     o.mapMemoryBytes = full;
@@ -116,8 +116,8 @@ TEST(TilePrefetch, AGuessNeverDisplacesATileInTheCache) {
     FrameStats stats;
     renderer.renderFrame(0, small(), stats);
     renderer.renderFrame(8, small(), stats);  // frame 0's tiles it does not read: evictable
-    ASSERT_EQ(stats.tilesEvicted, 0u);
-    ASSERT_EQ(stats.residentBytes, full);
+    ASSERT_EQ(stats.tiles.evicted, 0u);
+    ASSERT_EQ(stats.tiles.residentBytes, full);
     double seconds = 0.0;
     const std::vector<TileRequest> predicted =
         TilePredictor(renderer).predict(16, small(), 1, seconds);
@@ -126,8 +126,8 @@ TEST(TilePrefetch, AGuessNeverDisplacesATileInTheCache) {
     renderer.prefetch(predicted, 60.0, slack);
     // A frame's demand would evict frame 0's tiles to fit (planting that fails here); a
     // guess finds no room and fills nothing.
-    EXPECT_EQ(slack.tilesEvicted, 0u);
-    EXPECT_EQ(slack.tilesPrefetched, 0u);
+    EXPECT_EQ(slack.tiles.evicted, 0u);
+    EXPECT_EQ(slack.prefetch.filled, 0u);
 }
 
 TEST(TilePrefetch, PredictionPastItsDeadlineIsAbandoned) {
@@ -161,7 +161,7 @@ TEST(TilePrefetch, NeighboursOfLackedTilesAreAdjacentAndNotResident) {
     FrameStats stats;
     renderer.renderFrame(0, small(), stats);
     renderer.renderFrame(1, small(), stats);
-    ASSERT_GT(stats.tilesRequested, 0u);
+    ASSERT_GT(stats.tiles.requested, 0u);
     const std::vector<TileRequest> adjacent = renderer.adjacentTiles();
     ASSERT_FALSE(adjacent.empty());
     for (const TileRequest& r : adjacent) {

@@ -415,9 +415,9 @@ TEST(MultiphaseRenderer, GrazingFloorBeatsTheReferenceAtTheSameSamples) {
         const Image got = multi.renderFrame(frame, options, ms);
         const double mp = compareImages(got, truth).psnr, rp = compareImages(ref, truth).psnr;
         EXPECT_GE(mp, rp) << "frame " << frame;
-        EXPECT_EQ(ms.facets, 2u);
+        EXPECT_EQ(ms.dynamic.facets, 2u);
         EXPECT_EQ(ms.nonFiniteSamples, 0u);
-        EXPECT_EQ(ms.probeFallbacks, 0u) << "render fills every tile before shading";
+        EXPECT_EQ(ms.dynamic.probeFallbacks, 0u) << "render fills every tile before shading";
         RecordProperty("grazing_psnr_multiphase_" + std::to_string(frame), std::to_string(mp));
         RecordProperty("grazing_psnr_reference_" + std::to_string(frame), std::to_string(rp));
     }
@@ -449,10 +449,10 @@ TEST(MultiphaseRenderer, PixelRateShadesOncePerPixelAndSurface) {
     // At 4 samples a pixel point's footprint (half a pixel) is a sample's (1 / sqrt(4)):
     // the same map levels, so about as many tiles (a pixel's point at the pixel centre
     // reaches a few fewer at the edges of what is seen).
-    RecordProperty("tiles_sample", std::to_string(sample.tilesRequested));
-    RecordProperty("tiles_pixel", std::to_string(pixel.tilesRequested));
-    EXPECT_GT(pixel.tilesRequested, sample.tilesRequested * 3 / 4);
-    EXPECT_LE(pixel.tilesRequested, sample.tilesRequested);
+    RecordProperty("tiles_sample", std::to_string(sample.tiles.requested));
+    RecordProperty("tiles_pixel", std::to_string(pixel.tiles.requested));
+    EXPECT_GT(pixel.tiles.requested, sample.tiles.requested * 3 / 4);
+    EXPECT_LE(pixel.tiles.requested, sample.tiles.requested);
 }
 
 TEST(MultiphaseRenderer, QuadRateShadesOncePerTwoByTwoPixelsAndSurface) {
@@ -479,7 +479,7 @@ TEST(MultiphaseRenderer, QuadRateShadesOncePerTwoByTwoPixelsAndSurface) {
     EXPECT_GT(psnr, 22.5);
     // A point's footprint is a whole pixel, twice the per-pixel one: a level coarser, so
     // about a quarter of the tiles.
-    EXPECT_LT(quad.tilesRequested * 2, pixel.tilesRequested);
+    EXPECT_LT(quad.tiles.requested * 2, pixel.tiles.requested);
 }
 
 TEST(MultiphaseRenderer, WholePixelShortcutGivesTheSamePointsBitForBit) {
@@ -521,10 +521,10 @@ TEST(MultiphaseRenderer, MapsStayInTheirMemoryBudget) {
         FrameStats sa, sb;
         const Image ia = a.renderFrame(frame, options, sa);
         const Image ib = b.renderFrame(frame, options, sb);
-        evicted += sa.tilesEvicted;
-        EXPECT_EQ(sb.tilesEvicted, 0u);
+        evicted += sa.tiles.evicted;
+        EXPECT_EQ(sb.tiles.evicted, 0u);
         // Over the budget only by the always-resident levels and what one frame needs.
-        EXPECT_LT(sa.residentBytes, sb.residentBytes + 1u) << frame;
+        EXPECT_LT(sa.tiles.residentBytes, sb.tiles.residentBytes + 1u) << frame;
         EXPECT_GT(compareImages(ia, ib).psnr, 60.0) << frame;
     }
     EXPECT_GT(evicted, 0u);
