@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
 
+#include "phases/band_points.h"
 #include "phases/compositing.h"
 #include "phases/work_deadline.h"
 
@@ -63,45 +64,156 @@ bool backFacesHidden(const ObjectRepresentation& rep, const Surface& surface,
 }
 
 constexpr size_t kBatch = 1024;  // shading points per run of the dynamic shader
-constexpr uint32_t kNoPoint = ~uint32_t{0};
 
 }  // namespace
 
-// A band's shading points and results, kept while it is unfinished (its points whose
-// probes lacked tiles are shaded again after the fill, the rest are not) and reused from
-// frame to frame; and per thread, the buffers of one batch.
+// Per band, its shading points while it waits for tiles (band_points.h); per thread, the
+// buffers of the band being shaded and of one batch, and what shading cost.
 struct DynamicPhase::Band {
-    struct State {
-        bool built = false;
-        std::vector<uint32_t> object, facet;  // per shading point
-        std::vector<float> x, y;              // per shading point, pixels
-        std::vector<uint32_t> fragmentPoint;  // per visibility slot of the band
-        // Per pixel of the band, shaded per pixel or per 2x2 pixels: its point, where that
-        // one point is every sample's only fragment (its samples' fragmentPoint then unset);
-        // otherwise kNoPoint. Empty when shaded per sample.
-        std::vector<uint32_t> pixelPoint;
-        std::vector<float> color, opacity;  // 3 per shading point
-        // Points are grouped by object: object o's are [objectStart[o], objectStart[o + 1]).
-        std::vector<uint32_t> objectStart;
-        bool fresh = false;             // no point shaded yet: every point is pending
-        std::vector<uint32_t> pending;  // otherwise, the points still to shade
-    };
     struct Scratch {
-        State work;  // the band being shaded, unless it has a state of its own
-        std::vector<uint32_t> cursor, stillPending, permutation;
-        std::vector<uint32_t> unsortedObject, unsortedFacet;
-        std::vector<float> unsortedX, unsortedY;
+        BandPoints work;  // the band being shaded, unless it has points of its own
+        BandPointScratch points;
+        std::vector<uint32_t> stillPending;
         std::vector<uint32_t> batchFacet;
         std::vector<float> batchX, batchY, batchColor, batchOpacity;
         std::vector<uint8_t> batchMissed;
-        std::vector<uint8_t> member;  // per fragment of a pixel block: its group
         SurfaceShadingScratch surface;
         SurfaceShadingCounters counters;
         std::vector<ObjectFrameCost> costs;  // per object
+
+        // Every point of a fresh band, each object's as runs of the band's own arrays; the
+        // points whose probes lacked tiles go to stillPending.
+        void shadeFresh(std::span<const ObjectView> views, const ProbeOptions& probe,
+                        bool stopAtMissing, BandPoints& pts, std::vector<TileRequest>& lacking);
+        // After a fill, the points still pending (in order, so grouped by object), gathered
+        // into batches and their results scattered back.
+        void shadePending(std::span<const ObjectView> views, const ProbeOptions& probe,
+                          bool stopAtMissing, BandPoints& pts, std::vector<TileRequest>& lacking);
+        // What shading object o's points cost, and the tiles its probes lacked.
+        void addObjectCosts(size_t o, const SurfaceShadingCounters& c, Clock::time_point began,
+                            std::vector<TileRequest>& lacking);
     };
-    std::vector<State> states;
+    std::vector<BandPoints> states;
     tbb::enumerable_thread_specific<Scratch> scratch;
 };
+
+void DynamicPhase::Band::Scratch::shadeFresh(std::span<const ObjectView> views,
+                                             const ProbeOptions& probe, bool stopAtMissing,
+                                             BandPoints& pts, std::vector<TileRequest>& lacking) {
+    for (size_t o = 0; o + 1 < pts.objectStart.size(); ++o) {
+        const size_t begin = pts.objectStart[o], end = pts.objectStart[o + 1];
+        if (begin == end) continue;
+        const auto began = Clock::now();
+        SurfaceShadingCounters c;
+        surface.missing.clear();
+        for (size_t b = begin; b < end; b += kBatch) {
+            const size_t m = std::min(kBatch, end - b);
+            const SurfacePoints batch{&pts.facet[b], &pts.x[b], &pts.y[b], m};
+            const size_t missed =
+                shadeSurfacePoints(views[o], probe, stopAtMissing, batch, &pts.color[3 * b],
+                                   &pts.opacity[3 * b], batchMissed.data(), surface, c);
+            if (missed > 0)
+                for (size_t i = 0; i < m; ++i)
+                    if (batchMissed[i]) stillPending.push_back(static_cast<uint32_t>(b + i));
+        }
+        addObjectCosts(o, c, began, lacking);
+    }
+}
+
+void DynamicPhase::Band::Scratch::shadePending(std::span<const ObjectView> views,
+                                               const ProbeOptions& probe, bool stopAtMissing,
+                                               BandPoints& pts, std::vector<TileRequest>& lacking) {
+    batchFacet.resize(kBatch);
+    batchX.resize(kBatch), batchY.resize(kBatch);
+    batchColor.resize(3 * kBatch), batchOpacity.resize(3 * kBatch);
+    size_t first = 0;
+    while (first < pts.pending.size()) {
+        const uint32_t o = pts.object[pts.pending[first]];
+        size_t last = first;
+        while (last < pts.pending.size() && pts.object[pts.pending[last]] == o) ++last;
+        const auto began = Clock::now();
+        SurfaceShadingCounters c;
+        surface.missing.clear();
+        for (size_t b = first; b < last; b += kBatch) {
+            const size_t m = std::min(kBatch, last - b);
+            for (size_t i = 0; i < m; ++i) {
+                const uint32_t p = pts.pending[b + i];
+                batchFacet[i] = pts.facet[p];
+                batchX[i] = pts.x[p];
+                batchY[i] = pts.y[p];
+            }
+            const SurfacePoints batch{batchFacet.data(), batchX.data(), batchY.data(), m};
+            const size_t missed =
+                shadeSurfacePoints(views[o], probe, stopAtMissing, batch, batchColor.data(),
+                                   batchOpacity.data(), batchMissed.data(), surface, c);
+            for (size_t i = 0; i < m; ++i) {
+                const uint32_t p = pts.pending[b + i];
+                if (missed > 0 && batchMissed[i]) {
+                    stillPending.push_back(p);
+                    continue;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    pts.color[3 * p + k] = batchColor[3 * i + k];
+                    pts.opacity[3 * p + k] = batchOpacity[3 * i + k];
+                }
+            }
+        }
+        addObjectCosts(o, c, began, lacking);
+        first = last;
+    }
+}
+
+void DynamicPhase::Band::Scratch::addObjectCosts(size_t o, const SurfaceShadingCounters& c,
+                                                 Clock::time_point began,
+                                                 std::vector<TileRequest>& lacking) {
+    for (const TileKey& key : surface.missing) lacking.push_back({static_cast<uint32_t>(o), key});
+    ObjectFrameCost& cost = costs[o];
+    cost.shadeSeconds += secondsSince(began);
+    cost.instructions += c.instructions;
+    cost.probes += c.probes;
+    cost.probeFallbacks += c.fallbacks;
+    counters.instructions += c.instructions;
+    counters.nonFinite += c.nonFinite;
+}
+
+namespace {
+
+// Composites every sample of the band front to back over the background and notes the
+// pixels whose samples all came out alike (the resolve reads those once). A pixel one point
+// covers whole has all its samples alike: only its first is composited and written, the one
+// the resolve reads (at per-pixel shading, three quarters of the samples' passes over
+// memory).
+void compositeBand(const BandPoints& pts, const BandRange& r, const VisibilityBuffer& vis, int spp,
+                   const glm::vec3& background, float* rgbaOut, uint8_t* uniform) {
+    const int layers = vis.layers;
+    for (size_t pixel = r.firstPixel; pixel < r.endSample / spp; ++pixel) {
+        const size_t first = pixel * static_cast<size_t>(spp);
+        if (!pts.pixelPoint.empty()) {
+            if (const uint32_t p = pts.pixelPoint[pixel - r.firstPixel]; p != kNoPoint) {
+                SampleComposite c;
+                c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
+                c.finish(background, &rgbaOut[4 * first]);
+                uniform[pixel] = 1;
+                continue;
+            }
+        }
+        for (size_t smp = first; smp < first + spp; ++smp) {
+            SampleComposite c;
+            for (int l = 0; l < vis.count[smp]; ++l) {
+                const uint32_t p = pts.fragmentPoint[smp * layers + l - r.firstSlot];
+                c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
+            }
+            c.finish(background, &rgbaOut[4 * smp]);
+        }
+        const float* rgba = &rgbaOut[4 * first];
+        bool same = true;
+        for (int k = 1; k < spp && same; ++k)
+            same = std::memcmp(rgba, rgba + 4 * k, 4 * sizeof(float)) == 0;
+        uniform[pixel] = same ? 1 : 0;
+    }
+}
+
+}  // namespace
 
 DynamicPhase::DynamicPhase(const Scene& scene)
     : scene_(scene), scratch_(std::make_unique<Band>()) {}
@@ -197,7 +309,7 @@ void DynamicPhase::begin(const FrameState& frame,
     const int bands = (layout_->height() + options_.bandRows - 1) / options_.bandRows;
     bandDone_.assign(static_cast<size_t>(bands), 0);
     scratch_->states.resize(static_cast<size_t>(bands));
-    for (Band::State& state : scratch_->states) state.built = false;
+    for (BandPoints& points : scratch_->states) points.built = false;
     for (Band::Scratch& s : scratch_->scratch) s.costs.assign(n, ObjectFrameCost{});
 }
 
@@ -250,340 +362,44 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
     return all;
 }
 
+// 1. The band's shading points, once per frame; 2. each object's points in batches, those
+// whose probes lacked tiles staying pending (the band then keeps its points until a later
+// pass); 3. once none is pending, the band composited.
 void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& lacking) {
-    // A band keeps a state of its own only while it waits for tiles: shaded in one pass,
-    // it uses its thread's buffers and keeps nothing.
+    // A band keeps points of its own only while it waits for tiles: shaded in one pass, it
+    // uses its thread's buffers and keeps nothing.
     Band::Scratch& s = scratch_->scratch.local();
-    Band::State& st = scratch_->states[band].built ? scratch_->states[band] : s.work;
-    if (s.costs.size() != objects_.size()) s.costs.assign(objects_.size(), ObjectFrameCost{});
-    const SampleLayout& layout = *layout_;
-    const VisibilityBuffer& vis = visibility_;
-    const int width = layout.width(), spp = layout.spp(), layers = vis.layers;
-    const int row0 = static_cast<int>(band) * options_.bandRows;
-    const int row1 = std::min(layout.height(), row0 + options_.bandRows);
-    const size_t firstSample = layout.index(0, row0, 0);
-    const size_t endSample = layout.index(0, row1, 0);
-    const size_t firstSlot = firstSample * static_cast<size_t>(layers);
-    const size_t firstPixel = firstSample / static_cast<size_t>(spp);
-
-    // 1. Shading points, once per frame.
+    BandPoints& pts = scratch_->states[band].built ? scratch_->states[band] : s.work;
     const size_t objects = objects_.size();
-    if (!st.built) {
-        st.fragmentPoint.resize((endSample - firstSample) * static_cast<size_t>(layers));
-        st.objectStart.assign(objects + 1, 0);
-        if (options_.shadingRate == ShadingRate::Sample) {
-            // A point per fragment, placed by object as it is made (a counting sort).
-            st.pixelPoint.clear();
-            for (size_t smp = firstSample; smp < endSample; ++smp)
-                for (int l = 0; l < vis.count[smp]; ++l)
-                    ++st.objectStart[vis.object[smp * layers + l] + 1];
-            for (size_t o = 0; o < objects; ++o) st.objectStart[o + 1] += st.objectStart[o];
-            const size_t points = st.objectStart[objects];
-            st.object.resize(points), st.facet.resize(points);
-            st.x.resize(points), st.y.resize(points);
-            s.cursor.assign(st.objectStart.begin(), st.objectStart.end() - 1);
-            for (size_t smp = firstSample; smp < endSample; ++smp)
-                for (int l = 0; l < vis.count[smp]; ++l) {
-                    const size_t slot = smp * layers + l;
-                    const uint32_t o = vis.object[slot];
-                    const uint32_t at = s.cursor[o]++;
-                    st.object[at] = o;
-                    st.facet[at] = vis.facet[slot];
-                    st.x[at] = layout.x(smp);
-                    st.y[at] = layout.y(smp);
-                    st.fragmentPoint[slot - firstSlot] = at;
-                }
-        } else {
-            s.unsortedObject.clear(), s.unsortedFacet.clear();
-            s.unsortedX.clear(), s.unsortedY.clear();
-            auto addPoint = [&](uint32_t o, uint32_t f, float x, float y) {
-                s.unsortedObject.push_back(o);
-                s.unsortedFacet.push_back(f);
-                s.unsortedX.push_back(x);
-                s.unsortedY.push_back(y);
-                return static_cast<uint32_t>(s.unsortedObject.size() - 1);
-            };
-            struct Group {
-                uint32_t object;
-                int layer;
-                float sx, sy;
-                int count;
-            };
-            Group groups[64];
-            st.pixelPoint.assign(static_cast<size_t>(row1 - row0) * static_cast<size_t>(width),
-                                 kNoPoint);
-            auto pixelAt = [&](int px, int py) {
-                return static_cast<size_t>(py - row0) * static_cast<size_t>(width) +
-                       static_cast<size_t>(px);
-            };
-            // Per pixel, or per block of 2x2 pixels: the block's fragments grouped by
-            // surface. member: per (pixel of the block, sample, layer), its group.
-            const int block = options_.shadingRate == ShadingRate::Quad ? 2 : 1;
-            const size_t pixelSlots = static_cast<size_t>(spp) * layers;
-            s.member.resize(static_cast<size_t>(block * block) * pixelSlots);
-            for (int by = row0; by < row1; by += block)
-                for (int bx = 0; bx < width; bx += block) {
-                    if (block == 1 && options_.wholePixelShortcut) {
-                        // The common case: one surface covers every sample of the pixel, in
-                        // front. Its point is the pixel's precomputed centroid, on the facet
-                        // of its nearest sample: what the general path below finds.
-                        const size_t first = layout.index(bx, by, 0);
-                        bool whole = vis.count[first] == 1;
-                        const uint32_t o = whole ? vis.object[first * layers] : 0;
-                        for (int k = 1; k < spp && whole; ++k)
-                            whole =
-                                vis.count[first + k] == 1 && vis.object[(first + k) * layers] == o;
-                        if (whole) {
-                            const size_t pixel = first / static_cast<size_t>(spp);
-                            const size_t nearest =
-                                first + static_cast<size_t>(layout.nearestToCentroid(pixel));
-                            st.pixelPoint[pixelAt(bx, by)] =
-                                addPoint(o, vis.facet[nearest * layers], layout.centroidX(pixel),
-                                         layout.centroidY(pixel));
-                            continue;
-                        }
-                    }
-                    const int y1 = std::min(row1, by + block), x1 = std::min(width, bx + block);
-                    if (block == 2 && options_.wholePixelShortcut && x1 - bx == 2 && y1 - by == 2 &&
-                        by % 2 == 0) {
-                        // The same for a whole 2x2 block: its four pixels' samples all see
-                        // one surface, in front.
-                        const size_t firsts[4] = {
-                            layout.index(bx, by, 0), layout.index(bx + 1, by, 0),
-                            layout.index(bx, by + 1, 0), layout.index(bx + 1, by + 1, 0)};
-                        bool whole = vis.count[firsts[0]] == 1;
-                        const uint32_t o = whole ? vis.object[firsts[0] * layers] : 0;
-                        for (int q = 0; q < 4 && whole; ++q)
-                            for (int k = 0; k < spp && whole; ++k)
-                                whole = vis.count[firsts[q] + k] == 1 &&
-                                        vis.object[(firsts[q] + k) * layers] == o;
-                        if (whole) {
-                            const size_t quad = static_cast<size_t>(by / 2) * (width / 2) + bx / 2;
-                            const int m = layout.nearestToQuadCentroid(quad);
-                            const size_t nearest = firsts[m / spp] + static_cast<size_t>(m % spp);
-                            const uint32_t point =
-                                addPoint(o, vis.facet[nearest * layers], layout.quadCentroidX(quad),
-                                         layout.quadCentroidY(quad));
-                            for (int dy = 0; dy < 2; ++dy)
-                                for (int dx = 0; dx < 2; ++dx)
-                                    st.pixelPoint[pixelAt(bx + dx, by + dy)] = point;
-                            continue;
-                        }
-                    }
-                    // Calls f(sample, layer, member index) for every fragment of the block.
-                    auto forEachFragment = [&](auto&& f) {
-                        for (int py = by; py < y1; ++py)
-                            for (int px = bx; px < x1; ++px) {
-                                const size_t first = layout.index(px, py, 0);
-                                const size_t m0 =
-                                    static_cast<size_t>((py - by) * block + (px - bx)) * pixelSlots;
-                                for (int k = 0; k < spp; ++k)
-                                    for (int l = 0; l < vis.count[first + k]; ++l)
-                                        f(first + k, l, m0 + static_cast<size_t>(k * layers + l));
-                            }
-                    };
-                    int groupCount = 0;
-                    forEachFragment([&](size_t smp, int l, size_t m) {
-                        const uint32_t o = vis.object[smp * layers + l];
-                        int g = 0;
-                        while (g < groupCount && !(groups[g].object == o && groups[g].layer == l))
-                            ++g;
-                        if (g == groupCount) {
-                            if (groupCount == 64)
-                                g = 0;  // more surfaces than that: merge
-                            else
-                                groups[groupCount++] = {o, l, 0.0f, 0.0f, 0};
-                        }
-                        groups[g].sx += layout.x(smp);
-                        groups[g].sy += layout.y(smp);
-                        ++groups[g].count;
-                        s.member[m] = static_cast<uint8_t>(g);
-                    });
-                    // Each group's point: its centroid, on the facet of the member sample
-                    // nearest to it (the first such, in sample order).
-                    float cx[64], cy[64], best[64];
-                    uint32_t facet[64], pointOf[64];
-                    for (int g = 0; g < groupCount; ++g) {
-                        cx[g] = groups[g].sx / groups[g].count;
-                        cy[g] = groups[g].sy / groups[g].count;
-                        best[g] = 1e30f;
-                        facet[g] = 0;
-                    }
-                    forEachFragment([&](size_t smp, int l, size_t m) {
-                        const int g = s.member[m];
-                        const float dx = layout.x(smp) - cx[g], dy = layout.y(smp) - cy[g];
-                        if (dx * dx + dy * dy < best[g]) {
-                            best[g] = dx * dx + dy * dy;
-                            facet[g] = vis.facet[smp * layers + l];
-                        }
-                    });
-                    for (int g = 0; g < groupCount; ++g)
-                        pointOf[g] = addPoint(groups[g].object, facet[g], cx[g], cy[g]);
-                    forEachFragment([&](size_t smp, int l, size_t m) {
-                        st.fragmentPoint[smp * layers + l - firstSlot] = pointOf[s.member[m]];
-                    });
-                }
-            // Grouped by object (a counting sort), the fragments following their points.
-            const size_t points = s.unsortedObject.size();
-            for (uint32_t o : s.unsortedObject) ++st.objectStart[o + 1];
-            for (size_t o = 0; o < objects; ++o) st.objectStart[o + 1] += st.objectStart[o];
-            st.object.resize(points), st.facet.resize(points);
-            st.x.resize(points), st.y.resize(points);
-            s.cursor.assign(st.objectStart.begin(), st.objectStart.end() - 1);
-            s.permutation.resize(points);
-            for (size_t p = 0; p < points; ++p) {
-                const uint32_t at = s.cursor[s.unsortedObject[p]]++;
-                s.permutation[p] = at;
-                st.object[at] = s.unsortedObject[p];
-                st.facet[at] = s.unsortedFacet[p];
-                st.x[at] = s.unsortedX[p];
-                st.y[at] = s.unsortedY[p];
-            }
-            for (size_t pixel = firstPixel; pixel < endSample / spp; ++pixel) {
-                uint32_t& whole = st.pixelPoint[pixel - firstPixel];
-                if (whole != kNoPoint) {
-                    whole = s.permutation[whole];
-                    continue;
-                }
-                for (size_t smp = pixel * spp; smp < (pixel + 1) * spp; ++smp)
-                    for (int l = 0; l < vis.count[smp]; ++l) {
-                        uint32_t& point = st.fragmentPoint[smp * layers + l - firstSlot];
-                        point = s.permutation[point];
-                    }
-            }
-        }
-        const size_t points = st.object.size();
-        st.color.resize(3 * points);
-        st.opacity.resize(3 * points);
-        st.pending.clear();
-        st.fresh = true;
-        st.built = true;
-    }
+    if (s.costs.size() != objects) s.costs.assign(objects, ObjectFrameCost{});
+    const int row0 = static_cast<int>(band) * options_.bandRows;
+    const BandRange range(*layout_, visibility_.layers, row0,
+                          std::min(layout_->height(), row0 + options_.bandRows));
+    if (!pts.built)
+        buildBandPoints(*layout_, visibility_, range, objects,
+                        {options_.shadingRate, options_.wholePixelShortcut}, pts, s.points);
 
-    // 2. Each object's points in batches; those whose probes lacked tiles stay pending.
-    //    The first time, every point: the batches are runs of the band's own arrays.
     s.batchMissed.resize(kBatch);
     s.stillPending.clear();
-    auto addObjectCosts = [&](size_t o, const SurfaceShadingCounters& counters,
-                              Clock::time_point began) {
-        for (const TileKey& key : s.surface.missing)
-            lacking.push_back({static_cast<uint32_t>(o), key});
-        ObjectFrameCost& cost = s.costs[o];
-        cost.shadeSeconds += secondsSince(began);
-        cost.instructions += counters.instructions;
-        cost.probes += counters.probes;
-        cost.probeFallbacks += counters.fallbacks;
-        s.counters.instructions += counters.instructions;
-        s.counters.nonFinite += counters.nonFinite;
-    };
-    // After a fill, the points still pending (in order, so grouped by object), gathered
-    // into batches and their results scattered back.
-    auto shadePending = [&] {
-        s.batchFacet.resize(kBatch);
-        s.batchX.resize(kBatch), s.batchY.resize(kBatch);
-        s.batchColor.resize(3 * kBatch), s.batchOpacity.resize(3 * kBatch);
-        size_t first = 0;
-        while (first < st.pending.size()) {
-            const uint32_t o = st.object[st.pending[first]];
-            size_t last = first;
-            while (last < st.pending.size() && st.object[st.pending[last]] == o) ++last;
-            const auto began = Clock::now();
-            SurfaceShadingCounters counters;
-            s.surface.missing.clear();
-            for (size_t b = first; b < last; b += kBatch) {
-                const size_t m = std::min(kBatch, last - b);
-                for (size_t i = 0; i < m; ++i) {
-                    const uint32_t p = st.pending[b + i];
-                    s.batchFacet[i] = st.facet[p];
-                    s.batchX[i] = st.x[p];
-                    s.batchY[i] = st.y[p];
-                }
-                const SurfacePoints batch{s.batchFacet.data(), s.batchX.data(), s.batchY.data(), m};
-                const size_t missed = shadeSurfacePoints(
-                    views_[o], options_.probe, !acceptFallbacks, batch, s.batchColor.data(),
-                    s.batchOpacity.data(), s.batchMissed.data(), s.surface, counters);
-                for (size_t i = 0; i < m; ++i) {
-                    const uint32_t p = st.pending[b + i];
-                    if (missed > 0 && s.batchMissed[i]) {
-                        s.stillPending.push_back(p);
-                        continue;
-                    }
-                    for (int k = 0; k < 3; ++k) {
-                        st.color[3 * p + k] = s.batchColor[3 * i + k];
-                        st.opacity[3 * p + k] = s.batchOpacity[3 * i + k];
-                    }
-                }
-            }
-            addObjectCosts(o, counters, began);
-            first = last;
-        }
-    };
-    if (st.fresh) {
-        for (size_t o = 0; o < objects; ++o) {
-            const size_t begin = st.objectStart[o], end = st.objectStart[o + 1];
-            if (begin == end) continue;
-            const auto began = Clock::now();
-            SurfaceShadingCounters counters;
-            s.surface.missing.clear();
-            for (size_t b = begin; b < end; b += kBatch) {
-                const size_t m = std::min(kBatch, end - b);
-                const SurfacePoints batch{&st.facet[b], &st.x[b], &st.y[b], m};
-                const size_t missed = shadeSurfacePoints(
-                    views_[o], options_.probe, !acceptFallbacks, batch, &st.color[3 * b],
-                    &st.opacity[3 * b], s.batchMissed.data(), s.surface, counters);
-                if (missed > 0)
-                    for (size_t i = 0; i < m; ++i)
-                        if (s.batchMissed[i])
-                            s.stillPending.push_back(static_cast<uint32_t>(b + i));
-            }
-            addObjectCosts(o, counters, began);
-        }
-        st.fresh = false;
+    if (pts.fresh) {
+        s.shadeFresh(views_, options_.probe, !acceptFallbacks, pts, lacking);
+        pts.fresh = false;
     } else {
-        shadePending();
+        s.shadePending(views_, options_.probe, !acceptFallbacks, pts, lacking);
     }
-    st.pending.swap(s.stillPending);
-    if (!st.pending.empty()) {
+    pts.pending.swap(s.stillPending);
+    if (!pts.pending.empty()) {
         // Shaded again once the lacking tiles are filled: the band keeps these buffers.
-        if (&st == &s.work) std::swap(s.work, scratch_->states[band]);
+        if (&pts == &s.work) std::swap(s.work, scratch_->states[band]);
         return;
     }
 
-    // 3. Composite every sample front to back over the background; note the pixels whose
-    //    samples all came out alike (the resolve reads those once). A pixel one point
-    //    covers whole has all its samples alike: only its first is composited and written,
-    //    the one the resolve reads (at per-pixel shading, three quarters of the samples'
-    //    passes over memory).
-    const glm::vec3 background = scene_.settings.background;
-    for (size_t pixel = firstPixel; pixel < endSample / spp; ++pixel) {
-        const size_t first = pixel * static_cast<size_t>(spp);
-        if (!st.pixelPoint.empty()) {
-            if (const uint32_t p = st.pixelPoint[pixel - firstPixel]; p != kNoPoint) {
-                SampleComposite c;
-                c.over(&st.color[3 * p], &st.opacity[3 * p]);
-                c.finish(background, &samples_.rgba[4 * first]);
-                uniform_[pixel] = 1;
-                continue;
-            }
-        }
-        for (size_t smp = first; smp < first + spp; ++smp) {
-            SampleComposite c;
-            for (int l = 0; l < vis.count[smp]; ++l) {
-                const uint32_t p = st.fragmentPoint[smp * layers + l - firstSlot];
-                c.over(&st.color[3 * p], &st.opacity[3 * p]);
-            }
-            c.finish(background, &samples_.rgba[4 * smp]);
-        }
-        const float* rgba = &samples_.rgba[4 * first];
-        bool same = true;
-        for (int k = 1; k < spp && same; ++k)
-            same = std::memcmp(rgba, rgba + 4 * k, 4 * sizeof(float)) == 0;
-        uniform_[pixel] = same ? 1 : 0;
-    }
+    compositeBand(pts, range, visibility_, layout_->spp(), scene_.settings.background,
+                  samples_.rgba.data(), uniform_.data());
     for (size_t o = 0; o < objects; ++o)
-        s.costs[o].shadingPoints += st.objectStart[o + 1] - st.objectStart[o];
-    st.built = false;
-    if (&st != &s.work) std::swap(s.work, st);  // its buffers go back to the thread
+        s.costs[o].shadingPoints += pts.objectStart[o + 1] - pts.objectStart[o];
+    pts.built = false;
+    if (&pts != &s.work) std::swap(s.work, pts);  // its buffers go back to the thread
     bandDone_[band] = 1;
 }
 
