@@ -188,6 +188,296 @@ void insertLayer(TileScratch& t, size_t sample, int layers, float z, uint32_t o,
     n = static_cast<uint8_t>(opaque ? pos + 1 : keep + 1);
 }
 
+// The frame's tiles and depth range, as both passes see them.
+struct TileGrid {
+    int width = 0, height = 0, spp = 0, layers = 1, tile = 1, tilesX = 0, tilesY = 0;
+    size_t tileCount = 0;
+    float farInv = 0.0f;  // 1 / the far plane's depth: nearer surfaces have a larger 1/z
+};
+
+// The objects' facets as chunks of whole clusters, so a culled cluster is skipped in one
+// step. Reuses `chunks`; returns how many are in use.
+size_t makeChunks(const std::vector<RasterObject>& objects, std::vector<Chunk>& chunks) {
+    constexpr size_t kFacetsPerChunk = 1 << 15;
+    size_t count = 0;
+    auto add = [&](uint32_t o, size_t begin, size_t end, size_t cb, size_t ce) {
+        if (count == chunks.size()) chunks.emplace_back();
+        Chunk& c = chunks[count++];
+        c.object = o, c.begin = begin, c.end = end, c.clusterBegin = cb, c.clusterEnd = ce;
+    };
+    for (uint32_t o = 0; o < objects.size(); ++o) {
+        if (!objects[o].mesh) continue;
+        const FacetMesh& mesh = *objects[o].mesh;
+        if (mesh.clusters.empty()) {
+            for (size_t f = 0; f < mesh.facetCount(); f += kFacetsPerChunk)
+                add(o, f, std::min(f + kFacetsPerChunk, mesh.facetCount()), 0, 0);
+            continue;
+        }
+        size_t first = 0;
+        while (first < mesh.clusters.size()) {
+            size_t last = first, facets = 0;
+            while (last < mesh.clusters.size() &&
+                   (last == first || facets + mesh.clusters[last].facetCount <= kFacetsPerChunk))
+                facets += mesh.clusters[last++].facetCount;
+            add(o, mesh.clusters[first].firstFacet, mesh.clusters[first].firstFacet + facets, first,
+                last);
+            first = last;
+        }
+    }
+    return count;
+}
+
+// Pass 1: a chunk's facets binned to the tiles their boxes touch (facets crossing the near
+// plane or the guard band clipped first), then sorted by tile.
+class ChunkBinner {
+  public:
+    ChunkBinner(Chunk& c, const RasterObject& obj, const TileGrid& grid)
+        : c_(c), obj_(obj), mesh_(*obj.mesh), w_(*obj.warped), grid_(grid) {}
+
+    void bin(WorkDeadline& deadline) {
+        c_.entries.clear();
+        c_.entryTile.clear();
+        c_.clipped.clear();
+        c_.stats = RasterStats{};
+        c_.longestEdge2 = 0;
+        if (deadline.passed()) {
+            c_.tileStart.assign(grid_.tileCount + 1, 0);
+            return;
+        }
+        c_.stats.facets = c_.end - c_.begin;
+        const uint8_t* visible = obj_.clusterVisible;
+        if (c_.clusterEnd > c_.clusterBegin) {
+            for (size_t k = c_.clusterBegin; k < c_.clusterEnd; ++k) {
+                const FacetCluster& cluster = mesh_.clusters[k];
+                if (visible && !visible[k]) {
+                    c_.stats.facetsInCulledClusters += cluster.facetCount;
+                    continue;
+                }
+                for (size_t f = cluster.firstFacet; f < cluster.firstFacet + cluster.facetCount;
+                     ++f)
+                    binFacet(f);
+            }
+        } else {
+            for (size_t f = c_.begin; f < c_.end; ++f) binFacet(f);
+        }
+        sortByTile();
+    }
+
+  private:
+    void binFacet(size_t f) {
+        const uint32_t* p = &mesh_.positionIndex[3 * f];
+        if (!(w_.culled(p[0]) || w_.culled(p[1]) || w_.culled(p[2]))) {
+            const ScreenTriangle t = screenTriangle(w_, p);
+            if (obj_.longestEdgePixels)
+                for (int i = 0; i < 3; ++i) {
+                    const int64_t dx = t.x[(i + 1) % 3] - t.x[i], dy = t.y[(i + 1) % 3] - t.y[i];
+                    c_.longestEdge2 = std::max(c_.longestEdge2, dx * dx + dy * dy);
+                }
+            binTriangle(t, static_cast<uint32_t>(f), -1);
+            return;
+        }
+        ScreenTriangle pieces[6];
+        const int n = obj_.warp ? clipFacet(*obj_.warp, mesh_, w_, p, pieces) : 0;
+        if (n == 0) {
+            ++c_.stats.facetsCulled;
+            return;
+        }
+        ++c_.stats.facetsClipped;
+        for (int k = 0; k < n; ++k) {
+            const int32_t index = static_cast<int32_t>(c_.clipped.size());
+            c_.clipped.push_back(pieces[k]);
+            binTriangle(pieces[k], static_cast<uint32_t>(f), index);
+        }
+    }
+
+    void binTriangle(const ScreenTriangle& t, uint32_t f, int32_t clip) {
+        const int64_t area = signedArea(t);
+        if (area == 0) {
+            ++c_.stats.facetsDegenerate;
+            return;
+        }
+        // Facets wind counter-clockwise about their normal; the screen's y points down, so a
+        // facet seen from the front has negative area here.
+        if (obj_.cullBackFaces && area > 0) {
+            ++c_.stats.facetsBackFacing;
+            return;
+        }
+        const int32_t minX = std::min({t.x[0], t.x[1], t.x[2]}),
+                      maxX = std::max({t.x[0], t.x[1], t.x[2]});
+        const int32_t minY = std::min({t.y[0], t.y[1], t.y[2]}),
+                      maxY = std::max({t.y[0], t.y[1], t.y[2]});
+        const int x0 = std::max(0, minX >> kSub), y0 = std::max(0, minY >> kSub);
+        const int x1 = std::min(grid_.width - 1, maxX >> kSub),
+                  y1 = std::min(grid_.height - 1, maxY >> kSub);
+        if (x0 > x1 || y0 > y1) return;
+        for (int ty = y0 / grid_.tile; ty <= y1 / grid_.tile; ++ty)
+            for (int tx = x0 / grid_.tile; tx <= x1 / grid_.tile; ++tx) {
+                c_.entryTile.push_back(static_cast<uint32_t>(ty * grid_.tilesX + tx));
+                c_.entries.push_back({f, clip});
+            }
+    }
+
+    // Counting sort by tile, stable: facet order within each tile.
+    void sortByTile() {
+        const size_t tileCount = grid_.tileCount;
+        c_.tileStart.assign(tileCount + 1, 0);
+        for (uint32_t t : c_.entryTile) ++c_.tileStart[t + 1];
+        for (size_t t = 0; t < tileCount; ++t) c_.tileStart[t + 1] += c_.tileStart[t];
+        c_.sorted.resize(c_.entries.size());
+        std::vector<uint32_t>& next = c_.entryTile;  // reused: entries' tiles become cursors
+        for (size_t e = 0; e < c_.entries.size(); ++e) {
+            const uint32_t t = next[e];
+            c_.sorted[c_.tileStart[t]++] = c_.entries[e];
+        }
+        for (size_t t = tileCount; t > 0; --t) c_.tileStart[t] = c_.tileStart[t - 1];
+        c_.tileStart[0] = 0;
+    }
+
+    Chunk& c_;
+    const RasterObject& obj_;
+    const FacetMesh& mesh_;
+    const WarpedVertices& w_;
+    const TileGrid& grid_;
+};
+
+// Pass 2: one tile, every chunk's facets binned to it in order, depth-tested into the
+// frame's buffer (one layer: directly, a tile's row of samples being contiguous there) or
+// into a tile-local k-buffer copied out at the end (several layers).
+class TileRasterizer {
+  public:
+    TileRasterizer(size_t t, const TileGrid& grid, const SampleLayout& samples,
+                   VisibilityBuffer& out, TileScratch& scratch, RasterStats& stats)
+        : grid_(grid),
+          samples_(samples),
+          out_(out),
+          scratch_(scratch),
+          s_(stats),
+          fx_(samples.fixedX()),
+          fy_(samples.fixedY()),
+          tx0_(static_cast<int>(t % grid.tilesX) * grid.tile),
+          ty0_(static_cast<int>(t / grid.tilesX) * grid.tile),
+          tx1_(std::min(grid.width, tx0_ + grid.tile) - 1),
+          ty1_(std::min(grid.height, ty0_ + grid.tile) - 1),
+          rowSamples_(static_cast<size_t>(tx1_ - tx0_ + 1) * grid.spp),
+          direct_(grid.layers == 1),
+          ox_(tx0_ << kSub),
+          oy_(ty0_ << kSub),
+          cornerX_{0.0, static_cast<double>((tx1_ - tx0_ + 1) << kSub)},
+          cornerY_{0.0, static_cast<double>((ty1_ - ty0_ + 1) << kSub)} {}
+
+    void clear() {
+        if (!direct_) {
+            scratch_.prepare(rowSamples_ * static_cast<size_t>(ty1_ - ty0_ + 1), grid_.layers,
+                             grid_.farInv);
+            return;
+        }
+        for (int py = ty0_; py <= ty1_; ++py) {
+            const size_t g = samples_.index(tx0_, py, 0);
+            // The tile's samples and ids, asked for now rather than by whichever facet first
+            // reaches each line: a steady frame's visibility buffer is not in cache, and
+            // small facets' boxes gave the hardware prefetcher no run to follow.
+            // Rasterizing took 2-14% less (courtyard, gallery, teapot at 640x360).
+            for (size_t b = 0; b < rowSamples_; b += 16) {
+                __builtin_prefetch(fx_ + g + b);
+                __builtin_prefetch(fy_ + g + b);
+                __builtin_prefetch(&out_.object[g + b], 1);
+                __builtin_prefetch(&out_.facet[g + b], 1);
+            }
+            std::fill_n(&out_.invDepth[g], rowSamples_, grid_.farInv);
+        }
+    }
+
+    void draw(const ScreenTriangle& tri, uint32_t object, uint32_t facet, bool opaque,
+              const std::vector<uint8_t>& objectOpaque) {
+        Setup su;
+        setUp(tri, ox_, oy_, su);
+        // The edges at the tile's corners: all inside, the tile is covered whole; one wholly
+        // outside, nothing to do.
+        bool whole = true, outside = false;
+        for (int i = 0; i < 3; ++i) {
+            double lo = 1e300, hi = -1e300;
+            for (double cy : cornerY_)
+                for (double cx : cornerX_) {
+                    const double edge = su.c[i] + su.a[i] * cx + su.b[i] * cy;
+                    lo = std::min(lo, edge);
+                    hi = std::max(hi, edge);
+                }
+            whole = whole && lo > 0.0;
+            outside = outside || hi <= 0.0;
+        }
+        if (outside) return;
+        ++s_.facetsBinned;
+        s_.tilesCoveredWhole += whole;
+        const int32_t minX = std::min({tri.x[0], tri.x[1], tri.x[2]}),
+                      maxX = std::max({tri.x[0], tri.x[1], tri.x[2]});
+        const int32_t minY = std::min({tri.y[0], tri.y[1], tri.y[2]}),
+                      maxY = std::max({tri.y[0], tri.y[1], tri.y[2]});
+        const int bx0 = std::max(tx0_, minX >> kSub), by0 = std::max(ty0_, minY >> kSub);
+        const int bx1 = std::min(tx1_, maxX >> kSub), by1 = std::min(ty1_, maxY >> kSub);
+        const int spp = grid_.spp;
+        if (direct_) {
+            const size_t g = samples_.index(bx0, by0, 0);
+            s_.fragments +=
+                boxDepthTest(fx_ + g, fy_ + g, static_cast<size_t>(by1 - by0 + 1),
+                             static_cast<size_t>(bx1 - bx0 + 1) * spp,
+                             static_cast<size_t>(grid_.width) * spp, ox_, oy_, su, !whole,
+                             &out_.invDepth[g], &out_.object[g], &out_.facet[g], object, facet);
+            return;
+        }
+        for (int py = by0; py <= by1; ++py) {
+            const size_t g = samples_.index(bx0, py, 0);
+            const size_t n = static_cast<size_t>(bx1 - bx0 + 1) * spp;
+            const size_t l = static_cast<size_t>(py - ty0_) * rowSamples_ +
+                             static_cast<size_t>(bx0 - tx0_) * spp;
+            for (size_t i = 0; i < n; ++i) {
+                const double lx = fx_[g + i] - ox_, ly = fy_[g + i] - oy_;
+                bool in = true;
+                for (int k = 0; k < 3; ++k) in = in && su.c[k] + su.a[k] * lx + su.b[k] * ly > 0.0;
+                if (!in) continue;
+                const float z = static_cast<float>(su.zc + su.zx * lx + su.zy * ly);
+                if (!(z > grid_.farInv)) continue;
+                ++s_.fragments;
+                insertLayer(scratch_, l + i, grid_.layers, z, object, facet, opaque, objectOpaque,
+                            s_);
+            }
+        }
+    }
+
+    // Out to the frame's buffer, row by row: the sample counts (one layer), or the k-buffer.
+    void finish() {
+        const size_t layers = static_cast<size_t>(grid_.layers);
+        for (int py = ty0_; py <= ty1_; ++py) {
+            const size_t g = samples_.index(tx0_, py, 0);
+            if (direct_) {
+                const float* __restrict inv = &out_.invDepth[g];
+                uint8_t* __restrict count = &out_.count[g];
+                for (size_t i = 0; i < rowSamples_; ++i) count[i] = inv[i] > grid_.farInv ? 1 : 0;
+                continue;
+            }
+            const size_t l = static_cast<size_t>(py - ty0_) * rowSamples_;
+            const size_t gl = g * layers, ll = l * layers, nl = rowSamples_ * layers;
+            std::copy_n(&scratch_.inv[ll], nl, &out_.invDepth[gl]);
+            std::copy_n(&scratch_.object[ll], nl, &out_.object[gl]);
+            std::copy_n(&scratch_.facet[ll], nl, &out_.facet[gl]);
+            std::copy_n(&scratch_.count[l], rowSamples_, &out_.count[g]);
+        }
+    }
+
+  private:
+    const TileGrid& grid_;
+    const SampleLayout& samples_;
+    VisibilityBuffer& out_;
+    TileScratch& scratch_;
+    RasterStats& s_;
+    const int32_t* fx_;
+    const int32_t* fy_;
+    const int tx0_, ty0_, tx1_, ty1_;
+    const size_t rowSamples_;
+    const bool direct_;
+    const int32_t ox_, oy_;
+    const double cornerX_[2], cornerY_[2];
+};
+
 }  // namespace
 
 struct FacetRasterizer::State {
@@ -205,187 +495,34 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
                                 const RasterOptions& options, VisibilityBuffer& out,
                                 RasterStats& stats) {
     State& st = *state_;
-    const int width = samples.width(), height = samples.height(), spp = samples.spp();
     bool allOpaque = true;
     st.objectOpaque.resize(objects.size());
     for (size_t o = 0; o < objects.size(); ++o) {
         st.objectOpaque[o] = objects[o].opaque ? 1 : 0;
         allOpaque = allOpaque && objects[o].opaque;
     }
-    const int layers = allOpaque ? 1 : std::clamp(options.layers, 1, 255);
-    out.resize(width, height, spp, layers);
-    const int tile = std::clamp(options.tileSize, 1, 256);
-    const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;
-    const size_t tileCount = static_cast<size_t>(tilesX) * tilesY;
-    const float farInv = farDepth > 0.0f && std::isfinite(farDepth) ? 1.0f / farDepth : 0.0f;
-
-    // Chunks: whole clusters per chunk, so a culled cluster is skipped in one step.
-    constexpr size_t kFacetsPerChunk = 1 << 15;
-    size_t chunkCount = 0;
-    auto addChunk = [&](uint32_t o, size_t begin, size_t end, size_t cb, size_t ce) {
-        if (chunkCount == st.chunks.size()) st.chunks.emplace_back();
-        Chunk& c = st.chunks[chunkCount++];
-        c.object = o, c.begin = begin, c.end = end, c.clusterBegin = cb, c.clusterEnd = ce;
-    };
-    for (uint32_t o = 0; o < objects.size(); ++o) {
-        if (!objects[o].mesh) continue;
-        const FacetMesh& mesh = *objects[o].mesh;
-        if (mesh.clusters.empty()) {
-            for (size_t f = 0; f < mesh.facetCount(); f += kFacetsPerChunk)
-                addChunk(o, f, std::min(f + kFacetsPerChunk, mesh.facetCount()), 0, 0);
-            continue;
-        }
-        size_t first = 0;
-        while (first < mesh.clusters.size()) {
-            size_t last = first, facets = 0;
-            while (last < mesh.clusters.size() &&
-                   (last == first || facets + mesh.clusters[last].facetCount <= kFacetsPerChunk))
-                facets += mesh.clusters[last++].facetCount;
-            addChunk(o, mesh.clusters[first].firstFacet, mesh.clusters[first].firstFacet + facets,
-                     first, last);
-            first = last;
-        }
-    }
+    TileGrid grid;
+    grid.width = samples.width(), grid.height = samples.height(), grid.spp = samples.spp();
+    grid.layers = allOpaque ? 1 : std::clamp(options.layers, 1, 255);
+    out.resize(grid.width, grid.height, grid.spp, grid.layers);
+    grid.tile = std::clamp(options.tileSize, 1, 256);
+    grid.tilesX = (grid.width + grid.tile - 1) / grid.tile;
+    grid.tilesY = (grid.height + grid.tile - 1) / grid.tile;
+    grid.tileCount = static_cast<size_t>(grid.tilesX) * grid.tilesY;
+    grid.farInv = farDepth > 0.0f && std::isfinite(farDepth) ? 1.0f / farDepth : 0.0f;
+    const size_t chunkCount = makeChunks(objects, st.chunks);
 
     // Checked once per chunk and per tile: a clock read costs far less than either.
     WorkDeadline deadline(options.deadline);
-
-    // 1. Bin.
     tbb::parallel_for(size_t{0}, chunkCount, [&](size_t ci) {
         Chunk& c = st.chunks[ci];
-        const RasterObject& obj = objects[c.object];
-        const FacetMesh& mesh = *obj.mesh;
-        const WarpedVertices& w = *obj.warped;
-        c.entries.clear();
-        c.entryTile.clear();
-        c.clipped.clear();
-        c.stats = RasterStats{};
-        c.longestEdge2 = 0;
-        if (deadline.passed()) {
-            c.tileStart.assign(tileCount + 1, 0);
-            return;
-        }
-        const bool measure = obj.longestEdgePixels != nullptr;
-        RasterStats& s = c.stats;
-        s.facets = c.end - c.begin;
-        auto binTriangle = [&](const ScreenTriangle& t, uint32_t f, int32_t clip) {
-            const int64_t area = signedArea(t);
-            if (area == 0) {
-                ++s.facetsDegenerate;
-                return;
-            }
-            // Facets wind counter-clockwise about their normal; the screen's y points
-            // down, so a facet seen from the front has negative area here.
-            if (obj.cullBackFaces && area > 0) {
-                ++s.facetsBackFacing;
-                return;
-            }
-            const int32_t minX = std::min({t.x[0], t.x[1], t.x[2]}),
-                          maxX = std::max({t.x[0], t.x[1], t.x[2]});
-            const int32_t minY = std::min({t.y[0], t.y[1], t.y[2]}),
-                          maxY = std::max({t.y[0], t.y[1], t.y[2]});
-            const int x0 = std::max(0, minX >> kSub), y0 = std::max(0, minY >> kSub);
-            const int x1 = std::min(width - 1, maxX >> kSub),
-                      y1 = std::min(height - 1, maxY >> kSub);
-            if (x0 > x1 || y0 > y1) return;
-            for (int ty = y0 / tile; ty <= y1 / tile; ++ty)
-                for (int tx = x0 / tile; tx <= x1 / tile; ++tx) {
-                    c.entryTile.push_back(static_cast<uint32_t>(ty * tilesX + tx));
-                    c.entries.push_back({f, clip});
-                }
-        };
-        auto binFacet = [&](size_t f) {
-            const uint32_t* p = &mesh.positionIndex[3 * f];
-            if (!(w.culled(p[0]) || w.culled(p[1]) || w.culled(p[2]))) {
-                const ScreenTriangle t = screenTriangle(w, p);
-                if (measure)
-                    for (int i = 0; i < 3; ++i) {
-                        const int64_t dx = t.x[(i + 1) % 3] - t.x[i],
-                                      dy = t.y[(i + 1) % 3] - t.y[i];
-                        c.longestEdge2 = std::max(c.longestEdge2, dx * dx + dy * dy);
-                    }
-                binTriangle(t, static_cast<uint32_t>(f), -1);
-                return;
-            }
-            ScreenTriangle pieces[6];
-            const int n = obj.warp ? clipFacet(*obj.warp, mesh, w, p, pieces) : 0;
-            if (n == 0) {
-                ++s.facetsCulled;
-                return;
-            }
-            ++s.facetsClipped;
-            for (int k = 0; k < n; ++k) {
-                const int32_t index = static_cast<int32_t>(c.clipped.size());
-                c.clipped.push_back(pieces[k]);
-                binTriangle(pieces[k], static_cast<uint32_t>(f), index);
-            }
-        };
-        const uint8_t* visible = obj.clusterVisible;
-        if (c.clusterEnd > c.clusterBegin) {
-            for (size_t k = c.clusterBegin; k < c.clusterEnd; ++k) {
-                const FacetCluster& cluster = mesh.clusters[k];
-                if (visible && !visible[k]) {
-                    s.facetsInCulledClusters += cluster.facetCount;
-                    continue;
-                }
-                for (size_t f = cluster.firstFacet; f < cluster.firstFacet + cluster.facetCount;
-                     ++f)
-                    binFacet(f);
-            }
-        } else {
-            for (size_t f = c.begin; f < c.end; ++f) binFacet(f);
-        }
-        // Counting sort by tile, stable: facet order within each tile.
-        c.tileStart.assign(tileCount + 1, 0);
-        for (uint32_t t : c.entryTile) ++c.tileStart[t + 1];
-        for (size_t t = 0; t < tileCount; ++t) c.tileStart[t + 1] += c.tileStart[t];
-        c.sorted.resize(c.entries.size());
-        std::vector<uint32_t>& next = c.entryTile;  // reused: entries' tiles become cursors
-        for (size_t e = 0; e < c.entries.size(); ++e) {
-            const uint32_t t = next[e];
-            c.sorted[c.tileStart[t]++] = c.entries[e];
-        }
-        for (size_t t = tileCount; t > 0; --t) c.tileStart[t] = c.tileStart[t - 1];
-        c.tileStart[0] = 0;
+        ChunkBinner(c, objects[c.object], grid).bin(deadline);
     });
-
-    // 2. Rasterize tiles in parallel.
     for (RasterStats& s : st.tileStats) s = RasterStats{};
-    const int32_t* fx = samples.fixedX();
-    const int32_t* fy = samples.fixedY();
-    tbb::parallel_for(size_t{0}, deadline.passed() ? size_t{0} : tileCount, [&](size_t t) {
+    tbb::parallel_for(size_t{0}, deadline.passed() ? size_t{0} : grid.tileCount, [&](size_t t) {
         if (deadline.passed()) return;
-        RasterStats& s = st.tileStats.local();
-        TileScratch& scratch = st.scratch.local();
-        const int tx0 = static_cast<int>(t % tilesX) * tile,
-                  ty0 = static_cast<int>(t / tilesX) * tile;
-        const int tx1 = std::min(width, tx0 + tile) - 1, ty1 = std::min(height, ty0 + tile) - 1;
-        const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
-        const size_t rowSamples = static_cast<size_t>(tw) * spp;
-        // One layer: straight into the frame's buffer (a tile's row of samples is
-        // contiguous there); several: a tile-local k-buffer, copied out at the end.
-        const bool direct = layers == 1;
-        if (direct) {
-            for (int py = ty0; py <= ty1; ++py) {
-                const size_t g = samples.index(tx0, py, 0);
-                // The tile's samples and ids, asked for now rather than by whichever facet
-                // first reaches each line: a steady frame's visibility buffer is not in cache,
-                // and small facets' boxes gave the hardware prefetcher no run to follow.
-                // Rasterizing took 2-14% less (courtyard, gallery, teapot at 640x360).
-                for (size_t b = 0; b < rowSamples; b += 16) {
-                    __builtin_prefetch(fx + g + b);
-                    __builtin_prefetch(fy + g + b);
-                    __builtin_prefetch(&out.object[g + b], 1);
-                    __builtin_prefetch(&out.facet[g + b], 1);
-                }
-                std::fill_n(&out.invDepth[g], rowSamples, farInv);
-            }
-        } else {
-            scratch.prepare(rowSamples * th, layers, farInv);
-        }
-        const int32_t ox = tx0 << kSub, oy = ty0 << kSub;
-        const double cornerX[2] = {0.0, static_cast<double>(tw << kSub)};
-        const double cornerY[2] = {0.0, static_cast<double>(th << kSub)};
+        TileRasterizer tile(t, grid, samples, out, st.scratch.local(), st.tileStats.local());
+        tile.clear();
         for (size_t ci = 0; ci < chunkCount; ++ci) {
             const Chunk& c = st.chunks[ci];
             const RasterObject& obj = objects[c.object];
@@ -396,78 +533,12 @@ void FacetRasterizer::rasterize(const std::vector<RasterObject>& objects,
                         ? c.clipped[static_cast<size_t>(item.clip)]
                         : screenTriangle(*obj.warped,
                                          &obj.mesh->positionIndex[3 * size_t{item.facet}]);
-                Setup su;
-                setUp(tri, ox, oy, su);
-                // The edges at the tile's corners: all inside, the tile is covered whole;
-                // one wholly outside, nothing to do.
-                bool whole = true, outside = false;
-                for (int i = 0; i < 3; ++i) {
-                    double lo = 1e300, hi = -1e300;
-                    for (double cy : cornerY)
-                        for (double cx : cornerX) {
-                            const double edge = su.c[i] + su.a[i] * cx + su.b[i] * cy;
-                            lo = std::min(lo, edge);
-                            hi = std::max(hi, edge);
-                        }
-                    whole = whole && lo > 0.0;
-                    outside = outside || hi <= 0.0;
-                }
-                if (outside) continue;
-                ++s.facetsBinned;
-                s.tilesCoveredWhole += whole;
-                const int32_t minX = std::min({tri.x[0], tri.x[1], tri.x[2]}),
-                              maxX = std::max({tri.x[0], tri.x[1], tri.x[2]});
-                const int32_t minY = std::min({tri.y[0], tri.y[1], tri.y[2]}),
-                              maxY = std::max({tri.y[0], tri.y[1], tri.y[2]});
-                const int bx0 = std::max(tx0, minX >> kSub), by0 = std::max(ty0, minY >> kSub);
-                const int bx1 = std::min(tx1, maxX >> kSub), by1 = std::min(ty1, maxY >> kSub);
-                if (direct) {
-                    const size_t g = samples.index(bx0, by0, 0);
-                    s.fragments += boxDepthTest(fx + g, fy + g, static_cast<size_t>(by1 - by0 + 1),
-                                                static_cast<size_t>(bx1 - bx0 + 1) * spp,
-                                                static_cast<size_t>(width) * spp, ox, oy, su,
-                                                !whole, &out.invDepth[g], &out.object[g],
-                                                &out.facet[g], c.object, item.facet);
-                    continue;
-                }
-                for (int py = by0; py <= by1; ++py) {
-                    const size_t g = samples.index(bx0, py, 0);
-                    const size_t n = static_cast<size_t>(bx1 - bx0 + 1) * spp;
-                    const size_t l = static_cast<size_t>(py - ty0) * rowSamples +
-                                     static_cast<size_t>(bx0 - tx0) * spp;
-                    for (size_t i = 0; i < n; ++i) {
-                        const double lx = fx[g + i] - ox, ly = fy[g + i] - oy;
-                        bool in = true;
-                        for (int k = 0; k < 3; ++k)
-                            in = in && su.c[k] + su.a[k] * lx + su.b[k] * ly > 0.0;
-                        if (!in) continue;
-                        const float z = static_cast<float>(su.zc + su.zx * lx + su.zy * ly);
-                        if (!(z > farInv)) continue;
-                        ++s.fragments;
-                        insertLayer(scratch, l + i, layers, z, c.object, item.facet, obj.opaque,
-                                    st.objectOpaque, s);
-                    }
-                }
+                tile.draw(tri, c.object, item.facet, obj.opaque, st.objectOpaque);
             }
         }
-        // Out to the frame's buffer, row by row.
-        for (int py = ty0; py <= ty1; ++py) {
-            const size_t g = samples.index(tx0, py, 0);
-            if (direct) {
-                const float* __restrict inv = &out.invDepth[g];
-                uint8_t* __restrict count = &out.count[g];
-                for (size_t i = 0; i < rowSamples; ++i) count[i] = inv[i] > farInv ? 1 : 0;
-                continue;
-            }
-            const size_t l = static_cast<size_t>(py - ty0) * rowSamples;
-            const size_t gl = g * static_cast<size_t>(layers), ll = l * static_cast<size_t>(layers);
-            const size_t nl = rowSamples * static_cast<size_t>(layers);
-            std::copy_n(&scratch.inv[ll], nl, &out.invDepth[gl]);
-            std::copy_n(&scratch.object[ll], nl, &out.object[gl]);
-            std::copy_n(&scratch.facet[ll], nl, &out.facet[gl]);
-            std::copy_n(&scratch.count[l], rowSamples, &out.count[g]);
-        }
+        tile.finish();
     });
+
     stats = RasterStats{};
     stats.abandoned = deadline.missed();
     for (const RasterObject& obj : objects)
