@@ -9,40 +9,19 @@
 #include "phases/compositing.h"
 
 namespace mpshade {
-size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, bool stopAtMissing,
-                          const SurfacePoints& points, float* color, float* opacity,
-                          uint8_t* missed, SurfaceShadingScratch& scratch,
-                          SurfaceShadingCounters& counters) {
-    const ObjectRepresentation& rep = *view.rep;
-    const FacetMesh& mesh = rep.mesh;
-    const VertexAttributes& attr = mesh.attributes;
-    const bool useMap = rep.map != nullptr;
-    const size_t n = points.n;
-    const size_t channels =
-        useMap ? static_cast<size_t>(rep.map->channels()) : static_cast<size_t>(mesh.channels);
-    ShadingBatch& batch = scratch.batch;
-    batch.resize(n, channels);
-    if (useMap) scratch.queries.resize(n);
-    float* rows[ShadingBatch::kInputRows];
-    for (int r = 0; r < ShadingBatch::kInputRows; ++r) rows[r] = batch.row(r);
-    const bool readsN = !attr.rows[VertexAttributes::Nx].empty();
-    scratch.b1.resize(n), scratch.b2.resize(n);
-    if (useMap) scratch.derivatives.resize(4 * n);
-    float* __restrict bary1 = scratch.b1.data();
-    float* __restrict bary2 = scratch.b2.data();
-    float* __restrict px = rows[ShadingBatch::P];
-    float* __restrict py = rows[ShadingBatch::P + 1];
-    float* __restrict pz = rows[ShadingBatch::P + 2];
+namespace {
 
-    // 1. Where each point's ray meets its facet: the barycentric weights (and, for a probe,
-    //    their screen derivatives) and P. Per facet (consecutive points mostly share one:
-    //    the samples of a pixel, the pixels of a facet): its corners and the rearranged
-    //    triple products. The loops after this one have no branch on the facet and
-    //    vectorize.
+// Step 1: where each point's ray meets its facet: the barycentric weights (and, for a probe,
+// their screen derivatives, 4 per point) and P. Per facet (consecutive points mostly share
+// one: the samples of a pixel, the pixels of a facet): its corners and the rearranged triple
+// products. The loops after this one have no branch on the facet and vectorize.
+void intersectFacets(const ObjectView& view, const FacetMesh& mesh, const SurfacePoints& points,
+                     float* __restrict bary1, float* __restrict bary2, float* __restrict px,
+                     float* __restrict py, float* __restrict pz, float* __restrict derivatives) {
     size_t facet = ~size_t{0};
     glm::vec3 P0(0.0f), e1(0.0f), e2(0.0f), A1(0.0f), A2(0.0f), Dn(0.0f);
     float dxA1 = 0.0f, dyA1 = 0.0f, dxA2 = 0.0f, dyA2 = 0.0f, dxDn = 0.0f, dyDn = 0.0f;
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = 0; i < points.n; ++i) {
         if (points.facet[i] != facet) {
             facet = points.facet[i];
             const uint32_t* p = &mesh.positionIndex[3 * facet];
@@ -75,136 +54,193 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
         bary1[i] = b1, bary2[i] = b2;
         const glm::vec3 P = P0 + b1 * e1 + b2 * e2;
         px[i] = P.x, py[i] = P.y, pz[i] = P.z;
-        if (useMap) {
-            float* dd = &scratch.derivatives[4 * i];
+        if (derivatives) {
+            float* dd = &derivatives[4 * i];
             dd[0] = db1dx, dd[1] = db1dy, dd[2] = db2dx, dd[3] = db2dy;
         }
     }
+}
 
-    // 2. I, the unit direction from the eye, with one division (divisions dominated this
-    //    function's profile). A point at the eye takes its ray's direction.
-    {
-        float* __restrict ix = rows[ShadingBatch::I];
-        float* __restrict iy = rows[ShadingBatch::I + 1];
-        float* __restrict iz = rows[ShadingBatch::I + 2];
-        const float ex = view.eye.x, ey = view.eye.y, ez = view.eye.z;
-        const Float4 zero = splatFloat4(0.0f), one = splatFloat4(1.0f);
-        const Float4 ex4 = splatFloat4(ex), ey4 = splatFloat4(ey), ez4 = splatFloat4(ez);
-        size_t i = 0;
-        for (; i + 4 <= n; i += 4) {
-            const Float4 tx = loadFloat4(px + i) - ex4, ty = loadFloat4(py + i) - ey4,
-                         tz = loadFloat4(pz + i) - ez4;
-            const Float4 len2 = tx * tx + ty * ty + tz * tz;
-            const Float4 inv = one / sqrtFloat4(len2 > zero ? len2 : one);
-            storeFloat4(ix + i, tx * inv);
-            storeFloat4(iy + i, ty * inv);
-            storeFloat4(iz + i, tz * inv);
-        }
-        for (; i < n; ++i) {
-            const float tx = px[i] - ex, ty = py[i] - ey, tz = pz[i] - ez;
-            const float len2 = tx * tx + ty * ty + tz * tz;
-            const float inv = 1.0f / std::sqrt(len2 > 0.0f ? len2 : 1.0f);
-            ix[i] = tx * inv, iy[i] = ty * inv, iz[i] = tz * inv;
-        }
-        for (size_t k = 0; k < n; ++k)
-            if (!(ix[k] * ix[k] + iy[k] * iy[k] + iz[k] * iz[k] > 0.0f)) {
-                const glm::vec3 I =
-                    glm::normalize(view.d0 + points.x[k] * view.dx + points.y[k] * view.dy);
-                ix[k] = I.x, iy[k] = I.y, iz[k] = I.z;
-            }
+// Step 2: I, the unit direction from the eye, with one division (divisions dominated this
+// function's profile). A point at the eye takes its ray's direction.
+void viewDirections(const ObjectView& view, const SurfacePoints& points, const float* __restrict px,
+                    const float* __restrict py, const float* __restrict pz, float* __restrict ix,
+                    float* __restrict iy, float* __restrict iz) {
+    const size_t n = points.n;
+    const float ex = view.eye.x, ey = view.eye.y, ez = view.eye.z;
+    const Float4 zero = splatFloat4(0.0f), one = splatFloat4(1.0f);
+    const Float4 ex4 = splatFloat4(ex), ey4 = splatFloat4(ey), ez4 = splatFloat4(ez);
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const Float4 tx = loadFloat4(px + i) - ex4, ty = loadFloat4(py + i) - ey4,
+                     tz = loadFloat4(pz + i) - ez4;
+        const Float4 len2 = tx * tx + ty * ty + tz * tz;
+        const Float4 inv = one / sqrtFloat4(len2 > zero ? len2 : one);
+        storeFloat4(ix + i, tx * inv);
+        storeFloat4(iy + i, ty * inv);
+        storeFloat4(iz + i, tz * inv);
     }
+    for (; i < n; ++i) {
+        const float tx = px[i] - ex, ty = py[i] - ey, tz = pz[i] - ez;
+        const float len2 = tx * tx + ty * ty + tz * tz;
+        const float inv = 1.0f / std::sqrt(len2 > 0.0f ? len2 : 1.0f);
+        ix[i] = tx * inv, iy[i] = ty * inv, iz[i] = tz * inv;
+    }
+    for (size_t k = 0; k < n; ++k)
+        if (!(ix[k] * ix[k] + iy[k] * iy[k] + iz[k] * iz[k] > 0.0f)) {
+            const glm::vec3 I =
+                glm::normalize(view.d0 + points.x[k] * view.dx + points.y[k] * view.dy);
+            ix[k] = I.x, iy[k] = I.y, iz[k] = I.z;
+        }
+}
 
-    // 3. The facet's vertex attributes at the weights, a row at a time.
+// Step 3: a vertex attribute row at each point's weights.
+void interpolateRow(const uint32_t* __restrict attributeIndex, const SurfacePoints& points,
+                    const float* __restrict bary1, const float* __restrict bary2,
+                    const float* __restrict r, float* __restrict out) {
+    for (size_t i = 0; i < points.n; ++i) {
+        const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[i])];
+        const float b1 = bary1[i], b2 = bary2[i];
+        out[i] = (1.0f - b1 - b2) * r[a[0]] + b1 * r[a[1]] + b2 * r[a[2]];
+    }
+}
+
+// Interpolated normals back to unit length (a zero one stays zero).
+void normalizeRows(size_t n, float* __restrict nx, float* __restrict ny, float* __restrict nz) {
+    const Float4 zero = splatFloat4(0.0f), one = splatFloat4(1.0f);
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const Float4 x = loadFloat4(nx + i), y = loadFloat4(ny + i), z = loadFloat4(nz + i);
+        const Float4 l2 = x * x + y * y + z * z;
+        const Float4 inv = l2 > zero ? one / sqrtFloat4(l2 > zero ? l2 : one) : one;
+        storeFloat4(nx + i, x * inv);
+        storeFloat4(ny + i, y * inv);
+        storeFloat4(nz + i, z * inv);
+    }
+    for (; i < n; ++i) {
+        const float l2 = nx[i] * nx[i] + ny[i] * ny[i] + nz[i] * nz[i];
+        const float inv = l2 > 0.0f ? 1.0f / std::sqrt(l2 > 0.0f ? l2 : 1.0f) : 1.0f;
+        nx[i] *= inv, ny[i] *= inv, nz[i] *= inv;
+    }
+}
+
+// Step 4, with a shader map: each point's chart point and its footprint (the weights'
+// screen derivatives carried to the chart, times footprintScale).
+void chartQueries(const ObjectView& view, const FacetMesh& mesh, const SurfacePoints& points,
+                  const float* __restrict bary1, const float* __restrict bary2,
+                  const float* __restrict dd, ProbeQuery* queries) {
+    const float s = view.footprintScale;
     const uint32_t* const attributeIndex = mesh.attributeIndex.data();
-    auto interpolate = [&](const float* __restrict r, float* __restrict out) {
-        for (size_t i = 0; i < n; ++i) {
-            const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[i])];
-            const float b1 = bary1[i], b2 = bary2[i];
-            out[i] = (1.0f - b1 - b2) * r[a[0]] + b1 * r[a[1]] + b2 * r[a[2]];
-        }
-    };
-    for (int row : rep.geometryRows)
-        interpolate(attr.rows[static_cast<size_t>(row)].data(),
-                    rows[row < VertexAttributes::U ? row : row + 3]);
-    if (readsN) {
-        float* __restrict nx = rows[ShadingBatch::N];
-        float* __restrict ny = rows[ShadingBatch::N + 1];
-        float* __restrict nz = rows[ShadingBatch::N + 2];
-        const Float4 zero = splatFloat4(0.0f), one = splatFloat4(1.0f);
-        size_t i = 0;
-        for (; i + 4 <= n; i += 4) {
-            const Float4 x = loadFloat4(nx + i), y = loadFloat4(ny + i), z = loadFloat4(nz + i);
-            const Float4 l2 = x * x + y * y + z * z;
-            const Float4 inv = l2 > zero ? one / sqrtFloat4(l2 > zero ? l2 : one) : one;
-            storeFloat4(nx + i, x * inv);
-            storeFloat4(ny + i, y * inv);
-            storeFloat4(nz + i, z * inv);
-        }
-        for (; i < n; ++i) {
-            const float l2 = nx[i] * nx[i] + ny[i] * ny[i] + nz[i] * nz[i];
-            const float inv = l2 > 0.0f ? 1.0f / std::sqrt(l2 > 0.0f ? l2 : 1.0f) : 1.0f;
-            nx[i] *= inv, ny[i] *= inv, nz[i] *= inv;
-        }
+    for (size_t i = 0; i < points.n; ++i) {
+        const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[i])];
+        const ChartPoint& c0 = mesh.attributeChartPoint[a[0]];
+        const ChartPoint& c1 = mesh.attributeChartPoint[a[1]];
+        const ChartPoint& c2 = mesh.attributeChartPoint[a[2]];
+        const float du1 = c1.u - c0.u, du2 = c2.u - c0.u, dv1 = c1.v - c0.v, dv2 = c2.v - c0.v;
+        const float b1 = bary1[i], b2 = bary2[i];
+        const float* d = dd + 4 * i;
+        ProbeQuery& q = queries[i];
+        q.chart = c0.chart;
+        q.u = c0.u + b1 * du1 + b2 * du2;
+        q.v = c0.v + b1 * dv1 + b2 * dv2;
+        q.dudx = s * (du1 * d[0] + du2 * d[2]);
+        q.dudy = s * (du1 * d[1] + du2 * d[3]);
+        q.dvdx = s * (dv1 * d[0] + dv2 * d[2]);
+        q.dvdy = s * (dv1 * d[1] + dv2 * d[3]);
     }
+}
 
-    // 4. The n-tuple: the chart point and its footprint for the probe, or the facet's.
+// Step 5: the static n-tuple probed from the map into the batch's channels; the tiles the
+// probes lacked added to scratch.missing, sorted and without repeats. Returns how many
+// probes lacked a tile when stopping at missing ones (those points marked in `missed`).
+size_t probeChannels(const ShaderMap& map, const ProbeOptions& probe, bool stopAtMissing, size_t n,
+                     size_t channels, uint8_t* missed, SurfaceShadingScratch& scratch,
+                     SurfaceShadingCounters& counters) {
+    scratch.probed.resize(n * channels);
+    scratch.lacking.resize(8192);
+    ProbeResidency residency;
+    residency.missing = scratch.lacking.data();
+    residency.capacity = scratch.lacking.size();
+    residency.stopAtMissing = stopAtMissing;
+    residency.queryMissed = stopAtMissing ? missed : nullptr;
+    probeShaderMap(map, probe, {scratch.queries.data(), n}, scratch.probed.data(), &residency);
+    counters.probes += residency.bilinearProbes;
+    counters.fallbacks += residency.fallbacks;
+    counters.missingProbes += residency.missingProbes;
+    if (residency.count > 0) {
+        auto packedLess = [](const TileKey& x, const TileKey& y) {
+            return x.packed() < y.packed();
+        };
+        const auto first = scratch.lacking.begin();
+        const auto last = first + static_cast<std::ptrdiff_t>(residency.count);
+        std::sort(first, last, packedLess);
+        const auto end = std::unique(first, last);
+        for (auto it = first; it != end; ++it)
+            if (scratch.missing.empty() || !(scratch.missing.back() == *it))
+                scratch.missing.push_back(*it);
+    }
+    ShadingBatch& batch = scratch.batch;
+    for (size_t c = 0; c < channels; ++c) {
+        float* dst = batch.channel(c);
+        for (size_t i = 0; i < n; ++i) dst[i] = scratch.probed[i * channels + c];
+    }
+    return stopAtMissing ? residency.missingProbes : 0;
+}
+
+}  // namespace
+
+// Steps 1-5 fill the dynamic shader's inputs; step 6 runs it and makes its results finite.
+size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, bool stopAtMissing,
+                          const SurfacePoints& points, float* color, float* opacity,
+                          uint8_t* missed, SurfaceShadingScratch& scratch,
+                          SurfaceShadingCounters& counters) {
+    const ObjectRepresentation& rep = *view.rep;
+    const FacetMesh& mesh = rep.mesh;
+    const VertexAttributes& attr = mesh.attributes;
+    const bool useMap = rep.map != nullptr;
+    const size_t n = points.n;
+    const size_t channels =
+        useMap ? static_cast<size_t>(rep.map->channels()) : static_cast<size_t>(mesh.channels);
+    ShadingBatch& batch = scratch.batch;
+    batch.resize(n, channels);
+    if (useMap) scratch.queries.resize(n);
+    float* rows[ShadingBatch::kInputRows];
+    for (int r = 0; r < ShadingBatch::kInputRows; ++r) rows[r] = batch.row(r);
+    scratch.b1.resize(n), scratch.b2.resize(n);
+    if (useMap) scratch.derivatives.resize(4 * n);
+    const float* bary1 = scratch.b1.data();
+    const float* bary2 = scratch.b2.data();
+    const float* px = rows[ShadingBatch::P];
+    const float* py = rows[ShadingBatch::P + 1];
+    const float* pz = rows[ShadingBatch::P + 2];
+
+    intersectFacets(view, mesh, points, scratch.b1.data(), scratch.b2.data(), rows[ShadingBatch::P],
+                    rows[ShadingBatch::P + 1], rows[ShadingBatch::P + 2],
+                    useMap ? scratch.derivatives.data() : nullptr);
+    viewDirections(view, points, px, py, pz, rows[ShadingBatch::I], rows[ShadingBatch::I + 1],
+                   rows[ShadingBatch::I + 2]);
+    const uint32_t* const attributeIndex = mesh.attributeIndex.data();
+    for (int row : rep.geometryRows)
+        interpolateRow(attributeIndex, points, bary1, bary2,
+                       attr.rows[static_cast<size_t>(row)].data(),
+                       rows[row < VertexAttributes::U ? row : row + 3]);
+    if (!attr.rows[VertexAttributes::Nx].empty())
+        normalizeRows(n, rows[ShadingBatch::N], rows[ShadingBatch::N + 1],
+                      rows[ShadingBatch::N + 2]);
     if (useMap) {
-        const float s = view.footprintScale;
-        const float* __restrict dd = scratch.derivatives.data();
-        for (size_t i = 0; i < n; ++i) {
-            const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[i])];
-            const ChartPoint& c0 = mesh.attributeChartPoint[a[0]];
-            const ChartPoint& c1 = mesh.attributeChartPoint[a[1]];
-            const ChartPoint& c2 = mesh.attributeChartPoint[a[2]];
-            const float du1 = c1.u - c0.u, du2 = c2.u - c0.u, dv1 = c1.v - c0.v, dv2 = c2.v - c0.v;
-            const float b1 = bary1[i], b2 = bary2[i];
-            const float* d = dd + 4 * i;
-            ProbeQuery& q = scratch.queries[i];
-            q.chart = c0.chart;
-            q.u = c0.u + b1 * du1 + b2 * du2;
-            q.v = c0.v + b1 * dv1 + b2 * dv2;
-            q.dudx = s * (du1 * d[0] + du2 * d[2]);
-            q.dudy = s * (du1 * d[1] + du2 * d[3]);
-            q.dvdx = s * (dv1 * d[0] + dv2 * d[2]);
-            q.dvdy = s * (dv1 * d[1] + dv2 * d[3]);
-        }
+        chartQueries(view, mesh, points, bary1, bary2, scratch.derivatives.data(),
+                     scratch.queries.data());
     } else {
         for (size_t c = 0; c < channels; ++c)
-            interpolate(attr.rows[VertexAttributes::kGeometryRows + c].data(), batch.channel(c));
+            interpolateRow(attributeIndex, points, bary1, bary2,
+                           attr.rows[VertexAttributes::kGeometryRows + c].data(), batch.channel(c));
     }
-    size_t missedCount = 0;
     if (stopAtMissing && missed) std::fill(missed, missed + n, uint8_t{0});
-    if (useMap && channels > 0) {
-        scratch.probed.resize(n * channels);
-        scratch.lacking.resize(8192);
-        ProbeResidency residency;
-        residency.missing = scratch.lacking.data();
-        residency.capacity = scratch.lacking.size();
-        residency.stopAtMissing = stopAtMissing;
-        residency.queryMissed = stopAtMissing ? missed : nullptr;
-        probeShaderMap(*rep.map, probe, {scratch.queries.data(), n}, scratch.probed.data(),
-                       &residency);
-        counters.probes += residency.bilinearProbes;
-        counters.fallbacks += residency.fallbacks;
-        counters.missingProbes += residency.missingProbes;
-        if (residency.count > 0) {
-            auto packedLess = [](const TileKey& x, const TileKey& y) {
-                return x.packed() < y.packed();
-            };
-            const auto first = scratch.lacking.begin();
-            const auto last = first + static_cast<std::ptrdiff_t>(residency.count);
-            std::sort(first, last, packedLess);
-            const auto end = std::unique(first, last);
-            for (auto it = first; it != end; ++it)
-                if (scratch.missing.empty() || !(scratch.missing.back() == *it))
-                    scratch.missing.push_back(*it);
-        }
-        if (stopAtMissing && residency.missingProbes > 0) missedCount = residency.missingProbes;
-        for (size_t c = 0; c < channels; ++c) {
-            float* dst = batch.channel(c);
-            for (size_t i = 0; i < n; ++i) dst[i] = scratch.probed[i * channels + c];
-        }
-    }
+    size_t missedCount = 0;
+    if (useMap && channels > 0)
+        missedCount =
+            probeChannels(*rep.map, probe, stopAtMissing, n, channels, missed, scratch, counters);
+
     ShadingCounters shading;
     rep.dynamicKernel->run(*view.uniforms, batch.in, n, batch.out, scratch.workspace, shading);
     counters.instructions += shading.instructions;
