@@ -107,7 +107,8 @@ int runPlayCommand(const PlayCommandOptions& options) {
     const FrameRequest request =
         loadFrameRequest({options.scene, options.frames, options.size, options.spp, options.seed});
     const Scene& scene = request.scene;
-    const int width = request.width, height = request.height, spp = request.spp;
+    const int width = request.resolved.width, height = request.resolved.height,
+              spp = request.resolved.samplesPerPixel;
     PlaybackOptions po;
     po.fps = options.fps;
     po.render = request.render;

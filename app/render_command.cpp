@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/command_line.h"
+#include "app/frame_request.h"
 #include "app/frame_stats_json.h"
 #include "app/image_output.h"
 #include "app/interrupt_watch.h"
@@ -54,9 +55,8 @@ class ProgressBar {
     int lastPercent_ = -1, lastFrame_ = -1, first_ = 0;
 };
 
-}  // namespace
-
-int runRenderCommand(const RenderCommandOptions& options) {
+// The options no scene is needed to check.
+void checkRenderOptions(const RenderCommandOptions& options) {
     if (options.mode != "reference" && options.mode != "multiphase")
         throw InputError({"--mode", 0, 0, {}},
                          "unknown mode '" + options.mode + "' (available: reference, multiphase)");
@@ -68,84 +68,104 @@ int runRenderCommand(const RenderCommandOptions& options) {
     if (options.truthSpp != -1 && (options.truthSpp < 1 || options.truthSpp > 1024))
         throw InputError({"--truth-spp", 0, 0, {}},
                          "expected 1..1024, found " + std::to_string(options.truthSpp));
-    if (options.spp != -1 && (options.spp < 1 || options.spp > 1024))
-        throw InputError({"--spp", 0, 0, {}},
-                         "expected 1..1024, found " + std::to_string(options.spp));
-    const Scene scene = loadScene(options.scene);
-    RenderOptions render;
-    render.seed = options.seed;
-    render.samplesPerPixel = options.spp > 0 ? options.spp : 0;
-    parseImageSize(options.size, render.width, render.height);
-    int first, last;
-    parseFrameRange(options.frames, scene.frameCount(), first, last);
-    const bool multiphase = options.mode == "multiphase";
     if (options.memoryMb < 0)
         throw InputError({"--memory-mb", 0, 0, {}}, "expected a positive number of MB");
-    const uint64_t memoryLimit = options.memoryMb > 0
-                                     ? static_cast<uint64_t>(options.memoryMb) << 20
-                                     : defaultMemoryLimitBytes();
-    // The frame as rendered: the options over the scene's settings.
-    const int width = render.width > 0 ? render.width : scene.settings.width;
-    const int height = render.height > 0 ? render.height : scene.settings.height;
-    const int spp =
-        render.samplesPerPixel > 0 ? render.samplesPerPixel : scene.settings.samplesPerPixel;
-    {
-        FrameMemoryEstimate estimate = estimateFrameMemory(
-            width, height, spp, multiphase, !multiphase || options.compare, options.truthSpp);
-        const uint64_t rays = estimateRaySceneBytes(scene, !multiphase || options.compare);
-        const bool raysDominate = rays > estimate.bytes;
-        estimate.bytes += rays;
-        if (raysDominate) {
-            estimate.what +=
-                " and the ray queries of " + std::to_string(scene.objects.size()) + " objects";
-            estimate.hint = "fewer distinct shapes (equal ones share)";
-        }
-        checkMemory(estimate, memoryLimit,
-                    raysDominate                               ? options.scene + ": objects"
-                    : !options.size.empty() || options.spp > 0 ? "--size/--spp"
-                                                               : options.scene + ": settings");
-    }
+}
 
+// The multi-phase renderer's options from the command's.
+MultiphaseOptions multiphaseOptions(const RenderCommandOptions& options) {
+    MultiphaseOptions mo;
+    if (!options.shadingRate.empty()) {
+        if (options.shadingRate == "sample")
+            mo.shadingRate = ShadingRate::Sample;
+        else if (options.shadingRate == "pixel")
+            mo.shadingRate = ShadingRate::Pixel;
+        else if (options.shadingRate == "quad")
+            mo.shadingRate = ShadingRate::Quad;
+        else
+            throw InputError({"--shading-rate", 0, 0, {}},
+                             "expected sample, pixel or quad, found '" + options.shadingRate + "'");
+    }
+    if (options.footprintScale != 0.0f) {
+        if (!(options.footprintScale >= 0.05f && options.footprintScale <= 8.0f))
+            throw InputError({"--footprint-scale", 0, 0, {}},
+                             "expected 0.05..8, found " + std::to_string(options.footprintScale));
+        mo.dynamic.footprintScale = options.footprintScale;
+    }
+    if (options.cacheMb != 0) {
+        if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
+            throw InputError({"--cache-mb", 0, 0, {}},
+                             "expected 1..1048576 MB, found " + std::to_string(options.cacheMb));
+        mo.mapMemoryBytes = static_cast<size_t>(options.cacheMb) << 20;
+    }
+    // --compare measures the multi-phase engine against the reference: a frame the
+    // reference rendered in its place would only be compared with itself.
+    mo.singlePhaseFrames = !options.noSinglePhase && !options.compare;
+    return mo;
+}
+
+// --compare: the frame against the reference's (and with --truth-spp both against a truth
+// of many more samples: the error each makes, rather than how far apart they are), added
+// to the frame's stats.json entry and reported.
+void compareFrame(int frame, const Image& image, const FrameStats& stats,
+                  const RenderOptions& render, const RenderCommandOptions& options,
+                  ReferenceRenderer& reference, nlohmann::json& entry) {
+    FrameStats refStats;
+    const Image ref = reference.renderFrame(frame, render, refStats);
+    const ImageError err = compareImages(image, ref);
+    entry["reference"] = referenceFrameJson(stats, refStats, err);
+    const char* newline = isatty(STDERR_FILENO) ? "\n" : "";
+    if (options.truthSpp > 0) {
+        RenderOptions dense = render;
+        dense.samplesPerPixel = options.truthSpp;
+        FrameStats truthStats;
+        const Image truth = reference.renderFrame(frame, dense, truthStats);
+        const ImageError m = compareImages(image, truth);
+        const ImageError r = compareImages(ref, truth);
+        entry["truth"] = {{"samples_per_pixel", options.truthSpp},
+                          {"multiphase_psnr_db", m.psnr},
+                          {"multiphase_rmse", m.rmse},
+                          {"reference_psnr_db", r.psnr},
+                          {"reference_rmse", r.rmse}};
+        if (!options.quiet)
+            std::fprintf(stderr,
+                         "%sframe %d: against %d spp: multiphase %.2f dB, reference %.2f dB\n",
+                         newline, frame, options.truthSpp, m.psnr, r.psnr);
+    }
+    if (!options.quiet)
+        std::fprintf(stderr,
+                     "%sframe %d: PSNR %.2f dB against the reference, %.3f s vs %.3f s (%.2fx)\n",
+                     newline, frame, err.psnr, stats.wallSeconds, refStats.wallSeconds,
+                     stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0);
+}
+
+}  // namespace
+
+int runRenderCommand(const RenderCommandOptions& options) {
+    checkRenderOptions(options);
+    const bool multiphase = options.mode == "multiphase";
+    FrameRequestOptions ask{options.scene, options.frames, options.size, options.spp, options.seed};
+    ask.multiphase = multiphase;
+    ask.reference = !multiphase || options.compare;
+    ask.truthSpp = options.truthSpp;
+    ask.memoryLimitBytes = static_cast<uint64_t>(options.memoryMb) << 20;
+    const FrameRequest request = loadFrameRequest(ask);
+    const Scene& scene = request.scene;
+    const RenderOptions& render = request.render;
+    const int first = request.first, last = request.last;
     prepareOutputFolder(options.outDir);
 
     std::unique_ptr<ReferenceRenderer> reference;
-    if (!multiphase || options.compare) reference = std::make_unique<ReferenceRenderer>(scene);
+    if (ask.reference) reference = std::make_unique<ReferenceRenderer>(scene);
     std::unique_ptr<MultiphaseRenderer> multi;
     ShadingRate shadingRate = scene.settings.shadingRate;
     if (multiphase) {
-        MultiphaseOptions mo;
-        if (!options.shadingRate.empty()) {
-            if (options.shadingRate == "sample")
-                mo.shadingRate = ShadingRate::Sample;
-            else if (options.shadingRate == "pixel")
-                mo.shadingRate = ShadingRate::Pixel;
-            else if (options.shadingRate == "quad")
-                mo.shadingRate = ShadingRate::Quad;
-            else
-                throw InputError(
-                    {"--shading-rate", 0, 0, {}},
-                    "expected sample, pixel or quad, found '" + options.shadingRate + "'");
-        }
-        if (options.footprintScale != 0.0f) {
-            if (!(options.footprintScale >= 0.05f && options.footprintScale <= 8.0f))
-                throw InputError(
-                    {"--footprint-scale", 0, 0, {}},
-                    "expected 0.05..8, found " + std::to_string(options.footprintScale));
-            mo.dynamic.footprintScale = options.footprintScale;
-        }
-        if (options.cacheMb != 0) {
-            if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
-                throw InputError({"--cache-mb", 0, 0, {}}, "expected 1..1048576 MB, found " +
-                                                               std::to_string(options.cacheMb));
-            mo.mapMemoryBytes = static_cast<size_t>(options.cacheMb) << 20;
-        }
-        // --compare measures the multi-phase engine against the reference: a frame the
-        // reference rendered in its place would only be compared with itself.
-        mo.singlePhaseFrames = !options.noSinglePhase && !options.compare;
+        const MultiphaseOptions mo = multiphaseOptions(options);
         shadingRate = mo.shadingRate.value_or(shadingRate);
         multi = std::make_unique<MultiphaseRenderer>(scene, mo);
         multi->plan(first, last, render);
     }
+    Renderer& renderer = multiphase ? static_cast<Renderer&>(*multi) : *reference;
     ProgressBar bar(!options.quiet && isatty(STDERR_FILENO));
     bar.setFirst(first);
     nlohmann::json frames = nlohmann::json::array();
@@ -156,12 +176,12 @@ int runRenderCommand(const RenderCommandOptions& options) {
         nlohmann::json doc = {
             {"scene", options.scene},
             {"mode", options.mode},
-            {"width", width},
-            {"height", height},
-            {"samples_per_pixel", spp},
+            {"width", request.resolved.width},
+            {"height", request.resolved.height},
+            {"samples_per_pixel", request.resolved.samplesPerPixel},
             {"seed", options.seed},
             {"frames_requested", last - first},
-            {"memory_limit_mb", memoryLimit >> 20},
+            {"memory_limit_mb", request.memoryLimitBytes >> 20},
             {"peak_resident_mb", peakResidentBytes() >> 20},
             {"total_wall_seconds",
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
@@ -176,50 +196,12 @@ int runRenderCommand(const RenderCommandOptions& options) {
     Image image;  // reused frame to frame
     for (int frame = first; frame < last; ++frame) {
         FrameStats stats;
-        const ProgressFn progress = [&](int done, int total) {
+        renderer.renderFrame(frame, render, stats, image, [&](int done, int total) {
             bar.update(frame, last - first, done, total);
-        };
-        if (multiphase)
-            multi->renderFrame(frame, render, stats, image, progress);
-        else
-            image = reference->renderFrame(frame, render, stats, progress);
+        });
         writeFrameImages(image, options.outDir, frame);
         nlohmann::json entry = renderFrameJson(scene, stats, multiphase, image);
-        if (options.compare) {
-            FrameStats refStats;
-            const Image ref = reference->renderFrame(frame, render, refStats);
-            const ImageError err = compareImages(image, ref);
-            entry["reference"] = referenceFrameJson(stats, refStats, err);
-            if (options.truthSpp > 0) {
-                // Both renderers against a reference with many more samples: the error
-                // each makes, rather than how far apart they are.
-                RenderOptions dense = render;
-                dense.samplesPerPixel = options.truthSpp;
-                FrameStats truthStats;
-                const Image truth = reference->renderFrame(frame, dense, truthStats);
-                const ImageError m = compareImages(image, truth);
-                const ImageError r = compareImages(ref, truth);
-                entry["truth"] = {{"samples_per_pixel", options.truthSpp},
-                                  {"multiphase_psnr_db", m.psnr},
-                                  {"multiphase_rmse", m.rmse},
-                                  {"reference_psnr_db", r.psnr},
-                                  {"reference_rmse", r.rmse}};
-                if (!options.quiet)
-                    std::fprintf(stderr,
-                                 "%sframe %d: against %d spp: multiphase %.2f dB, reference "
-                                 "%.2f dB\n",
-                                 isatty(STDERR_FILENO) ? "\n" : "", frame, options.truthSpp, m.psnr,
-                                 r.psnr);
-            }
-            if (!options.quiet)
-                std::fprintf(
-                    stderr,
-                    "%sframe %d: PSNR %.2f dB against the reference, %.3f s vs %.3f s "
-                    "(%.2fx)\n",
-                    isatty(STDERR_FILENO) ? "\n" : "", frame, err.psnr, stats.wallSeconds,
-                    refStats.wallSeconds,
-                    stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0);
-        }
+        if (options.compare) compareFrame(frame, image, stats, render, options, *reference, entry);
         frames.push_back(entry);
         writeStats();
         if (interrupted()) break;

@@ -25,7 +25,7 @@ std::string source(const std::string& relative) {
 // The reference renderer on frame 0 of an example, at a reduced size.
 void referenceRenderer(benchmark::State& state, const char* scenePath) {
     const Scene scene = loadScene(source(scenePath));
-    const ReferenceRenderer renderer(scene);
+    ReferenceRenderer renderer(scene);
     RenderOptions options;
     options.width = 240;
     options.height = 135;

@@ -87,10 +87,10 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
         o.facetBytes = r.facetBytes;
         o.mapBytes = r.mapBytes;
     }
-    const RenderOptions& ro = options.render;
-    p.width = ro.width > 0 ? ro.width : scene.settings.width;
-    p.height = ro.height > 0 ? ro.height : scene.settings.height;
-    p.spp = ro.samplesPerPixel > 0 ? ro.samplesPerPixel : scene.settings.samplesPerPixel;
+    const RenderOptions ro = options.render.resolved(scene.settings);
+    p.width = ro.width;
+    p.height = ro.height;
+    p.spp = ro.samplesPerPixel;
     p.threads = trace.threads();
     p.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return p;

@@ -21,11 +21,12 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
     const BackgroundFiller::Hold paused(filler_.get(), useStamp_);
     const size_t n = slots_.size();
     const int last = std::min(scene_.frameCount() - 1, frame + frames);
-    const DynamicOptions dynamic = frameDynamicOptions();
+    const DynamicOptions dynamic = dynamicOptionsFor(options);
+    const RenderOptions resolved = options.resolved(scene_.settings);
     std::vector<uint8_t> planned(n, 0);
     for (int f = frame + 1; f <= last; ++f) {
         const FrameState ahead =
-            frameStateAt(resources_, f, options.width, options.height, options.samplesPerPixel);
+            frameStateAt(resources_, f, resolved.width, resolved.height, resolved.samplesPerPixel);
         for (size_t i = 0; i < n; ++i) {
             ObjectSlot& slot = slots_[i];
             if (slot.representation || planned[i] ||

@@ -64,9 +64,11 @@ std::vector<const ObjectRepresentation*> MultiphaseRenderer::representations() c
     return out;
 }
 
-DynamicOptions MultiphaseRenderer::frameDynamicOptions() const {
+DynamicOptions MultiphaseRenderer::dynamicOptionsFor(const RenderOptions& options) const {
     DynamicOptions o = options_.dynamic;
-    o.shadingRate = options_.shadingRate.value_or(scene_.settings.shadingRate);
+    o.shadingRate =
+        options.shadingRate.value_or(options_.shadingRate.value_or(scene_.settings.shadingRate));
+    if (options.footprintScale > 0.0f) o.footprintScale = options.footprintScale;
     return o;
 }
 
@@ -83,7 +85,8 @@ void MultiphaseRenderer::discardStaticWork() {
 }
 
 void MultiphaseRenderer::plan(int first, int last, const RenderOptions& options) {
-    planner_.plan(first, last, options.width, options.height);
+    const RenderOptions o = options.resolved(scene_.settings);
+    planner_.plan(first, last, o.width, o.height);
 }
 
 void MultiphaseRenderer::setFrameBudget(double seconds) {
@@ -144,8 +147,8 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
 // and its sample layout.
 void MultiphaseRenderer::beginFrame(int frame, const RenderOptions& options, FrameStats& stats) {
     stats = FrameStats{};
-    frame_ =
-        frameStateAt(resources_, frame, options.width, options.height, options.samplesPerPixel);
+    const RenderOptions o = options.resolved(scene_.settings);
+    frame_ = frameStateAt(resources_, frame, o.width, o.height, o.samplesPerPixel);
     for (ObjectSlot& slot : slots_) {
         slot.frameStaticSeconds = 0.0;
         slot.frameDynamic = ObjectFrameCost{};
@@ -167,26 +170,14 @@ void MultiphaseRenderer::beginFrame(int frame, const RenderOptions& options, Fra
             if (slot.representation && slot.representation->map)
                 slot.representation->map->reclaim();
     }
-    if (!layout_ ||
-        !layout_->matches(frame_.width, frame_.height, frame_.spp, options.seed, options.filter)) {
-        // A few layouts are kept: a player switching samples per pixel (its quality
-        // regulator) goes back and forth between two, and one costs 0.06-0.08 s to make at
-        // 480x270.
-        layout_ = nullptr;
-        for (const auto& kept : layouts_)
-            if (kept->matches(frame_.width, frame_.height, frame_.spp, options.seed,
-                              options.filter))
-                layout_ = kept;
-        if (!layout_) {
-            const ScopedSpan span(options_.trace, "sample layout", PhaseKind::Dynamic,
-                                  SpanLevel::Phase, -1, frame);
-            layout_ = std::make_shared<const SampleLayout>(frame_.width, frame_.height, frame_.spp,
-                                                           options.seed, options.filter);
-            if (layouts_.size() == 3) layouts_.erase(layouts_.begin());
-            layouts_.push_back(layout_);
-        }
-    }
-    dynamicOptions_ = frameDynamicOptions();
+    const auto asked = Clock::now();
+    bool made = false;
+    layout_ =
+        layouts_.get(frame_.width, frame_.height, frame_.spp, options.seed, options.filter, &made);
+    if (made && options_.trace)
+        options_.trace->span("sample layout", PhaseKind::Dynamic, SpanLevel::Phase, asked,
+                             Clock::now(), -1, frame);
+    dynamicOptions_ = dynamicOptionsFor(options);
 }
 
 // 1-2. The objects in view, and of them those whose static phase is due, with why.
@@ -387,13 +378,6 @@ void MultiphaseRenderer::recordFrame(const FramePlan& plan, FrameStats& stats) {
     stats.index = plan.frame;
     stats.time = frame_.time;
     stats.samples = static_cast<uint64_t>(frame_.width) * frame_.height * frame_.spp;
-}
-
-Image MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
-                                      const ProgressFn& progress) {
-    Image image;
-    renderFrame(frame, options, stats, image, progress);
-    return image;
 }
 
 void MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,

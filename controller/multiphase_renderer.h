@@ -19,10 +19,11 @@
 #include "controller/tile_filler.h"
 #include "phases/dynamic_phase.h"
 #include "phases/reference_renderer.h"
+#include "phases/sample_layout_cache.h"
 
 namespace mpshade {
 
-class MultiphaseRenderer {
+class MultiphaseRenderer : public Renderer {
   public:
     MultiphaseRenderer(const Scene& scene, const MultiphaseOptions& options = {});
     ~MultiphaseRenderer();
@@ -32,15 +33,13 @@ class MultiphaseRenderer {
     // it every frame of the scene is assumed.
     void plan(int first, int last, const RenderOptions& options);
 
-    // Renders frame `frame`, running the static phase first for objects that need it.
-    Image renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
-                      const ProgressFn& progress = {});
-    // The same, into `image`, whose storage is reused when its size is the frame's (a
-    // fresh 640x360 image cost a player 10 ms of page faults per frame).
+    // Renders frame `frame`, running the static phase first for objects that need it, at
+    // the options' quality (RenderOptions::shadingRate and footprintScale).
+    using Renderer::renderFrame;
     void renderFrame(int frame, const RenderOptions& options, FrameStats& stats, Image& image,
-                     const ProgressFn& progress = {});
+                     const ProgressFn& progress = {}) override;
     SampleBuffer renderSamples(int frame, const RenderOptions& options, FrameStats& stats,
-                               const ProgressFn& progress = {});
+                               const ProgressFn& progress = {}) override;
 
     // Drops every object's representation and shader-map tiles, as a camera cut to an
     // unrelated view leaves nothing to reuse: the next frame runs every static phase it
@@ -67,11 +66,6 @@ class MultiphaseRenderer {
     // `seconds` and the cache has room left (a guess never evicts a tile); counts them in
     // stats.prefetch.filled. Returns the seconds spent.
     double prefetch(std::span<const TileRequest> tiles, double seconds, FrameStats& stats);
-    // Overrides the scene's shading rate for the frames that follow (unset: the scene's).
-    void setShadingRate(std::optional<ShadingRate> rate) { options_.shadingRate = rate; }
-    // Sets DynamicOptions::footprintScale for the frames that follow (2: probes read one mip
-    // level coarser than the shading points' footprint asks).
-    void setFootprintScale(float scale) { options_.dynamic.footprintScale = scale; }
     const ObjectReport& report(size_t object) const { return slots_[object].report; }
     // Tiles queued for the background filler and not filled yet (0 without one).
     size_t backgroundQueued() const { return filler_ ? filler_->queued() : 0; }
@@ -85,9 +79,10 @@ class MultiphaseRenderer {
     const Scene& scene() const { return scene_; }
     // The frame states' source (ray scenes for occlusion included), fixed for the render.
     const SceneResources& resources() const { return resources_; }
-    // The dynamic phase's options for the frames now: the scene's shading rate unless
-    // MultiphaseOptions::shadingRate or setShadingRate() overrides it.
-    DynamicOptions frameDynamicOptions() const;
+    // The dynamic phase's options for a frame rendered with `options`: its shading rate
+    // and footprint scale where it sets them, else MultiphaseOptions', else the scene's
+    // shading rate.
+    DynamicOptions dynamicOptionsFor(const RenderOptions& options) const;
 
   private:
     struct FramePlan;
@@ -125,10 +120,10 @@ class MultiphaseRenderer {
     TileFiller tiles_;
     RepresentationPlanner planner_;
     std::vector<ObjectSlot> slots_;
-    std::shared_ptr<const SampleLayout> layout_;
-    std::vector<std::shared_ptr<const SampleLayout>> layouts_;  // the last few made
+    std::shared_ptr<const SampleLayout> layout_;  // the frame's
+    SampleLayoutCache layouts_;
     FrameState frame_;
-    DynamicOptions dynamicOptions_;                 // the frame's, its shading rate resolved
+    DynamicOptions dynamicOptions_;                 // the frame's (dynamicOptionsFor)
     uint32_t useStamp_ = 0;                         // frames rendered: the maps' recency stamp
     std::unique_ptr<ReferenceRenderer> reference_;  // made at the first single-phase frame
     bool singlePhaseFrame_ = false;                 // the last frame was: its samples

@@ -7,144 +7,200 @@
 #include "geometry/error.h"
 
 namespace mpshade {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The request's render options at a quality step: its shading rate and footprint scale,
+// and with `withSamples` its samples per pixel where the step sets them.
+RenderOptions atStep(const RenderOptions& render, const QualityStep& step, bool withSamples) {
+    RenderOptions r = render;
+    r.shadingRate = step.rate;
+    r.footprintScale = step.footprintScale;
+    if (withSamples && step.samplesPerPixel > 0) r.samplesPerPixel = step.samplesPerPixel;
+    return r;
+}
+
+// One playback: the renderer, its regulator and predictor, and the steps of the pre-roll
+// and of each frame.
+class Player {
+  public:
+    Player(const Scene& scene, const PlaybackOptions& options)
+        : scene_(scene),
+          options_(options),
+          renderer_(scene, rendererOptions(options)),
+          regulator_(scene.settings.shadingRate,
+                     options.render.resolved(scene.settings).samplesPerPixel, options.regulator),
+          predictor_(renderer_),
+          budget_(1.0 / options.fps) {
+        renderer_.plan(options.first, options.last, options.render);
+    }
+
+    // Before the clock: the first frame at the scene's own shading rate as far as the cache
+    // allows (the pre-roll has all the time it needs, but not more memory than the cache:
+    // its fills go through the budgeted path, which stops when the cache is full), the
+    // regulator calibrated, and the cache warmed.
+    void preroll(PlaybackSummary& summary) {
+        renderer_.setFrameBudget(1e9);
+        RenderOptions first = options_.render;
+        first.shadingRate = scene_.settings.shadingRate;  // the regulator's top step
+        FrameStats stats;
+        renderer_.renderFrame(options_.first, first, stats, image_);
+        calibrate(summary);
+        if (options_.prefetch) warmCache();
+        renderer_.setFrameBudget(budget_);
+    }
+
+    // One frame within its budget, then what its slack allows: building ahead, predicting
+    // and prefetching. Returns the frame's stats and the quality it played at.
+    FrameStats play(int frame, PlaybackQuality& quality) {
+        quality = {regulator_.level(), regulator_.step()};
+        FrameStats stats;
+        renderer_.renderFrame(frame, atStep(options_.render, quality.step, true), stats, image_);
+        // The twentieth of the budget kept for the end of the frame, as fills keep it.
+        const double slack = 0.95 * budget_ - stats.wallSeconds;
+        if (options_.lookAheadSeconds > 0.0 && slack > 0.0)
+            buildAhead(frame, quality, slack, stats);
+        prefetchAhead(frame, quality, stats);
+        const auto regulating = Clock::now();
+        regulator_.update(stats, budget_);
+        stats.controllerSeconds += secondsSince(regulating);
+        return stats;
+    }
+
+    const Image& image() const { return image_; }
+
+  private:
+    static MultiphaseOptions rendererOptions(const PlaybackOptions& options) {
+        MultiphaseOptions mo;
+        // The always-resident levels are filled as each map is made: a missing tile always
+        // has a coarser level to fall back on.
+        mo.staticPhase.shaderMap.fillPinnedUpFront = true;
+        mo.singlePhaseFrames = false;  // the reference renderer cannot keep a frame rate
+        mo.mapMemoryBytes = options.cacheBytes;
+        mo.backgroundFills = options.backgroundFills;
+        mo.backgroundDuringFrames = options.backgroundDuringFrames;
+        mo.trace = options.trace;
+        return mo;
+    }
+
+    // The regulator's ratios: the first frame again at every step, now warm (its objects
+    // built, its buffers allocated); each also fills what its own step reads.
+    void calibrate(PlaybackSummary& summary) {
+        std::vector<double> stepSeconds(static_cast<size_t>(regulator_.levels()));
+        for (int k = 0; k < regulator_.levels(); ++k) {
+            FrameStats s;
+            renderer_.renderFrame(options_.first, atStep(options_.render, regulator_.step(k), true),
+                                  s, image_);
+            stepSeconds[static_cast<size_t>(k)] = s.dynamic.seconds();
+            summary.steps.push_back({regulator_.step(k), stepSeconds[static_cast<size_t>(k)], 0});
+        }
+        regulator_.calibrate(stepSeconds, budget_);
+    }
+
+    // Warming the cache for the first frames, at the step they start on: the tiles of every
+    // third frame of the first prerollPrefetchSeconds, predicted at half the size, filled as
+    // far as the cache allows. Then one prediction as the frames make them, so the first
+    // frames know what one costs.
+    void warmCache() {
+        const RenderOptions step = atStep(options_.render, regulator_.step(), true);
+        const int ahead =
+            static_cast<int>(std::lround(options_.prerollPrefetchSeconds * scene_.settings.fps));
+        std::vector<TileRequest> tiles;
+        for (int f = options_.first + 1; f <= std::min(options_.last - 1, options_.first + ahead);
+             f += 3) {
+            std::vector<TileRequest> more = predictor_.predict(f, step, 2, predictCost_);
+            tiles.insert(tiles.end(), more.begin(), more.end());
+        }
+        FrameStats warm;
+        renderer_.prefetch(tiles, options_.prerollPrefetchWallSeconds, warm);
+        predictor_.predict(options_.first, step, options_.predictDivisor, predictCost_);
+    }
+
+    // Objects the next lookAheadSeconds will see, built in the frame's slack.
+    void buildAhead(int frame, const PlaybackQuality& quality, double slack, FrameStats& stats) {
+        const int frames =
+            static_cast<int>(std::ceil(options_.lookAheadSeconds * scene_.settings.fps));
+        const double spent =
+            renderer_.buildAhead(frame, frames, atStep(options_.render, quality.step, false), slack,
+                                 stats.budget.builtAhead);
+        addSlackWork(spent, stats);
+    }
+
+    // Only once the frame's own tiles are all in, within the twentieth of the budget kept
+    // for the end of the frame: the tiles predicted for predictSeconds ahead and those next
+    // to the tiles this frame lacked, filled in what is left.
+    void prefetchAhead(int frame, const PlaybackQuality& quality, FrameStats& stats) {
+        const double slackLeft = 0.95 * budget_ - stats.wallSeconds;
+        const bool retry = framesWithoutPrediction_ >= options_.predictRetryFrames &&
+                           slackLeft > 0.5 * predictCost_;
+        ++framesWithoutPrediction_;
+        if (!options_.prefetch || stats.budget.tilesDeferred != 0 ||
+            !(slackLeft > predictCost_ || retry))
+            return;
+        framesWithoutPrediction_ = 0;
+        // A prediction runs longer than its last at times (twice as long, when the machine
+        // is busy elsewhere): one still running at the end of the slack is abandoned rather
+        // than making the frame late.
+        const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                 std::chrono::duration<double>(slackLeft));
+        const int ahead =
+            std::min(options_.last - 1,
+                     frame + std::max(1, static_cast<int>(std::lround(options_.predictSeconds *
+                                                                      scene_.settings.fps))));
+        const auto predicting = Clock::now();
+        std::vector<TileRequest> tiles =
+            predictor_.predict(ahead, atStep(options_.render, quality.step, false),
+                               options_.predictDivisor, predictCost_, deadline);
+        const double predicted = secondsSince(predicting);
+        stats.prefetch.abandoned = predictor_.abandoned();
+        stats.prefetch.predicted = tiles.size();
+        const std::vector<TileRequest> adjacent = renderer_.adjacentTiles();
+        stats.prefetch.adjacent = adjacent.size();
+        tiles.insert(tiles.end(), adjacent.begin(), adjacent.end());
+        const double spent = predicted + renderer_.prefetch(tiles, slackLeft - predicted, stats);
+        stats.prefetch.seconds = spent;
+        addSlackWork(spent, stats);
+    }
+
+    // Static work done in the frame's slack is the frame's.
+    void addSlackWork(double seconds, FrameStats& stats) const {
+        stats.staticWork.seconds += seconds;
+        stats.wallSeconds += seconds;
+        stats.budget.deadlineMet = stats.wallSeconds <= budget_;
+    }
+
+    const Scene& scene_;
+    const PlaybackOptions& options_;
+    MultiphaseRenderer renderer_;
+    QualityRegulator regulator_;
+    TilePredictor predictor_;
+    const double budget_;
+    double predictCost_ = 0.0;  // the last prediction's seconds
+    int framesWithoutPrediction_ = 0;
+    Image image_;  // reused frame to frame
+};
+
+}  // namespace
 
 PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
                           const PlaybackFrameFn& onFrame,
                           const std::function<void(const PlaybackSummary&)>& onPreroll) {
     MPSHADE_CHECK(options.fps > 0.0);
-    MultiphaseOptions mo;
-    // The always-resident levels are filled as each map is made: a missing tile always has
-    // a coarser level to fall back on.
-    mo.staticPhase.shaderMap.fillPinnedUpFront = true;
-    mo.singlePhaseFrames = false;  // the reference renderer cannot keep a frame rate
-    mo.mapMemoryBytes = options.cacheBytes;
-    mo.backgroundFills = options.backgroundFills;
-    mo.backgroundDuringFrames = options.backgroundDuringFrames;
-    mo.trace = options.trace;
-    MultiphaseRenderer renderer(scene, mo);
-    renderer.plan(options.first, options.last, options.render);
     PlaybackSummary summary;
+    Player player(scene, options);
     if (options.first >= options.last) return summary;
-    const auto start = std::chrono::steady_clock::now();
-    // The pre-roll has all the time it needs, but not more memory than the cache: its fills
-    // go through the budgeted path, which stops when the cache is full.
-    renderer.setFrameBudget(1e9);
-    const int spp = options.render.samplesPerPixel > 0 ? options.render.samplesPerPixel
-                                                       : scene.settings.samplesPerPixel;
-    renderer.setShadingRate(scene.settings.shadingRate);  // the regulator's top step
-    FrameStats preroll;
-    Image image;  // reused frame to frame
-    renderer.renderFrame(options.first, options.render, preroll, image);
-    // The regulator's ratios: the first frame again at every step, now warm (its objects
-    // built, its buffers allocated); each also fills what its own step reads.
-    QualityRegulator regulator(scene.settings.shadingRate, spp, options.regulator);
-    // The request's render options with a step's samples per pixel.
-    const auto stepOptions = [&](int level) {
-        RenderOptions r = options.render;
-        if (regulator.step(level).samplesPerPixel > 0)
-            r.samplesPerPixel = regulator.step(level).samplesPerPixel;
-        return r;
-    };
-    std::vector<double> stepSeconds(static_cast<size_t>(regulator.levels()));
-    for (int k = 0; k < regulator.levels(); ++k) {
-        renderer.setShadingRate(regulator.step(k).rate);
-        renderer.setFootprintScale(regulator.step(k).footprintScale);
-        FrameStats s;
-        renderer.renderFrame(options.first, stepOptions(k), s, image);
-        stepSeconds[static_cast<size_t>(k)] = s.dynamic.seconds();
-        summary.steps.push_back({regulator.step(k), stepSeconds[static_cast<size_t>(k)], 0});
-    }
-    const double budget = 1.0 / options.fps;
-    regulator.calibrate(stepSeconds, budget);
-    renderer.setShadingRate(regulator.step().rate);
-    renderer.setFootprintScale(regulator.step().footprintScale);
-    // Warming the cache for the first frames, at the step they start on: the tiles of
-    // every third frame of the first prerollPrefetchSeconds, predicted at half the size,
-    // filled as far as the cache allows. Then one prediction as the frames make them, so
-    // the first frames know what one costs.
-    TilePredictor predictor(renderer);
-    double predictCost = 0.0;  // the last prediction's seconds
-    int framesWithoutPrediction = 0;
-    if (options.prefetch) {
-        const int ahead =
-            static_cast<int>(std::lround(options.prerollPrefetchSeconds * scene.settings.fps));
-        std::vector<TileRequest> tiles;
-        for (int f = options.first + 1; f <= std::min(options.last - 1, options.first + ahead);
-             f += 3) {
-            std::vector<TileRequest> more =
-                predictor.predict(f, stepOptions(regulator.level()), 2, predictCost);
-            tiles.insert(tiles.end(), more.begin(), more.end());
-        }
-        FrameStats warm;
-        renderer.prefetch(tiles, options.prerollPrefetchWallSeconds, warm);
-        predictor.predict(options.first, stepOptions(regulator.level()), options.predictDivisor,
-                          predictCost);
-    }
-    summary.prerollSeconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const auto start = Clock::now();
+    player.preroll(summary);
+    summary.prerollSeconds = secondsSince(start);
     if (onPreroll) onPreroll(summary);
-    renderer.setFrameBudget(budget);
     for (int frame = options.first; frame < options.last; ++frame) {
-        const PlaybackQuality quality{regulator.level(), regulator.step()};
-        renderer.setShadingRate(quality.step.rate);
-        renderer.setFootprintScale(quality.step.footprintScale);
-        FrameStats stats;
-        renderer.renderFrame(frame, stepOptions(quality.level), stats, image);
-        // The twentieth of the budget kept for the end of the frame, as fills keep it.
-        const double slack = 0.95 * budget - stats.wallSeconds;
-        if (options.lookAheadSeconds > 0.0 && slack > 0.0) {
-            const int frames =
-                static_cast<int>(std::ceil(options.lookAheadSeconds * scene.settings.fps));
-            const double spent =
-                renderer.buildAhead(frame, frames, options.render, slack, stats.budget.builtAhead);
-            stats.staticWork.seconds += spent;
-            stats.wallSeconds += spent;
-            stats.budget.deadlineMet = stats.wallSeconds <= budget;
-        }
-        // Only once the frame's own tiles are all in, within the twentieth of the budget
-        // kept for the end of the frame.
-        const double slackLeft = 0.95 * budget - stats.wallSeconds;
-        const bool retry =
-            framesWithoutPrediction >= options.predictRetryFrames && slackLeft > 0.5 * predictCost;
-        ++framesWithoutPrediction;
-        if (options.prefetch && stats.budget.tilesDeferred == 0 &&
-            (slackLeft > predictCost || retry)) {
-            framesWithoutPrediction = 0;
-            // A prediction runs longer than its last at times (twice as long, when the
-            // machine is busy elsewhere): one still running at the end of the slack is
-            // abandoned rather than making the frame late.
-            const auto deadline = std::chrono::steady_clock::now() +
-                                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                      std::chrono::duration<double>(slackLeft));
-            const int ahead =
-                std::min(options.last - 1,
-                         frame + std::max(1, static_cast<int>(std::lround(options.predictSeconds *
-                                                                          scene.settings.fps))));
-            const auto predicting = std::chrono::steady_clock::now();
-            std::vector<TileRequest> tiles = predictor.predict(
-                ahead, options.render, options.predictDivisor, predictCost, deadline);
-            const double predicted =
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - predicting)
-                    .count();
-            stats.prefetch.abandoned = predictor.abandoned();
-            stats.prefetch.predicted = tiles.size();
-            const std::vector<TileRequest> adjacent = renderer.adjacentTiles();
-            stats.prefetch.adjacent = adjacent.size();
-            tiles.insert(tiles.end(), adjacent.begin(), adjacent.end());
-            const double spent = predicted + renderer.prefetch(tiles, slackLeft - predicted, stats);
-            stats.prefetch.seconds = spent;
-            stats.staticWork.seconds += spent;
-            stats.wallSeconds += spent;
-            stats.budget.deadlineMet = stats.wallSeconds <= budget;
-        }
+        PlaybackQuality quality;
+        const FrameStats stats = player.play(frame, quality);
         ++summary.frames;
         summary.deadlinesMet += stats.budget.deadlineMet ? 1 : 0;
         ++summary.steps[static_cast<size_t>(quality.level)].frames;
-        const auto regulating = std::chrono::steady_clock::now();
-        regulator.update(stats, budget);
-        stats.controllerSeconds +=
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - regulating).count();
-        if (onFrame && !onFrame(stats, image, quality)) break;
+        if (onFrame && !onFrame(stats, player.image(), quality)) break;
     }
     return summary;
 }

@@ -20,8 +20,8 @@ RepresentationPlanner::RepresentationPlanner(const Scene& scene, const StaticPha
 
 void RepresentationPlanner::plan(int first, int last, int width, int height) {
     first_ = first;
-    width_ = width > 0 ? width : scene_.settings.width;
-    height_ = height > 0 ? height : scene_.settings.height;
+    width_ = width;
+    height_ = height;
     for (std::vector<int>& seen : framesSeen_)
         seen.assign(static_cast<size_t>(std::max(0, last - first)), 0);
     for (int f = first; f < last; ++f) {

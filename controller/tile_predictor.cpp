@@ -12,16 +12,14 @@ std::vector<TileRequest> TilePredictor::predict(int frame, const RenderOptions& 
                                                 std::chrono::steady_clock::time_point deadline) {
     const auto start = std::chrono::steady_clock::now();
     const Scene& scene = renderer_.scene();
-    const DynamicOptions current = renderer_.frameDynamicOptions();
+    const DynamicOptions current = renderer_.dynamicOptionsFor(options);
     const ScopedSpan span(current.trace, "predict tiles", PhaseKind::Static, SpanLevel::Phase, -1,
                           frame);
     divisor = std::max(1, divisor);
-    const int width =
-        std::max(1, (options.width > 0 ? options.width : scene.settings.width) / divisor);
-    const int height =
-        std::max(1, (options.height > 0 ? options.height : scene.settings.height) / divisor);
-    const int spp =
-        options.samplesPerPixel > 0 ? options.samplesPerPixel : scene.settings.samplesPerPixel;
+    const RenderOptions full = options.resolved(scene.settings);
+    const int width = std::max(1, full.width / divisor);
+    const int height = std::max(1, full.height / divisor);
+    const int spp = full.samplesPerPixel;
     state_ = frameStateAt(renderer_.resources(), frame, width, height, 1);
     if (!layout_ || !layout_->matches(width, height, 1, options.seed, options.filter))
         layout_ =

@@ -48,32 +48,22 @@ struct Scratch {
 
 ReferenceRenderer::ReferenceRenderer(const Scene& scene) : scene_(scene), resources_(scene) {}
 
-std::shared_ptr<const SampleLayout> ReferenceRenderer::layoutFor(
-    int width, int height, int spp, const RenderOptions& options) const {
-    std::lock_guard<std::mutex> lock(layoutMutex_);
-    if (!layout_ || !layout_->matches(width, height, spp, options.seed, options.filter))
-        layout_ =
-            std::make_shared<const SampleLayout>(width, height, spp, options.seed, options.filter);
-    return layout_;
-}
-
-Image ReferenceRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
-                                     const ProgressFn& progress) const {
+void ReferenceRenderer::renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
+                                    Image& image, const ProgressFn& progress) {
     const SampleBuffer samples = renderSamples(frame, options, stats, progress);
     const auto start = std::chrono::steady_clock::now();
-    Image image;
     samples.layout->resolve(samples.rgba.data(), nullptr, image);
     stats.wallSeconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return image;
 }
 
 SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& options,
-                                              FrameStats& stats, const ProgressFn& progress) const {
+                                              FrameStats& stats, const ProgressFn& progress) {
     const auto start = std::chrono::steady_clock::now();
     const RenderSettings& settings = scene_.settings;
+    const RenderOptions o = options.resolved(scene_.settings);
     const FrameState frameState =
-        frameStateAt(resources_, frame, options.width, options.height, options.samplesPerPixel);
+        frameStateAt(resources_, frame, o.width, o.height, o.samplesPerPixel);
     const int width = frameState.width, height = frameState.height, spp = frameState.spp;
     const float time = frameState.time;
     const CameraState& camera = frameState.camera;
@@ -82,7 +72,7 @@ SampleBuffer ReferenceRenderer::renderSamples(int frame, const RenderOptions& op
     const WorldRayScene world(resources_, states);
 
     SampleBuffer samples;
-    samples.reset(layoutFor(width, height, spp, options));
+    samples.reset(layouts_.get(width, height, spp, options.seed, options.filter));
     const SampleLayout& layout = *samples.layout;
     const int tile = std::max(1, options.tileSize);
     const int tilesX = (width + tile - 1) / tile, tilesY = (height + tile - 1) / tile;

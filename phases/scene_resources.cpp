@@ -2,6 +2,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "geometry/error.h"
 #include "scene/variability.h"
 #include "shading/shader_compiler.h"
 
@@ -46,9 +47,10 @@ FrameState frameStateAt(const SceneResources& resources, int frame, int width, i
     const Scene& scene = resources.scene();
     FrameState f;
     f.index = frame;
-    f.width = width > 0 ? width : scene.settings.width;
-    f.height = height > 0 ? height : scene.settings.height;
-    f.spp = spp > 0 ? spp : scene.settings.samplesPerPixel;
+    MPSHADE_CHECK(width > 0 && height > 0 && spp > 0);
+    f.width = width;
+    f.height = height;
+    f.spp = spp;
     f.time = scene.frameTime(frame);
     f.camera = cameraAt(scene, f.time, f.width, f.height);
     const size_t n = scene.objects.size();

@@ -67,7 +67,7 @@ struct FrameState {
 // inside the camera's view frustum, between its near and far planes.
 bool objectInView(const Surface& surface, const ObjectState& state, const CameraState& camera);
 
-// width, height, spp: 0 takes the scene's setting.
+// width, height, spp: as rendered, each at least 1 (RenderOptions::resolved).
 FrameState frameStateAt(const SceneResources& resources, int frame, int width, int height, int spp);
 
 // The frame's world: Embree instances of each object's surface, placed at time t.

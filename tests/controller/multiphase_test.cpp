@@ -401,7 +401,7 @@ TEST(MultiphaseRenderer, NoPinholesOverTwoHundredViewsInTheRange) {
     std::mt19937 rng(17);
     const int frames = 200;
     const Scene scene = loadScene(writeBlobScene("pinholes", frames, rng));
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     MultiphaseRenderer multi(scene);
     int staticRuns = 0, holes = 0, inside = 0;
     for (int f = 0; f < frames; ++f) {
@@ -464,7 +464,7 @@ TEST(MultiphaseRenderer, ExamplesMatchTheReference) {
     // reference by half a decibel (measured: 1.1 to 1.6 dB better).
     for (const char* path : {"examples/vase/scene.json", "examples/teapot/scene.json"}) {
         const Scene scene = loadScene(test::sourcePath(path));
-        const ReferenceRenderer reference(scene);
+        ReferenceRenderer reference(scene);
         MultiphaseRenderer multi(scene, machineryOnly());
         const RenderOptions options = smallFrame();
         RenderOptions dense = options;
@@ -496,7 +496,7 @@ TEST(MultiphaseRenderer, ShaderMapRepresentationMatchesTheReference) {
     scene.objects[0].shadermapResolution =
         64;  // the vase's 104 charts: about a texel per pixel here
     scene.objects[1].shadermapResolution = 256;  // the floor: one chart
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     MultiphaseRenderer multi(scene, machineryOnly());
     const RenderOptions options = smallFrame();
     FrameStats rs, ms;
@@ -521,7 +521,7 @@ TEST(MultiphaseRenderer, StaticPartNotWorthStoringLeavesGeometryOnly) {
     const Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
     size_t teapot = 0;
     while (scene.objects[teapot].name != "teapot") ++teapot;
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     MultiphaseRenderer multi(scene, machineryOnly());
     const RenderOptions options = smallFrame();
     FrameStats rs, ms;
@@ -567,7 +567,7 @@ TEST(MultiphaseRenderer, PrefilteredShaderMapsOnAMinifiedSurface) {
                      "representation": "shadermap", "shadermap_resolution": 2048,
                      "range": { "distance_factor": 1.1, "angle": 5 } } ] })";
     const Scene scene = loadScene(dir + "scene.json");
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     FrameStats stats;
     RenderOptions dense;
     dense.samplesPerPixel = 64;
@@ -597,7 +597,7 @@ TEST(MultiphaseRenderer, StaticWorkThatWouldNotPayGoesSinglePhase) {
     const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
     RenderOptions options;
     options.width = 120, options.height = 68;
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     FrameStats rs;
     const Image ref = reference.renderFrame(3, options, rs);
 

@@ -38,7 +38,7 @@ Measured measure(const std::string& file, int frame, MultiphaseOptions options =
     const Scene scene = loadScene(test::sourcePath("examples/hard/" + file));
     options.singlePhaseFrames = false;  // the multi-phase path is what is judged
     MultiphaseRenderer multi(scene, options);
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     RenderOptions dense = small();
     dense.samplesPerPixel = 32;
     dense.seed = 0x9e3779b9u;

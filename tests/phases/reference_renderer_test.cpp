@@ -34,7 +34,7 @@ const char* kBallScene = R"({
 TEST(ReferenceRenderer, SphereCoverageMatchesItsSilhouette) {
     const Scene scene =
         loadScene(writeScene("coverage", kBallScene, "surface s() { Ci = color(1, 0, 0); }"));
-    const ReferenceRenderer renderer(scene);
+    ReferenceRenderer renderer(scene);
     RenderOptions options;
     FrameStats stats;
     const SampleBuffer samples = renderer.renderSamples(0, options, stats);
@@ -90,7 +90,7 @@ TEST(ReferenceRenderer, TranslucentLayersCompositeFrontToBack) {
     // Each plane Oi = 0.5.
     const Scene scene = loadScene(
         writeScene("layers", kTwoPlanesScene, "surface s(color c = 0) { Ci = c; Oi = 0.5; }"));
-    const ReferenceRenderer renderer(scene);
+    ReferenceRenderer renderer(scene);
     FrameStats stats;
     const float expected[4] = {0.5f, 0.25f, 0.25f, 0.75f};
     expectEveryPixel(renderer.renderFrame(0, {}, stats), expected);
@@ -136,7 +136,7 @@ TEST(ImageCompare, ErrorsFromNumbersWorkedByHand) {
 
 TEST(ReferenceRenderer, IsDeterministicForASeed) {
     const Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
-    const ReferenceRenderer renderer(scene);
+    ReferenceRenderer renderer(scene);
     RenderOptions options;
     options.width = 80;
     options.height = 60;
@@ -153,7 +153,7 @@ TEST(ReferenceRenderer, IsDeterministicForASeed) {
 TEST(ReferenceRenderer, NonFiniteShaderResultsAreCountedAndZeroed) {
     const Scene scene = loadScene(writeScene(
         "nan", kBallScene, "surface s() { Ci = color(exp(1000 * u) - exp(1000 * u)); }"));
-    const ReferenceRenderer renderer(scene);
+    ReferenceRenderer renderer(scene);
     FrameStats stats;
     const Image image = renderer.renderFrame(0, {}, stats);
     EXPECT_GT(stats.nonFiniteSamples, 0u);

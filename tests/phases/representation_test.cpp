@@ -391,7 +391,7 @@ TEST(RepresentationChoice, SeenOftenAMapSeenOnceFacets) {
 }
 
 Image renderTruth(const Scene& scene, int frame, int width, int height) {
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     RenderOptions dense;
     dense.width = width, dense.height = height, dense.samplesPerPixel = 64;
     FrameStats stats;
@@ -404,7 +404,7 @@ TEST(MultiphaseRenderer, GrazingFloorBeatsTheReferenceAtTheSameSamples) {
     // at least as well as the reference renderer at the same 4 samples (measured: about
     // 1.5 dB better, the map's filtering against the reference's aliasing).
     const Scene scene = loadScene(test::sourcePath("tests/data/scenes/grazing_floor.json"));
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     MultiphaseRenderer multi(scene);
     RenderOptions options;
     options.width = 160, options.height = 90;
@@ -427,7 +427,7 @@ TEST(MultiphaseRenderer, PixelRateShadesOncePerPixelAndSurface) {
     Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
     RenderOptions options;
     options.width = 120, options.height = 80;
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     FrameStats rs, sample, pixel;
     const Image ref = reference.renderFrame(1, options, rs);
     MultiphaseOptions perSample, perPixel;
@@ -459,7 +459,7 @@ TEST(MultiphaseRenderer, QuadRateShadesOncePerTwoByTwoPixelsAndSurface) {
     Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
     RenderOptions options;
     options.width = 120, options.height = 80;
-    const ReferenceRenderer reference(scene);
+    ReferenceRenderer reference(scene);
     FrameStats rs, pixel, quad;
     const Image ref = reference.renderFrame(1, options, rs);
     MultiphaseOptions perPixel, perQuad;
