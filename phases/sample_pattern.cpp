@@ -98,7 +98,25 @@ bool SampleLayout::matches(int width, int height, int spp, uint32_t seed,
 void SampleLayout::prepareFilter() {
     MPSHADE_CHECK(filter_.radius > 0.0f && filter_.radius <= 8.0f && filter_.sigma > 0.0f);
     MPSHADE_CHECK(spp_ <= 16384);  // 4 spp fits the quads' nearest-sample index
+    prepareCentroids();
+    prepareQuadCentroids();
     const size_t n = count();
+    fx_.resize(n);
+    fy_.resize(n);
+    tbb::parallel_for(0, height_, [&](int py) {
+        for (size_t s = index(0, py, 0); s < index(0, py, 0) + static_cast<size_t>(width_) * spp_;
+             ++s) {
+            fx_[s] = static_cast<int32_t>(std::lround(xy_[2 * s] * 256.0f));
+            fy_[s] = static_cast<int32_t>(std::lround(xy_[2 * s + 1] * 256.0f));
+        }
+    });
+    prepareTaps();
+    preparePixelWeights();
+    prepareBlockWeights();
+    prepareInverseSums();
+}
+
+void SampleLayout::prepareCentroids() {
     const size_t pixels = static_cast<size_t>(width_) * height_;
     centroid_.resize(2 * pixels);
     nearest_.resize(pixels);
@@ -126,6 +144,9 @@ void SampleLayout::prepareFilter() {
             nearest_[p] = static_cast<uint16_t>(nearest);
         }
     });
+}
+
+void SampleLayout::prepareQuadCentroids() {
     const int qw = width_ / 2, qh = height_ / 2;
     quadCentroid_.resize(2 * static_cast<size_t>(qw) * qh);
     quadNearest_.resize(static_cast<size_t>(qw) * qh);
@@ -157,15 +178,9 @@ void SampleLayout::prepareFilter() {
             quadNearest_[b] = static_cast<uint16_t>(nearest);
         }
     });
-    fx_.resize(n);
-    fy_.resize(n);
-    tbb::parallel_for(0, height_, [&](int py) {
-        for (size_t s = index(0, py, 0); s < index(0, py, 0) + static_cast<size_t>(width_) * spp_;
-             ++s) {
-            fx_[s] = static_cast<int32_t>(std::lround(xy_[2 * s] * 256.0f));
-            fy_[s] = static_cast<int32_t>(std::lround(xy_[2 * s + 1] * 256.0f));
-        }
-    });
+}
+
+void SampleLayout::prepareTaps() {
     // A sample inside pixel q is at distance in (o - 1/2, o + 1/2] from the centre of
     // pixel q + o, so it reaches the pixels with |o| < radius + 1/2.
     reach_ = static_cast<int>(std::ceil(filter_.radius + 0.5f)) - 1;
@@ -177,7 +192,7 @@ void SampleLayout::prepareFilter() {
         return d < filter_.radius ? std::max(0.0, std::exp(-d * d * inv2s2) - tail) : 0.0;
     };
     const size_t taps = static_cast<size_t>(taps_);
-    weights_.resize(n * 2 * taps);
+    weights_.resize(count() * 2 * taps);
     tbb::parallel_for(0, height_, [&](int py) {
         for (int px = 0; px < width_; ++px)
             for (int k = 0; k < spp_; ++k) {
@@ -190,8 +205,12 @@ void SampleLayout::prepareFilter() {
                 }
             }
     });
-    // Per pixel, its samples' weights summed, towards each pixel in reach (taps x taps,
-    // rows then columns), for pixels whose samples are all alike.
+}
+
+// Per pixel, its samples' weights summed, towards each pixel in reach (taps x taps, rows
+// then columns), for pixels whose samples are all alike.
+void SampleLayout::preparePixelWeights() {
+    const size_t taps = static_cast<size_t>(taps_);
     pixelWeights_.resize(static_cast<size_t>(width_) * height_ * taps * taps);
     tbb::parallel_for(0, height_, [&](int py) {
         for (int px = 0; px < width_; ++px) {
@@ -204,9 +223,12 @@ void SampleLayout::prepareFilter() {
             }
         }
     });
-    // Per whole 2x2 block, for a filter reaching one pixel around: its four pixels' summed
-    // weights towards the 4 x 4 pixels it reaches (rows then columns, from the pixel up
-    // and left of it).
+}
+
+// Per whole 2x2 block, for a filter reaching one pixel around: its four pixels' summed
+// weights towards the 4 x 4 pixels it reaches (rows then columns, from the pixel up and left
+// of it).
+void SampleLayout::prepareBlockWeights() {
     blockWeights_.clear();
     if (reach_ == 1) {
         const int bw = width_ / 2, bh = height_ / 2;
@@ -228,6 +250,10 @@ void SampleLayout::prepareFilter() {
             }
         });
     }
+}
+
+void SampleLayout::prepareInverseSums() {
+    const size_t taps = static_cast<size_t>(taps_);
     inverseSum_.resize(static_cast<size_t>(width_) * height_);
     tbb::parallel_for(0, height_, [&](int py) {
         for (int px = 0; px < width_; ++px) {
@@ -246,6 +272,52 @@ void SampleLayout::prepareFilter() {
         }
     });
 }
+
+namespace {
+
+// The resolve's writes: out-pixel rows [py0, py1] of the `pixels` image (width wide, RGBA),
+// each getting weights (its row of `w`, `stride` apart and offset by the first row's
+// distance `row0` from the source) times a color, over `columns` pixels from column x.
+template <int columns>
+[[gnu::always_inline]] inline void addWeighted(float* pixels, int width, int x, int py0, int py1,
+                                               int row0, const float* w, int stride,
+                                               const Float4& c) {
+    for (int py = py0; py <= py1; ++py) {
+        const float* wr = w + stride * (py - row0);
+        float* o = pixels + (static_cast<size_t>(py) * width + x) * 4;
+        for (int k = 0; k < columns; ++k) storeFloat4(o + 4 * k, loadFloat4(o + 4 * k) + wr[k] * c);
+    }
+}
+
+// A pixel's samples [first, last) with a filter reaching one pixel around, summed in
+// registers first, so each pixel in reach is read and written once per pixel rather than
+// once per sample.
+[[gnu::always_inline]] inline void addSamples3x3(float* pixels, int width, int qx, int qy, int py0,
+                                                 int py1, const float* rgba, const float* weights,
+                                                 size_t first, size_t last) {
+    Float4 sum[3][3];
+    for (auto& row : sum)
+        for (Float4& v : row) v = splatFloat4(0.0f);
+    for (size_t s = first; s < last; ++s) {
+        const float* w = weights + s * 6;
+        const Float4 c = loadFloat4(rgba + 4 * s);
+        const Float4 c0 = w[0] * c, c1 = w[1] * c, c2 = w[2] * c;
+        for (int r = 0; r < 3; ++r) {
+            sum[r][0] += w[3 + r] * c0;
+            sum[r][1] += w[3 + r] * c1;
+            sum[r][2] += w[3 + r] * c2;
+        }
+    }
+    for (int py = py0; py <= py1; ++py) {
+        const Float4* add = sum[py - qy + 1];
+        float* o = pixels + (static_cast<size_t>(py) * width + qx - 1) * 4;
+        storeFloat4(o, loadFloat4(o) + add[0]);
+        storeFloat4(o + 4, loadFloat4(o + 4) + add[1]);
+        storeFloat4(o + 8, loadFloat4(o + 8) + add[2]);
+    }
+}
+
+}  // namespace
 
 void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out,
                            bool quads) const {
@@ -303,68 +375,29 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
                 if (alike) {
                     // A 2x2 block shaded once (at one shading point per 2x2 pixels): its one
                     // color to the 4 x 4 pixels it reaches, from its top row, for both.
-                    if (qy % 2 == 0 && qx % 2 == 0) {
-                        const float* w =
-                            blockWeights + (static_cast<size_t>(by) * blocksX + qx / 2) * 16;
-                        const Float4 c =
-                            loadFloat4(rgba + 4 * (static_cast<size_t>(qy) * width + qx) * spp);
-                        for (int py = std::max(r0, qy - 1); py <= std::min(r1 - 1, qy + 2); ++py) {
-                            const float* wr = w + 4 * (py - qy + 1);
-                            float* o = pixels + (static_cast<size_t>(py) * width + qx - 1) * 4;
-                            storeFloat4(o, loadFloat4(o) + wr[0] * c);
-                            storeFloat4(o + 4, loadFloat4(o + 4) + wr[1] * c);
-                            storeFloat4(o + 8, loadFloat4(o + 8) + wr[2] * c);
-                            storeFloat4(o + 12, loadFloat4(o + 12) + wr[3] * c);
-                        }
-                    }
+                    if (qy % 2 == 0 && qx % 2 == 0)
+                        addWeighted<4>(
+                            pixels, width, qx - 1, std::max(r0, qy - 1), std::min(r1 - 1, qy + 2),
+                            qy - 1,
+                            blockWeights + (static_cast<size_t>(by) * blocksX + qx / 2) * 16, 4,
+                            loadFloat4(rgba + 4 * (static_cast<size_t>(qy) * width + qx) * spp));
                     continue;
                 }
                 if (py0 > py1) continue;  // a row read for the blocks it starts
-                const int px0 = std::max(0, qx - reach), px1 = std::min(width - 1, qx + reach);
                 const size_t pixel = static_cast<size_t>(qy) * width + qx;
                 const size_t first = pixel * spp;
                 const bool same = uniform && uniform[pixel];
                 const size_t last = same ? first + 1 : first + spp;
-                if (reach == 1 && same && qx > 0 && qx + 1 < width) {
-                    // The same for a pixel whose samples are alike: one color, its samples'
-                    // weights summed.
-                    const float* w = pixelWeights + pixel * 9;
-                    const Float4 c = loadFloat4(rgba + 4 * first);
-                    for (int py = py0; py <= py1; ++py) {
-                        const float* wr = w + 3 * (py - qy + 1);
-                        float* o = pixels + (static_cast<size_t>(py) * width + qx - 1) * 4;
-                        storeFloat4(o, loadFloat4(o) + wr[0] * c);
-                        storeFloat4(o + 4, loadFloat4(o + 4) + wr[1] * c);
-                        storeFloat4(o + 8, loadFloat4(o + 8) + wr[2] * c);
-                    }
+                if (reach == 1 && qx > 0 && qx + 1 < width) {
+                    if (same)  // one color, its samples' weights summed
+                        addWeighted<3>(pixels, width, qx - 1, py0, py1, qy - 1,
+                                       pixelWeights + pixel * 9, 3, loadFloat4(rgba + 4 * first));
+                    else
+                        addSamples3x3(pixels, width, qx, qy, py0, py1, rgba, weights, first, last);
                     continue;
                 }
-                if (reach == 1 && !same && qx > 0 && qx + 1 < width) {
-                    // The common case unrolled: a 3 x 3 neighbourhood inside the image. The
-                    // pixel's samples are summed in registers first, so each pixel in reach
-                    // is read and written once per pixel rather than once per sample.
-                    Float4 sum[3][3];
-                    for (auto& row : sum)
-                        for (Float4& v : row) v = splatFloat4(0.0f);
-                    for (size_t s = first; s < last; ++s) {
-                        const float* w = weights + s * 6;
-                        const Float4 c = loadFloat4(rgba + 4 * s);
-                        const Float4 c0 = w[0] * c, c1 = w[1] * c, c2 = w[2] * c;
-                        for (int r = 0; r < 3; ++r) {
-                            sum[r][0] += w[3 + r] * c0;
-                            sum[r][1] += w[3 + r] * c1;
-                            sum[r][2] += w[3 + r] * c2;
-                        }
-                    }
-                    for (int py = py0; py <= py1; ++py) {
-                        const Float4* add = sum[py - qy + 1];
-                        float* o = pixels + (static_cast<size_t>(py) * width + qx - 1) * 4;
-                        storeFloat4(o, loadFloat4(o) + add[0]);
-                        storeFloat4(o + 4, loadFloat4(o + 4) + add[1]);
-                        storeFloat4(o + 8, loadFloat4(o + 8) + add[2]);
-                    }
-                    continue;
-                }
+                // The general case: a wider filter, or a pixel at the image's edge.
+                const int px0 = std::max(0, qx - reach), px1 = std::min(width - 1, qx + reach);
                 for (size_t s = first; s < last; ++s) {
                     const float* w =
                         same ? pixelWeights + pixel * taps * taps : weights + s * 2 * taps;

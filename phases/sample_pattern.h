@@ -97,7 +97,17 @@ class SampleLayout {
     template <class T>
     using Buffer = std::vector<T, Unset<T>>;
 
+    // What the shading points and the resolve read, made once with the layout: each pixel's
+    // and each 2x2 block's centroid and nearest sample, the positions in fixed point, the
+    // filter's separable taps per sample, their sums per pixel and per block, and each
+    // pixel's inverse weight sum.
     void prepareFilter();
+    void prepareCentroids();
+    void prepareQuadCentroids();
+    void prepareTaps();
+    void preparePixelWeights();
+    void prepareBlockWeights();
+    void prepareInverseSums();
 
     int width_ = 0, height_ = 0, spp_ = 1;
     uint32_t seed_ = 0;
