@@ -145,6 +145,94 @@ double StaticPhase::combinedFacets(size_t object, const ObjectState& state,
         .estimatedFacets;
 }
 
+namespace {
+
+// The diced surface's positions, facets and chart points moved into `mesh` (the facets'
+// position indices through the welded positions).
+void takeDicedMesh(DicedSurface& diced, FacetMesh& mesh) {
+    mesh.format = diced.format;
+    mesh.qx = std::move(diced.qx);
+    mesh.qy = std::move(diced.qy);
+    mesh.qz = std::move(diced.qz);
+    mesh.positionIndex.resize(diced.triangles.size());
+    for (size_t k = 0; k < diced.triangles.size(); ++k)
+        mesh.positionIndex[k] = diced.positionOf[diced.triangles[k]];
+    mesh.attributeIndex = std::move(diced.triangles);
+    std::vector<uint32_t>().swap(diced.positionOf);
+    mesh.attributeChartPoint = std::move(diced.attributePoints);
+    mesh.clusters = std::move(diced.clusters);
+}
+
+// The longest projected edge the facets have at the representative view, pixels, measured
+// as the dynamic phase measures it (through the fixed-point warp).
+float longestEdgePixels(const FacetMesh& mesh, const ObjectState& state,
+                        const CameraState& camera) {
+    const FixedPointWarp warp(state.objectToWorld, camera, mesh.format);
+    WarpedVertices warped;
+    warp.warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.positionCount(), warped);
+    int64_t longest = 0;
+    for (size_t f = 0; f < mesh.facetCount(); ++f) {
+        const uint32_t* p = &mesh.positionIndex[3 * f];
+        if (warped.culled(p[0]) || warped.culled(p[1]) || warped.culled(p[2])) continue;
+        for (int i = 0; i < 3; ++i) {
+            const int64_t dx = warped.x[p[(i + 1) % 3]] - warped.x[p[i]];
+            const int64_t dy = warped.y[p[(i + 1) % 3]] - warped.y[p[i]];
+            longest = std::max(longest, dx * dx + dy * dy);
+        }
+    }
+    return static_cast<float>(std::sqrt(static_cast<double>(longest))) / 256.0f;
+}
+
+// The vertex attributes: the geometry the dynamic part reads, and with `runStatic` (a
+// combined representation) the n-tuple of mesh.channels the static part computes at each
+// vertex. Returns the static shader instructions run.
+uint64_t shadeVertices(const ObjectShading& obj, const DicedSurface& diced,
+                       const ObjectState& state, const ShadingUniforms& uniforms, bool runStatic,
+                       FacetMesh& mesh) {
+    const size_t staticChannels = static_cast<size_t>(mesh.channels);
+    const size_t n = mesh.attributeChartPoint.size();
+    VertexAttributes& attr = mesh.attributes;
+    attr.count = n;
+    attr.rows.assign(VertexAttributes::kGeometryRows + staticChannels, {});
+    for (int row : obj.geometryRows) attr.rows[static_cast<size_t>(row)].resize(n);
+    for (size_t c = 0; c < staticChannels; ++c)
+        attr.rows[VertexAttributes::kGeometryRows + c].resize(n);
+    tbb::enumerable_thread_specific<VertexScratch> scratch;
+    std::atomic<uint64_t> instructions{0};
+    tbb::parallel_for(size_t{0}, (n + kChunk - 1) / kChunk, [&](size_t chunk) {
+        enableFlushToZero();
+        VertexScratch& b = scratch.local();
+        const size_t begin = chunk * kChunk, m = std::min(kChunk, n - begin);
+        b.batch.resize(m, staticChannels);
+        for (size_t i = 0; i < m; ++i) {
+            const SurfaceSample& g = diced.attributeGeometry[begin + i];
+            const ChartPoint& at = mesh.attributeChartPoint[begin + i];
+            const glm::vec3 I = glm::normalize(g.P - state.eye);
+            b.batch.setPoint(i, g, at, I);
+            for (int row : obj.geometryRows) {
+                // VertexAttributes rows follow the shading batch's first 15 rows, then
+                // u v s t (the batch's rows U..T, after I).
+                const int src = row < VertexAttributes::U ? row : row + 3;
+                attr.rows[static_cast<size_t>(row)][begin + i] = b.batch.row(src)[i];
+            }
+        }
+        if (!runStatic) return;
+        ShadingCounters counters;
+        obj.staticKernel->run(uniforms, b.batch.in, m, b.batch.out, b.workspace, counters);
+        instructions += counters.instructions;
+        for (size_t c = 0; c < staticChannels; ++c)
+            std::copy(b.batch.out.channels[c], b.batch.out.channels[c] + m,
+                      attr.rows[VertexAttributes::kGeometryRows + c].begin() + begin);
+    });
+    return instructions;
+}
+
+}  // namespace
+
+// Dices the surface for the view's range, moves the facets into the representation, and
+// shades its vertices; a combined representation also measures its longest edge, a
+// separate one gets a shader map (the previous one, still valid, or a new one with its
+// always-resident levels).
 std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Representation kind,
                                                          const ObjectState& state,
                                                          const CameraState& camera,
@@ -178,101 +266,48 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     rep->culledPatches = diced.culledCharts;
     rep->frustumCulledPatches = diced.frustumCulled;
     rep->cappedPatches = diced.cappedCharts;
-
     FacetMesh& mesh = rep->mesh;
-    mesh.format = diced.format;
-    mesh.qx = std::move(diced.qx);
-    mesh.qy = std::move(diced.qy);
-    mesh.qz = std::move(diced.qz);
-    mesh.positionIndex.resize(diced.triangles.size());
-    for (size_t k = 0; k < diced.triangles.size(); ++k)
-        mesh.positionIndex[k] = diced.positionOf[diced.triangles[k]];
-    mesh.attributeIndex = std::move(diced.triangles);
-    std::vector<uint32_t>().swap(diced.positionOf);
-    mesh.attributeChartPoint = std::move(diced.attributePoints);
-    mesh.clusters = std::move(diced.clusters);
+    takeDicedMesh(diced, mesh);
     const size_t channels = obj.factored.staticPart.channelOutputs.size();
     mesh.channels = useMap ? 0 : static_cast<int>(channels);
+    // The survey between grid points can miss a little, so the facets are diced again when
+    // their edges outgrow P/2 or, if dicing overshot it, what they started at.
+    if (!useMap)
+        rep->maxEdgePixels =
+            std::max(dicing.maxEdgePixels, 1.05f * longestEdgePixels(mesh, state, camera));
+    costs.instructions += shadeVertices(obj, diced, state, uniforms, !useMap, mesh);
     if (!useMap) {
-        // The longest projected edge the facets have at the representative view, measured
-        // as the dynamic phase measures it: the survey between grid points can miss a
-        // little, so the facets are diced again when their edges outgrow P/2 or, if dicing
-        // overshot it, what they started at.
-        const FixedPointWarp warp(state.objectToWorld, camera, mesh.format);
-        WarpedVertices warped;
-        warp.warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.positionCount(), warped);
-        int64_t longest = 0;
-        for (size_t f = 0; f < mesh.facetCount(); ++f) {
-            const uint32_t* p = &mesh.positionIndex[3 * f];
-            if (warped.culled(p[0]) || warped.culled(p[1]) || warped.culled(p[2])) continue;
-            for (int i = 0; i < 3; ++i) {
-                const int64_t dx = warped.x[p[(i + 1) % 3]] - warped.x[p[i]];
-                const int64_t dy = warped.y[p[(i + 1) % 3]] - warped.y[p[i]];
-                longest = std::max(longest, dx * dx + dy * dy);
-            }
-        }
-        const float atDicing = static_cast<float>(std::sqrt(static_cast<double>(longest))) / 256.0f;
-        rep->maxEdgePixels = std::max(dicing.maxEdgePixels, 1.05f * atDicing);
-    }
-
-    // Geometry the dynamic part reads, and (combined) the n-tuple from the static part.
-    const size_t n = mesh.attributeChartPoint.size();
-    VertexAttributes& attr = mesh.attributes;
-    attr.count = n;
-    attr.rows.assign(VertexAttributes::kGeometryRows + static_cast<size_t>(mesh.channels), {});
-    for (int row : obj.geometryRows) attr.rows[static_cast<size_t>(row)].resize(n);
-    for (int c = 0; c < mesh.channels; ++c)
-        attr.rows[VertexAttributes::kGeometryRows + static_cast<size_t>(c)].resize(n);
-    tbb::enumerable_thread_specific<VertexScratch> scratch;
-    std::atomic<uint64_t> instructions{0};
-    tbb::parallel_for(size_t{0}, (n + kChunk - 1) / kChunk, [&](size_t chunk) {
-        enableFlushToZero();
-        VertexScratch& b = scratch.local();
-        const size_t begin = chunk * kChunk, m = std::min(kChunk, n - begin);
-        b.batch.resize(m, useMap ? 0 : channels);
-        for (size_t i = 0; i < m; ++i) {
-            const SurfaceSample& g = diced.attributeGeometry[begin + i];
-            const ChartPoint& at = mesh.attributeChartPoint[begin + i];
-            const glm::vec3 I = glm::normalize(g.P - state.eye);
-            b.batch.setPoint(i, g, at, I);
-            for (int row : obj.geometryRows) {
-                // VertexAttributes rows follow the shading batch's first 15 rows, then
-                // u v s t (the batch's rows U..T, after I).
-                const int src = row < VertexAttributes::U ? row : row + 3;
-                attr.rows[static_cast<size_t>(row)][begin + i] = b.batch.row(src)[i];
-            }
-        }
-        if (useMap) return;
-        ShadingCounters counters;
-        obj.staticKernel->run(uniforms, b.batch.in, m, b.batch.out, b.workspace, counters);
-        instructions += counters.instructions;
-        for (size_t c = 0; c < channels; ++c)
-            std::copy(b.batch.out.channels[c], b.batch.out.channels[c] + m,
-                      attr.rows[VertexAttributes::kGeometryRows + c].begin() + begin);
-    });
-    costs.instructions += instructions;
-    if (!useMap) {
-        costs.programRuns += n;
+        costs.programRuns += mesh.attributeChartPoint.size();
     } else if (channels == 0) {
         // Nothing static is stored (factoring.h, storeAboveCost): no map to make.
     } else if (previous && previous->map && !obj.staticReadsFrame) {
         rep->map = previous->map;  // still valid: its tiles are kept
     } else {
-        ShaderMapOptions mapOptions = options_.shaderMap;
-        int cap = sceneObject.shadermapResolution > 0 ? sceneObject.shadermapResolution
-                                                      : mapOptions.resolution;
-        int resolution = 1;
-        while (resolution < cap && resolution < (1 << 20)) resolution *= 2;
-        mapOptions.resolution = resolution;
-        mapOptions.tileSize = std::min(mapOptions.tileSize, resolution);
-        rep->map = std::make_shared<ShaderMap>(
-            surface, *obj.staticKernel, uniforms, mapOptions,
-            pools_.forTileBytes(ShaderMap::tileBytesFor(mapOptions, static_cast<int>(channels))));
+        rep->map = makeShaderMap(index, uniforms);
         costs.addFill(rep->map->fillStats(), obj.staticKernel->instructionCount());
     }
     ++costs.runs;
     costs.seconds += std::chrono::duration<double>(Clock::now() - start).count();
     return rep;
+}
+
+// A new map at the object's resolution (its own cap, else the options', rounded up to a
+// power of two), its tiles in the pool for its tile size.
+std::shared_ptr<ShaderMap> StaticPhase::makeShaderMap(size_t index,
+                                                      const ShadingUniforms& uniforms) const {
+    const ObjectShading& obj = *objects_[index];
+    const SceneObject& sceneObject = scene_.objects[index];
+    const size_t channels = obj.factored.staticPart.channelOutputs.size();
+    ShaderMapOptions mapOptions = options_.shaderMap;
+    const int cap = sceneObject.shadermapResolution > 0 ? sceneObject.shadermapResolution
+                                                        : mapOptions.resolution;
+    int resolution = 1;
+    while (resolution < cap && resolution < (1 << 20)) resolution *= 2;
+    mapOptions.resolution = resolution;
+    mapOptions.tileSize = std::min(mapOptions.tileSize, resolution);
+    return std::make_shared<ShaderMap>(
+        *sceneObject.surface, *obj.staticKernel, uniforms, mapOptions,
+        pools_.forTileBytes(ShaderMap::tileBytesFor(mapOptions, static_cast<int>(channels))));
 }
 
 void StaticPhase::fill(std::span<const TileRequest> requests,

@@ -111,6 +111,7 @@ class StaticPhase {
 
   private:
     static DicingView dicingView(const ObjectState& state, const CameraState& camera);
+    std::shared_ptr<ShaderMap> makeShaderMap(size_t index, const ShadingUniforms& uniforms) const;
 
     const Scene& scene_;
     const SceneResources& resources_;
