@@ -118,6 +118,35 @@ std::string sceneName(const std::string& path, std::set<std::string>& taken) {
     return unique;
 }
 
+// The truth's frames, from the cache where it has them, rendered (and cached) otherwise;
+// counted and timed in `e`.
+std::vector<Image> truthFrames(const Scene& scene, const RenderOptions& dense,
+                               const std::filesystem::path& out, SceneEvaluation& e,
+                               SweepProgress& progress) {
+    const TruthKey key{sceneContentHash(e.scene), e.width, e.height, e.truthSpp, dense.seed};
+    const std::filesystem::path truthDir = key.folder(out);
+    std::vector<Image> truth;
+    std::unique_ptr<ReferenceRenderer> reference;
+    const auto start = Clock::now();
+    for (int f = e.first; f < e.last; ++f) {
+        std::optional<Image> cached = readTruthFrame(truthDir, f, e.width, e.height);
+        if (cached) {
+            truth.push_back(std::move(*cached));
+            ++e.truthFramesCached;
+        } else {
+            if (!reference) reference = std::make_unique<ReferenceRenderer>(scene);
+            FrameStats stats;
+            truth.push_back(reference->renderFrame(f, dense, stats));
+            writeTruthFrame(truthDir, f, truth.back());
+            ++e.truthFramesRendered;
+        }
+        progress.step("truth");
+    }
+    e.truthSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    e.truthSelfPsnr = psnrOfMse(meanSquaredError(truth[0], truth[0]));
+    return truth;
+}
+
 }  // namespace
 
 int runEvalCommand(const EvalCommandOptions& options) {
@@ -180,29 +209,7 @@ int runEvalCommand(const EvalCommandOptions& options) {
         RenderOptions dense = base;
         dense.samplesPerPixel = e.truthSpp;
         dense.seed = base.seed ^ 0x9e3779b9u;
-        const TruthKey key{sceneContentHash(e.scene), e.width, e.height, e.truthSpp, dense.seed};
-        const std::filesystem::path truthDir = key.folder(out);
-        std::vector<Image> truth;
-        {
-            std::unique_ptr<ReferenceRenderer> reference;
-            const auto start = Clock::now();
-            for (int f = e.first; f < e.last; ++f) {
-                std::optional<Image> cached = readTruthFrame(truthDir, f, e.width, e.height);
-                if (cached) {
-                    truth.push_back(std::move(*cached));
-                    ++e.truthFramesCached;
-                } else {
-                    if (!reference) reference = std::make_unique<ReferenceRenderer>(scene);
-                    FrameStats stats;
-                    truth.push_back(reference->renderFrame(f, dense, stats));
-                    writeTruthFrame(truthDir, f, truth.back());
-                    ++e.truthFramesRendered;
-                }
-                progress.step("truth");
-            }
-            e.truthSeconds = std::chrono::duration<double>(Clock::now() - start).count();
-            e.truthSelfPsnr = psnrOfMse(meanSquaredError(truth[0], truth[0]));
-        }
+        const std::vector<Image> truth = truthFrames(scene, dense, out, e, progress);
 
         for (const EvalConfig& c : configs) {
             e.runs.push_back(runEvalConfig(e.scene, c, e.first, e.last, base, truth,

@@ -52,13 +52,13 @@ ShaderBinding defaultBinding() {
     return b;
 }
 
-}  // namespace
-
-int runFactorCommand(const FactorCommandOptions& options) {
-    auto ast = loadShaderFile(options.shader);
+// The binding to factor for: --scene's --object (its parameters checked against the
+// shader's), or parameters at their defaults with a fixed ambient and distant light;
+// `described` says which.
+ShaderBinding bindingFor(const FactorCommandOptions& options, const ShaderAst& ast,
+                         std::string& described) {
     ShaderBinding binding = defaultBinding();
-    std::string bindingText =
-        "parameters at their defaults, a fixed ambient and a fixed distant light";
+    described = "parameters at their defaults, a fixed ambient and a fixed distant light";
     if (!options.scene.empty() || !options.object.empty()) {
         if (options.scene.empty())
             throw InputError({"--object", 0, 0, {}}, "--object needs --scene");
@@ -77,61 +77,63 @@ int runFactorCommand(const FactorCommandOptions& options) {
                                                          " (objects: " + names + ")");
         for (const ParamValue& p : object->params) {
             bool declared = false;
-            for (const ParamDecl& d : ast->params) declared = declared || d.name == p.name;
+            for (const ParamDecl& d : ast.params) declared = declared || d.name == p.name;
             if (!declared)
                 throw InputError({options.shader, 0, 0, {}},
                                  "object '" + object->name + "' binds parameter '" + p.name +
                                      "', which this shader does not declare");
         }
         binding = bindingOf(scene, *object);
-        bindingText = "object '" + object->name + "' in " + options.scene;
+        described = "object '" + object->name + "' in " + options.scene;
     }
-    FactorOptions factorOptions;
-    factorOptions.storeAboveCost = options.storeAboveCost;
-    const FactoredShader f = factorShader(*ast, binding, factorOptions);
-    const double ratio =
-        f.staticInstructions > 0 ? double(f.dynamicInstructions) / f.staticInstructions : 0.0;
+    return binding;
+}
 
-    if (options.json) {
-        nlohmann::json channels = nlohmann::json::array();
-        for (size_t k = 0; k < f.channels.size(); ++k) {
-            const ChannelInfo& c = f.channels[k];
-            channels.push_back({{"index", k},
-                                {"name", c.name},
-                                {"type", typeName(c.type)},
-                                {"component", c.component},
-                                {"line", c.line},
-                                {"column", c.column},
-                                {"op", opName(c.op)},
-                                {"source", sourceLine(ast->source, c.line)}});
-        }
-        nlohmann::json lines = nlohmann::json::array();
-        for (const DynamicLine& l : f.dynamicLines)
-            lines.push_back({{"line", l.line},
-                             {"source", sourceLine(ast->source, l.line)},
-                             {"chain", l.chain}});
-        nlohmann::json doc = {{"shader", ast->name},
-                              {"file", options.shader},
-                              {"binding", bindingText},
-                              {"naive_width", f.naiveWidth},
-                              {"chosen_width", f.chosenWidth},
-                              {"channels", channels},
-                              {"instructions",
-                               {{"unfactored", f.originalInstructions},
-                                {"static", f.staticInstructions},
-                                {"dynamic", f.dynamicInstructions}}},
-                              {"cost",
-                               {{"unfactored", f.originalCost},
-                                {"static", f.staticCost},
-                                {"dynamic", f.dynamicCost},
-                                {"static_repeated", f.recomputedStaticCost}}},
-                              {"dynamic_to_static_instructions", ratio},
-                              {"dynamic_lines", lines}};
-        std::printf("%s\n", doc.dump(2).c_str());
-        return 0;
+// --json: the factoring as one document.
+void printFactoringJson(const FactorCommandOptions& options, const ShaderAst& ast,
+                        const std::string& bindingText, const FactoredShader& f, double ratio) {
+    nlohmann::json channels = nlohmann::json::array();
+    for (size_t k = 0; k < f.channels.size(); ++k) {
+        const ChannelInfo& c = f.channels[k];
+        channels.push_back({{"index", k},
+                            {"name", c.name},
+                            {"type", typeName(c.type)},
+                            {"component", c.component},
+                            {"line", c.line},
+                            {"column", c.column},
+                            {"op", opName(c.op)},
+                            {"source", sourceLine(ast.source, c.line)}});
     }
+    nlohmann::json lines = nlohmann::json::array();
+    for (const DynamicLine& l : f.dynamicLines)
+        lines.push_back(
+            {{"line", l.line}, {"source", sourceLine(ast.source, l.line)}, {"chain", l.chain}});
+    nlohmann::json doc = {{"shader", ast.name},
+                          {"file", options.shader},
+                          {"binding", bindingText},
+                          {"naive_width", f.naiveWidth},
+                          {"chosen_width", f.chosenWidth},
+                          {"channels", channels},
+                          {"instructions",
+                           {{"unfactored", f.originalInstructions},
+                            {"static", f.staticInstructions},
+                            {"dynamic", f.dynamicInstructions}}},
+                          {"cost",
+                           {{"unfactored", f.originalCost},
+                            {"static", f.staticCost},
+                            {"dynamic", f.dynamicCost},
+                            {"static_repeated", f.recomputedStaticCost}}},
+                          {"dynamic_to_static_instructions", ratio},
+                          {"dynamic_lines", lines}};
+    std::printf("%s\n", doc.dump(2).c_str());
+}
 
-    std::printf("%s (%s), factored for %s\n\n", ast->name.c_str(), options.shader.c_str(),
+// The factoring for a reader: the n-tuple's channels, the costs, the dynamic lines with
+// what reaches them, and with --dump both parts.
+void printFactoring(const FactorCommandOptions& options, const ShaderAst& ast,
+                    const std::string& bindingText, const FactoredShader& f, double ratio,
+                    int storeAboveCost) {
+    std::printf("%s (%s), factored for %s\n\n", ast.name.c_str(), options.shader.c_str(),
                 bindingText.c_str());
     std::printf("n-tuple: %d float%s (storing every static value a dynamic operation reads: %d)\n",
                 f.chosenWidth, f.chosenWidth == 1 ? "" : "s", f.naiveWidth);
@@ -140,7 +142,7 @@ int runFactorCommand(const FactorCommandOptions& options) {
             "  %s: %d cost units of static work a point, cheaper to repeat than "
             "to read back (--store-above-cost %d), run by the dynamic part\n",
             f.chosenWidth == 0 ? "nothing stored" : "some not stored", f.recomputedStaticCost,
-            factorOptions.storeAboveCost);
+            storeAboveCost);
     if (!f.channels.empty())
         std::printf("  %-9s %-7s %-18s %s\n", "channel", "type", "holds", "computed at");
     for (size_t k = 0; k < f.channels.size();) {
@@ -151,7 +153,7 @@ int runFactorCommand(const FactorCommandOptions& options) {
         const char* type = group == 3 ? typeName(c.type) : "float";
         std::printf("  %-9s %-7s %-18s line %d:%d  %s\n", index.c_str(), type,
                     channelLabel(c, group).c_str(), c.line, c.column,
-                    sourceLine(ast->source, c.line).c_str());
+                    sourceLine(ast.source, c.line).c_str());
         k += static_cast<size_t>(group);
     }
     std::printf("\nper sample         instructions   cost units\n");
@@ -165,7 +167,7 @@ int runFactorCommand(const FactorCommandOptions& options) {
     if (f.dynamicLines.empty())
         std::printf("  none: the whole shader is static for this binding\n");
     for (const DynamicLine& l : f.dynamicLines) {
-        std::printf("  %3d | %s\n", l.line, sourceLine(ast->source, l.line).c_str());
+        std::printf("  %3d | %s\n", l.line, sourceLine(ast.source, l.line).c_str());
         std::string chain;
         for (const std::string& step : l.chain)
             chain += (chain.empty() ? "" : "\n        <- ") + step;
@@ -175,6 +177,23 @@ int runFactorCommand(const FactorCommandOptions& options) {
         std::printf("\nstatic part:\n%s\ndynamic part:\n%s", f.staticPart.dump().c_str(),
                     f.dynamicPart.dump().c_str());
     }
+}
+
+}  // namespace
+
+int runFactorCommand(const FactorCommandOptions& options) {
+    auto ast = loadShaderFile(options.shader);
+    std::string bindingText;
+    const ShaderBinding binding = bindingFor(options, *ast, bindingText);
+    FactorOptions factorOptions;
+    factorOptions.storeAboveCost = options.storeAboveCost;
+    const FactoredShader f = factorShader(*ast, binding, factorOptions);
+    const double ratio =
+        f.staticInstructions > 0 ? double(f.dynamicInstructions) / f.staticInstructions : 0.0;
+    if (options.json)
+        printFactoringJson(options, *ast, bindingText, f, ratio);
+    else
+        printFactoring(options, *ast, bindingText, f, ratio, factorOptions.storeAboveCost);
     return 0;
 }
 
