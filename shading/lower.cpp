@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "geometry/error.h"
 
@@ -252,6 +253,101 @@ class Lowerer {
         return sum;
     }
 
+    // The builtins that apply one operation to each component of their arguments.
+    static std::optional<Op> componentwiseOp(Builtin fn) {
+        switch (fn) {
+            case Builtin::Abs:
+                return Op::Abs;
+            case Builtin::Floor:
+                return Op::Floor;
+            case Builtin::Ceil:
+                return Op::Ceil;
+            case Builtin::Fract:
+                return Op::Fract;
+            case Builtin::Sqrt:
+                return Op::Sqrt;
+            case Builtin::Exp:
+                return Op::Exp;
+            case Builtin::Log:
+                return Op::Log;
+            case Builtin::Sin:
+                return Op::Sin;
+            case Builtin::Cos:
+                return Op::Cos;
+            case Builtin::Tan:
+                return Op::Tan;
+            case Builtin::Asin:
+                return Op::Asin;
+            case Builtin::Acos:
+                return Op::Acos;
+            case Builtin::Atan:
+                return Op::Atan;
+            case Builtin::Sign:
+                return Op::Sign;
+            case Builtin::Min:
+                return Op::Min;
+            case Builtin::Max:
+                return Op::Max;
+            case Builtin::Mod:
+                return Op::Mod;
+            case Builtin::Pow:
+                return Op::Pow;
+            case Builtin::Atan2:
+                return Op::Atan2;
+            case Builtin::Step:
+                return Op::Step;
+            case Builtin::Clamp:
+                return Op::Clamp;
+            case Builtin::Mix:
+                return Op::Mix;
+            case Builtin::Smoothstep:
+                return Op::Smoothstep;
+            case Builtin::Bake:
+                return Op::Bake;
+            case Builtin::Dynamic:
+                return Op::Dynamic;
+            default:
+                return std::nullopt;
+        }
+    }
+
+    // noise, snoise, cellnoise, fbm and turbulence at p (a float p is (p, 0, 0)); fbm and
+    // turbulence take a constant octave count.
+    Val noiseCall(Builtin fn, const Expr& e, const Val& p) {
+        static const Op kOps[] = {Op::Noise, Op::Snoise, Op::Cellnoise, Op::Fbm, Op::Turbulence};
+        const Op op = kOps[static_cast<int>(fn) - static_cast<int>(Builtin::Noise)];
+        int octaves = 0;
+        if (fn == Builtin::Fbm || fn == Builtin::Turbulence)
+            octaves = constantInt(*e.args[1], "the octave count", 1, 16);
+        at(e.line, e.column);
+        const int zero = b_.constant(0.0f);
+        std::vector<int> xyz = isTriple(p.type) ? std::vector<int>{p.c[0], p.c[1], p.c[2]}
+                                                : std::vector<int>{p.c[0], zero, zero};
+        return scalarVal(b_.emit(op, xyz, 1, octaves));
+    }
+
+    // ambient(): the bound ambient lights, those that do not move folded into a constant.
+    Val ambientSum() {
+        Val sum;
+        sum.type = ValueType::Color;
+        float folded[3] = {0, 0, 0};
+        std::vector<int> animated;
+        for (size_t l = 0; l < binding_.lights.size(); ++l) {
+            const LightBinding& light = binding_.lights[l];
+            if (light.kind != LightKind::Ambient) continue;
+            if (light.animated) {
+                animated.push_back(b_.emit(Op::LightAmbient, {}, 3, static_cast<int>(l)));
+            } else {
+                for (int k = 0; k < 3; ++k) folded[k] += light.color[k];
+            }
+        }
+        for (int k = 0; k < 3; ++k) {
+            sum.c[k] = b_.constant(folded[k]);
+            for (int first : animated) sum.c[k] = b_.emit(Op::Add, {sum.c[k], first + k});
+        }
+        return sum;
+    }
+
     Val call(const Expr& e) {
         const Builtin fn = findBuiltin(e.name);
         std::vector<Val> a;
@@ -262,57 +358,8 @@ class Lowerer {
         for (size_t k = 0; k < valueArgs; ++k) a.push_back(expr(*e.args[k]));
         at(e.line, e.column);
         const ValueType rt = e.type;
+        if (const std::optional<Op> op = componentwiseOp(fn)) return componentwise(*op, a, rt);
         switch (fn) {
-            case Builtin::Abs:
-                return componentwise(Op::Abs, a, rt);
-            case Builtin::Floor:
-                return componentwise(Op::Floor, a, rt);
-            case Builtin::Ceil:
-                return componentwise(Op::Ceil, a, rt);
-            case Builtin::Fract:
-                return componentwise(Op::Fract, a, rt);
-            case Builtin::Sqrt:
-                return componentwise(Op::Sqrt, a, rt);
-            case Builtin::Exp:
-                return componentwise(Op::Exp, a, rt);
-            case Builtin::Log:
-                return componentwise(Op::Log, a, rt);
-            case Builtin::Sin:
-                return componentwise(Op::Sin, a, rt);
-            case Builtin::Cos:
-                return componentwise(Op::Cos, a, rt);
-            case Builtin::Tan:
-                return componentwise(Op::Tan, a, rt);
-            case Builtin::Asin:
-                return componentwise(Op::Asin, a, rt);
-            case Builtin::Acos:
-                return componentwise(Op::Acos, a, rt);
-            case Builtin::Atan:
-                return componentwise(Op::Atan, a, rt);
-            case Builtin::Sign:
-                return componentwise(Op::Sign, a, rt);
-            case Builtin::Min:
-                return componentwise(Op::Min, a, rt);
-            case Builtin::Max:
-                return componentwise(Op::Max, a, rt);
-            case Builtin::Mod:
-                return componentwise(Op::Mod, a, rt);
-            case Builtin::Pow:
-                return componentwise(Op::Pow, a, rt);
-            case Builtin::Atan2:
-                return componentwise(Op::Atan2, a, rt);
-            case Builtin::Step:
-                return componentwise(Op::Step, a, rt);
-            case Builtin::Clamp:
-                return componentwise(Op::Clamp, a, rt);
-            case Builtin::Mix:
-                return componentwise(Op::Mix, a, rt);
-            case Builtin::Smoothstep:
-                return componentwise(Op::Smoothstep, a, rt);
-            case Builtin::Bake:
-                return componentwise(Op::Bake, a, rt);
-            case Builtin::Dynamic:
-                return componentwise(Op::Dynamic, a, rt);
             case Builtin::Dot:
                 return scalarVal(dot(a[0], a[1]));
             case Builtin::Length:
@@ -353,40 +400,10 @@ class Lowerer {
             case Builtin::Snoise:
             case Builtin::Cellnoise:
             case Builtin::Fbm:
-            case Builtin::Turbulence: {
-                static const Op kOps[] = {Op::Noise, Op::Snoise, Op::Cellnoise, Op::Fbm,
-                                          Op::Turbulence};
-                const Op op = kOps[static_cast<int>(fn) - static_cast<int>(Builtin::Noise)];
-                int octaves = 0;
-                if (fn == Builtin::Fbm || fn == Builtin::Turbulence)
-                    octaves = constantInt(*e.args[1], "the octave count", 1, 16);
-                at(e.line, e.column);
-                const Val& p = a[0];
-                const int zero = b_.constant(0.0f);
-                std::vector<int> xyz = isTriple(p.type) ? std::vector<int>{p.c[0], p.c[1], p.c[2]}
-                                                        : std::vector<int>{p.c[0], zero, zero};
-                return scalarVal(b_.emit(op, xyz, 1, octaves));
-            }
-            case Builtin::Ambient: {
-                Val sum;
-                sum.type = ValueType::Color;
-                float folded[3] = {0, 0, 0};
-                std::vector<int> animated;
-                for (size_t l = 0; l < binding_.lights.size(); ++l) {
-                    const LightBinding& light = binding_.lights[l];
-                    if (light.kind != LightKind::Ambient) continue;
-                    if (light.animated) {
-                        animated.push_back(b_.emit(Op::LightAmbient, {}, 3, static_cast<int>(l)));
-                    } else {
-                        for (int k = 0; k < 3; ++k) folded[k] += light.color[k];
-                    }
-                }
-                for (int k = 0; k < 3; ++k) {
-                    sum.c[k] = b_.constant(folded[k]);
-                    for (int first : animated) sum.c[k] = b_.emit(Op::Add, {sum.c[k], first + k});
-                }
-                return sum;
-            }
+            case Builtin::Turbulence:
+                return noiseCall(fn, e, a[0]);
+            case Builtin::Ambient:
+                return ambientSum();
             case Builtin::Diffuse: {
                 Val P = global(GlobalId::P);
                 return lightSum(Op::Diffuse,
@@ -423,7 +440,7 @@ class Lowerer {
                 return scalarVal(
                     a[0].type == ValueType::Int ? a[0].c[0] : b_.emit(Op::Trunc, {a[0].c[0]}),
                     ValueType::Int);
-            case Builtin::None:
+            default:  // None, and the componentwise builtins taken above
                 break;
         }
         fail(e.line, e.column, "unknown function '" + e.name + "'");
