@@ -28,37 +28,51 @@ bool assignable(ValueType from, ValueType to) {
     return false;
 }
 
+// A builtin call's arguments checked against its signature; each check that fails says why.
+class ArgumentCheck {
+  public:
+    ArgumentCheck(Builtin b, const std::vector<ValueType>& args, std::string& why)
+        : b_(b), args_(args), why_(why) {}
+
+    // Exactly n arguments, each a value.
+    bool arity(size_t n) const {
+        if (args_.size() != n) {
+            why_ = std::string("'") + builtinName(b_) + "' takes " + std::to_string(n) +
+                   (n == 1 ? " argument" : " arguments") + ", not " + std::to_string(args_.size());
+            return false;
+        }
+        if (!allScalarOrTriple(args_)) {
+            why_ = "arguments must be values";
+            return false;
+        }
+        return true;
+    }
+    bool needTriple(size_t i) const {
+        if (isTriple(args_[i])) return true;
+        why_ = std::string("argument ") + std::to_string(i + 1) + " of '" + builtinName(b_) +
+               "' must be a color, point, vector or normal, not " + typeName(args_[i]);
+        return false;
+    }
+    bool needScalar(size_t i) const {
+        if (isScalar(args_[i])) return true;
+        why_ = std::string("argument ") + std::to_string(i + 1) + " of '" + builtinName(b_) +
+               "' must be a float or int, not " + typeName(args_[i]);
+        return false;
+    }
+
+  private:
+    Builtin b_;
+    const std::vector<ValueType>& args_;
+    std::string& why_;
+};
+
 }  // namespace
 
 ValueType builtinResultType(Builtin b, const std::vector<ValueType>& args, std::string& why) {
-    auto arity = [&](size_t n) {
-        if (args.size() != n) {
-            why = std::string("'") + builtinName(b) + "' takes " + std::to_string(n) +
-                  (n == 1 ? " argument" : " arguments") + ", not " + std::to_string(args.size());
-            return false;
-        }
-        if (!allScalarOrTriple(args)) {
-            why = "arguments must be values";
-            return false;
-        }
-        return true;
-    };
-    auto needTriple = [&](size_t i) {
-        if (!isTriple(args[i])) {
-            why = std::string("argument ") + std::to_string(i + 1) + " of '" + builtinName(b) +
-                  "' must be a color, point, vector or normal, not " + typeName(args[i]);
-            return false;
-        }
-        return true;
-    };
-    auto needScalar = [&](size_t i) {
-        if (!isScalar(args[i])) {
-            why = std::string("argument ") + std::to_string(i + 1) + " of '" + builtinName(b) +
-                  "' must be a float or int, not " + typeName(args[i]);
-            return false;
-        }
-        return true;
-    };
+    const ArgumentCheck check(b, args, why);
+    auto arity = [&](size_t n) { return check.arity(n); };
+    auto needTriple = [&](size_t i) { return check.needTriple(i); };
+    auto needScalar = [&](size_t i) { return check.needScalar(i); };
     switch (b) {
         case Builtin::Abs:
         case Builtin::Floor:
