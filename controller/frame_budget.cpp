@@ -62,16 +62,9 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     const BackgroundFiller::Hold paused(filler_.get(),
                                         useStamp_);  // the cache's budget is this loop's alone
     stats.controllerSeconds += paused.seconds();
-    // Coarser levels first: a tile there serves four times the surface of one a level
-    // finer, and (built from its children where they are resident) costs no more.
-    std::stable_sort(
-        lacking_.begin(), lacking_.end(),
-        [](const TileRequest& a, const TileRequest& b) { return a.key.level > b.key.level; });
-    // A twentieth of the budget is kept for what follows the fills. A frame already late
-    // gets its minimum share; one that is not is never made late by fills.
-    const double budget = options_.frameBudgetSeconds, elapsed = secondsSince(start);
-    const double end =
-        elapsed < 0.95 * budget ? 0.95 * budget : elapsed + options_.minimumStaticShare * budget;
+    orderCoarsestFirst(lacking_);
+    const double end = budgetedFillEnd(secondsSince(start), options_.frameBudgetSeconds,
+                                       options_.minimumStaticShare);
     FillLimits limits = fillLimits(CacheRoom::EvictWithin, stats.index);
     limits.deadline =
         start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(end));

@@ -27,7 +27,8 @@ class RepresentationPlanner {
                           std::optional<Representation> forced);
 
     // The frames that will be asked for, [first, last) at width x height pixels (as
-    // rendered: RenderOptions::resolved). Without a plan every frame of the scene is assumed to see every object.
+    // rendered: RenderOptions::resolved). Without a plan every frame of the scene is assumed to see
+    // every object.
     void plan(int first, int last, int width, int height);
 
     // The estimate's inputs that need no dicing survey (combinedFacets is left 0).

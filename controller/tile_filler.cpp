@@ -79,4 +79,14 @@ void TileFiller::fill(std::span<const TileRequest> tiles,
                            limits.frame);
 }
 
+void orderCoarsestFirst(std::vector<TileRequest>& tiles) {
+    std::stable_sort(tiles.begin(), tiles.end(), [](const TileRequest& a, const TileRequest& b) {
+        return a.key.level > b.key.level;
+    });
+}
+
+double budgetedFillEnd(double elapsed, double budget, double minimumStaticShare) {
+    return elapsed < 0.95 * budget ? 0.95 * budget : elapsed + minimumStaticShare * budget;
+}
+
 }  // namespace mpshade

@@ -86,4 +86,15 @@ class TileFiller {
 // into stats.tiles.
 void recordResidency(const TilePools& pools, FrameStats& stats);
 
+// A budgeted frame's lacking tiles in the order its fills take them: coarser levels first
+// (a tile there serves four times the surface of one a level finer, and, built from its
+// children where they are resident, costs no more), in the order asked within a level.
+void orderCoarsestFirst(std::vector<TileRequest>& tiles);
+
+// When a budgeted frame's fills end, seconds from the frame's start, the frame's own work
+// having taken `elapsed` of `budget`: a twentieth of the budget is kept for what follows the
+// fills, so a frame on time is never made late by them; a frame already late gets its
+// minimum share of the budget.
+double budgetedFillEnd(double elapsed, double budget, double minimumStaticShare);
+
 }  // namespace mpshade

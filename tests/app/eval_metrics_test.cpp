@@ -88,5 +88,15 @@ TEST(EvalMetrics, TimeAtPsnrInterpolatesLogTimeLinearlyInDecibels) {
     EXPECT_FALSE(timeAtPsnr({{1.0, 30.0}}, 30.0).valid);
 }
 
+TEST(EvalMetrics, AtTheFrontsFirstRungItsOwnTimeExactly) {
+    // Exactly at the first rung's PSNR: that rung's time as measured, not one interpolated
+    // to it through logarithms (2^log2(0.05) is not 0.05 in doubles), and not marked.
+    const std::vector<TimedError> ladder = {{0.05, 30.0}, {0.4, 33.0}};
+    const LadderTime t = timeAtPsnr(ladder, 30.0);
+    ASSERT_TRUE(t.valid);
+    EXPECT_EQ(t.seconds, 0.05);
+    EXPECT_FALSE(t.extrapolated);
+}
+
 }  // namespace
 }  // namespace mpshade

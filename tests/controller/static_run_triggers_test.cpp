@@ -1,8 +1,10 @@
-// Which due rebuilds a frame budget admits: never-built objects always, rebuilds cheapest
-// first while 1.5 times their last run fits the time left (at it exactly too), the rest
-// marked deferred.
+// When an object's static phase is due again for the sampling fiducials (the image height,
+// combined facets longer than P/2, at the bound exactly and just past it), and which due
+// rebuilds a frame budget admits: never-built objects always, rebuilds cheapest first while
+// 1.5 times their last run fits the time left (at it exactly too), the rest marked deferred.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -32,6 +34,67 @@ std::vector<StaticRunDue> dues(const std::vector<size_t>& objects) {
         out.push_back(d);
     }
     return out;
+}
+
+// An object built for the view it is seen from now (no geometric fiducial moves), `kind`,
+// at an image 270 pixels tall with P/2 = 0.5 pixel.
+struct BuiltForThisView {
+    ObjectSlot slot;
+    ObjectState state;
+    CameraState camera;
+    ShadingUniforms uniforms;
+    std::vector<float> scratch;
+
+    explicit BuiltForThisView(Representation kind) {
+        state.eye = glm::vec3(0.0f, 1.0f, 5.0f);
+        camera.eye = state.eye;
+        camera.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+        camera.height = 270;
+        auto rep = std::make_unique<ObjectRepresentation>();
+        rep->kind = kind;
+        rep->representativeEye = state.eye;
+        rep->representativeForward = camera.forward;
+        rep->center = glm::vec3(0.0f);
+        rep->imageHeight = 270;
+        rep->maxEdgePixels = 0.5f;
+        slot.representation = std::move(rep);
+    }
+    std::optional<StaticRunDue> due() {
+        return staticRunDue(3, slot, state, camera, uniforms, 0.05f, scratch);
+    }
+};
+
+TEST(StaticRunDue, AnyOtherImageHeightIsDueWithBothHeights) {
+    for (int height : {135, 269, 271, 540}) {
+        BuiltForThisView b(Representation::ShaderMap);
+        b.camera.height = height;
+        const std::optional<StaticRunDue> d = b.due();
+        ASSERT_TRUE(d) << height;
+        EXPECT_EQ(d->cause, StaticRunDue::ImageSize);
+        EXPECT_EQ(d->object, 3u);
+        EXPECT_EQ(d->measured, static_cast<float>(height));
+        EXPECT_EQ(d->threshold, 270.0f);
+    }
+    BuiltForThisView same(Representation::ShaderMap);
+    EXPECT_FALSE(same.due());
+}
+
+TEST(StaticRunDue, CombinedFacetsPastPOverTwoAreDueAtTheBoundNot) {
+    BuiltForThisView b(Representation::Facets);
+    b.slot.longestEdge = 0.5f;  // exactly P/2: still holds
+    EXPECT_FALSE(b.due());
+    for (float longest : {std::nextafter(0.5f, 1.0f), 0.75f, 0.99f}) {
+        b.slot.longestEdge = longest;
+        const std::optional<StaticRunDue> d = b.due();
+        ASSERT_TRUE(d) << longest;
+        EXPECT_EQ(d->cause, StaticRunDue::FacetsTooLong);
+        EXPECT_EQ(d->measured, longest);
+        EXPECT_EQ(d->threshold, 0.5f);
+    }
+    // A separate representation's facets carry no n-tuple: their length is not a fiducial.
+    BuiltForThisView map(Representation::ShaderMap);
+    map.slot.longestEdge = 5.0f;
+    EXPECT_FALSE(map.due());
 }
 
 TEST(AdmitRebuilds, CheapestFirstWhileHalfAsMuchAgainFitsAtTheBoundaryToo) {

@@ -1,5 +1,6 @@
 // The one tile filler's limits: how each CacheRoom keeps the cache's budget (at the budget
-// exactly and one byte under it), what it skips, and a deadline already past.
+// exactly and one byte under it), what it skips, and a deadline already past; and a
+// budgeted frame's fill order and end.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -136,6 +137,26 @@ TEST(TileFiller, ADeadlineAlreadyPastFillsNothing) {
     EXPECT_EQ(result.consumed, 0u);
     EXPECT_EQ(result.costs.tilesFilled, 0u);
     EXPECT_FALSE(f.map().resident(f.finest(1)[0].key));
+}
+
+TEST(BudgetedFills, CoarserLevelsFirstInTheOrderAskedWithinALevel) {
+    std::vector<TileRequest> tiles;
+    const uint16_t levels[] = {0, 3, 1, 3, 0, 5, 1};
+    for (uint16_t k = 0; k < 7; ++k) tiles.push_back({k, TileKey{0, levels[k], k, 0}});
+    orderCoarsestFirst(tiles);
+    const uint32_t objects[] = {5, 1, 3, 2, 6, 0, 4};  // asked as 0..6
+    for (size_t k = 0; k < 7; ++k) EXPECT_EQ(tiles[k].object, objects[k]) << k;
+}
+
+TEST(BudgetedFills, EndAtTheKeptTwentiethOrGiveALateFrameItsShare) {
+    const double budget = 0.04, share = 0.1;
+    // On time: to 95% of the budget, however little the frame took.
+    EXPECT_DOUBLE_EQ(budgetedFillEnd(0.0, budget, share), 0.038);
+    EXPECT_DOUBLE_EQ(budgetedFillEnd(0.03, budget, share), 0.038);
+    // At the kept twentieth exactly, or past it: the minimum share on top of what it took.
+    EXPECT_DOUBLE_EQ(budgetedFillEnd(0.038, budget, share), 0.038 + 0.004);
+    EXPECT_DOUBLE_EQ(budgetedFillEnd(0.05, budget, share), 0.05 + 0.004);
+    EXPECT_DOUBLE_EQ(budgetedFillEnd(0.05, budget, 0.0), 0.05);
 }
 
 }  // namespace
