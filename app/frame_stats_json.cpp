@@ -13,7 +13,7 @@ void addMultiphaseFrameJson(const Scene& scene, const FrameStats& stats, nlohman
     entry["resolve_seconds"] = stats.dynamic.resolveSeconds;
     entry["static_runs"] = stats.staticWork.work.runs;
     entry["static_runs_due"] = staticRunsDueJson(scene, stats);
-    entry["tiles_requested"] = stats.tiles.requested;
+    entry["tiles_requested"] = stats.tiles.missing;
     entry["tiles_filled"] = stats.staticWork.work.tilesFilled;
     entry["tiles_evicted"] = stats.tiles.evicted;
     entry["resident_bytes"] = stats.tiles.residentBytes;

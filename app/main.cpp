@@ -144,7 +144,7 @@ int main(int argc, char** argv) {
     playCmd->add_flag("--no-prefetch", play.noPrefetch,
                       "Fill no tiles ahead of the frames that ask for them (for comparisons)");
     playCmd->add_flag("--no-background-fills", play.noBackgroundFills,
-                      "Fill lacking tiles only in frames' slack, on no worker thread alongside "
+                      "Fill missing tiles only in frames' slack, on no worker thread alongside "
                       "them (for comparisons)");
     playCmd->add_flag("--quiet", play.quiet, "No progress or summary on stderr");
 

@@ -1,5 +1,5 @@
 // background_filler.h -- fills shader-map tiles on a worker thread beside the frames: the
-// tiles a locked-rate frame lacked and had no time left to fill are queued here, and the
+// tiles a locked-rate frame found missing and had no time left to fill are queued here, and the
 // worker fills them while the controller does other things -- the frame's image being
 // written, a prediction's probes of the same maps (controller/tile_prefetch.cpp), the next
 // frame's dynamic phase if the controller lets it (MultiphaseOptions::

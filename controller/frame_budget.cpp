@@ -1,6 +1,6 @@
 // frame_budget.cpp -- MultiphaseRenderer's mechanisms for a locked frame rate
 // (MultiphaseOptions::frameBudgetSeconds; the policy that drives them is
-// controller/playback.h): the lacking tiles filled in the time left of a frame, and
+// controller/playback.h): the missing tiles filled in the time left of a frame, and
 // objects built ahead of the frames that will see them.
 #include <algorithm>
 #include <chrono>
@@ -55,41 +55,41 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
 }
 
 void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& stats) {
-    if (lacking_.empty()) {
-        lastLacking_.clear();
+    if (missing_.empty()) {
+        lastMissing_.clear();
         return;
     }
     const BackgroundFiller::Hold paused(filler_.get(),
                                         useStamp_);  // the cache's budget is this loop's alone
     stats.controllerSeconds += paused.seconds();
-    orderCoarsestFirst(lacking_);
+    orderCoarsestFirst(missing_);
     const double end = budgetedFillEnd(secondsSince(start), options_.frameBudgetSeconds,
                                        options_.minimumStaticShare);
     FillLimits limits = fillLimits(CacheRoom::EvictWithin, stats.index);
     limits.deadline =
         start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(end));
     TileFillResult fills;
-    tiles_.fill(lacking_, drawn_, limits, fills);
+    tiles_.fill(missing_, drawn_, limits, fills);
     countFills(fills, stats);
-    stats.budget.tilesDeferred = lacking_.size() - fills.consumed;
+    stats.budget.tilesDeferred = missing_.size() - fills.consumed;
     recordResidency(static_.tilePools(), stats);
-    if (options_.backgroundFills && fills.consumed < lacking_.size())
+    if (options_.backgroundFills && fills.consumed < missing_.size())
         queueForBackground(fills.consumed);
-    lastLacking_.swap(lacking_);
-    lacking_.clear();
+    lastMissing_.swap(missing_);
+    missing_.clear();
 }
 
-// The lacking tiles from `from` on, for the background filler (made at the first frame
+// The missing tiles from `from` on, for the background filler (made at the first frame
 // that needs it), at most MultiphaseOptions::backgroundQueue of them.
 void MultiphaseRenderer::queueForBackground(size_t from) {
     if (!filler_)
         filler_ = std::make_unique<BackgroundFiller>(static_.tilePools(), options_.mapMemoryBytes,
                                                      options_.backgroundIdlePriority);
     std::vector<BackgroundJob> jobs;
-    const size_t end = std::min(lacking_.size(), from + options_.backgroundQueue);
+    const size_t end = std::min(missing_.size(), from + options_.backgroundQueue);
     jobs.reserve(end - from);
     for (size_t k = from; k < end; ++k)
-        jobs.push_back({lacking_[k].object, drawn_[lacking_[k].object]->map, lacking_[k].key});
+        jobs.push_back({missing_[k].object, drawn_[missing_[k].object]->map, missing_[k].key});
     filler_->submit(std::move(jobs));
 }
 

@@ -14,7 +14,7 @@
 
 namespace mpshade {
 
-// Constant quality fills every tile a frame's probes lack before it shades, so no probe
+// Constant quality fills every tile a frame's probes find missing before it shades, so no probe
 // falls back and the maps' always-resident levels are filled only where frames ask for
 // them (on the courtyard's 24 frames, filling them all up front took 1.0 s of 6.3).
 inline StaticPhaseOptions constantQualityStaticPhase() {
@@ -43,8 +43,8 @@ struct MultiphaseOptions {
     // renderer). Null: nowhere, and nothing is measured for it.
     PhaseTrace* trace = nullptr;
     // Above 0: the frame rate is locked (`mpshade play`). A frame shades once, probes
-    // lacking tiles falling back to the finest coarser level resident; then, in the time left
-    // of this many seconds, the tiles they lacked are filled (coarser levels first: each
+    // missing tiles falling back to the finest coarser level resident; then, in the time left
+    // of this many seconds, the tiles they found missing are filled (coarser levels first: each
     // serves more of the screen, for less) and the rest left for later frames. An object
     // whose static phase is due is drawn from its last representation unless its last
     // static run fits the time left; one never built is always built. 0: constant quality.
@@ -59,7 +59,7 @@ struct MultiphaseOptions {
     // A prefetched tile no frame read within this many frames counts as wasted (it stays
     // resident, an ordinary tile for the cache).
     int prefetchPatienceFrames = 30;
-    // With a frame budget: the lacking tiles a frame had no time left to fill are queued
+    // With a frame budget: the missing tiles a frame had no time left to fill are queued
     // for a worker thread that fills them at idle priority (background_filler.h), from the
     // end of the frame's fills until the next frame starts -- and, with
     // backgroundDuringFrames, alongside its dynamic phase too. At most backgroundQueue are

@@ -105,12 +105,12 @@ void MultiphaseRenderer::setFrameBudget(double seconds) {
 //                       over the frames it serves, the reference renderer draws the frame
 //                       and nothing is built.
 //   buildDue            the static phase of the due objects, in parallel.
-//   shadeAndFill        the dynamic phase; at constant quality, the tiles its probes lacked
-//                       are filled (tile_filler.h) and only the bands that lacked them are
+//   shadeAndFill        the dynamic phase; at constant quality, the tiles its probes found missing
+//                       are filled (tile_filler.h) and only the bands that missed them are
 //                       shaded again, so no sample reads a coarser level than its footprint
 //                       asks and the image does not depend on what earlier frames filled.
 //   recordFrame         what the frame drew and cost, per object (object_slot.h) and in all.
-// renderFrame() then resolves pixels and, within a budget, fills the tiles lacked in the
+// renderFrame() then resolves pixels and, within a budget, fills the missing tiles in the
 // time left (frame_budget.cpp). Playback's look-ahead and prefetching are frame_budget.cpp
 // and tile_prefetch.cpp.
 void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameStats& stats,
@@ -283,9 +283,9 @@ void MultiphaseRenderer::recordBuild(size_t i, Representation kind, const Static
     r.staticCosts += costs;
 }
 
-// 3. The dynamic phase. At constant quality the tiles its probes lacked are filled between
-// shading passes, and only the bands that lacked them are shaded again; within a budget it
-// shades once, with fallbacks, and the tiles lacked are filled after the resolve in the
+// 3. The dynamic phase. At constant quality the tiles its probes found missing are filled between
+// shading passes, and only the bands that missed them are shaded again; within a budget it
+// shades once, with fallbacks, and the missing tiles are filled after the resolve in the
 // time left (fillWithinBudget).
 void MultiphaseRenderer::shadeAndFill(FramePlan& plan, FrameStats& stats,
                                       const ProgressFn& progress) {
@@ -307,20 +307,20 @@ void MultiphaseRenderer::shadeAndFill(FramePlan& plan, FrameStats& stats,
     }
     dynamic_.begin(frame_, plan.drawn, layout_, dynamicOptions_);
     if (progress) progress(2, 4);
-    lacking_.clear();
+    missing_.clear();
     if (plan.budgeted) {
-        lacking_ = dynamic_.shade(true);
-        stats.tiles.requested += lacking_.size();
+        missing_ = dynamic_.shade(true);
+        stats.tiles.missing += missing_.size();
         drawn_ = plan.drawn;
     }
     if (!prefetched_.empty()) settlePrefetched(stats);
     TileFillResult fills;
     for (int pass = 0; !plan.budgeted; ++pass) {
-        const bool last = pass >= 6;  // a safety net: each pass fills what the last lacked
-        const std::vector<TileRequest> lacking = dynamic_.shade(last);
-        stats.tiles.requested += lacking.size();
-        if (lacking.empty() || last) break;
-        tiles_.fill(lacking, plan.drawn, fillLimits(CacheRoom::EvictAndExceed, plan.frame), fills);
+        const bool last = pass >= 6;  // a safety net: each pass fills what the last found missing
+        const std::vector<TileRequest> missing = dynamic_.shade(last);
+        stats.tiles.missing += missing.size();
+        if (missing.empty() || last) break;
+        tiles_.fill(missing, plan.drawn, fillLimits(CacheRoom::EvictAndExceed, plan.frame), fills);
     }
     countFills(fills, stats);
     if (progress) progress(3, 4);

@@ -60,7 +60,8 @@ class MultiphaseRenderer : public Renderer {
     double buildAhead(int frame, int frames, const RenderOptions& options, double seconds,
                       int& built);
     // Prefetching in a frame's slack (claims 10 and 11; predictions: tile_predictor.h).
-    // The tiles next to those the last frame lacked (the 8 around, same level), not resident.
+    // The tiles next to those the last frame found missing (the 8 around, same level), not
+    // resident.
     std::vector<TileRequest> adjacentTiles() const;
     // Fills those of `tiles` not resident, in order, while the time spent stays within
     // `seconds` and the cache has room left (a guess never evicts a tile); counts them in
@@ -104,7 +105,7 @@ class MultiphaseRenderer : public Renderer {
     // Adds what a fill did to the frame's stats and to each object's costs.
     void countFills(const TileFillResult& fills, FrameStats& stats);
     FillLimits fillLimits(CacheRoom room, int frame) const;  // the cache's, this frame's
-    // With a frame budget: fills this frame's lacking tiles (lacking_) until the budget,
+    // With a frame budget: fills this frame's missing tiles (missing_) until the budget,
     // counted from `start`, is spent; queues what is left for the background filler.
     void fillWithinBudget(std::chrono::steady_clock::time_point start, FrameStats& stats);
     void queueForBackground(size_t from);
@@ -129,9 +130,9 @@ class MultiphaseRenderer : public Renderer {
     bool singlePhaseFrame_ = false;                 // the last frame was: its samples
     SampleBuffer singlePhaseSamples_;
     std::vector<float> inputScratch_;
-    // With a frame budget: the frame's lacking tiles and what drew them; the last frame's
-    // lacking tiles (for adjacentTiles); its dynamic phase (warp to resolve), seconds.
-    std::vector<TileRequest> lacking_, lastLacking_;
+    // With a frame budget: the frame's missing tiles and what drew them; the last frame's
+    // missing tiles (for adjacentTiles); its dynamic phase (warp to resolve), seconds.
+    std::vector<TileRequest> missing_, lastMissing_;
     std::vector<const ObjectRepresentation*> drawn_;
     double lastDynamicSeconds_ = 0.0;
     PrefetchLedger prefetched_;  // the tiles prefetched and not yet read

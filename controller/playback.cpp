@@ -129,7 +129,7 @@ class Player {
 
     // Only once the frame's own tiles are all in, within the twentieth of the budget kept
     // for the end of the frame: the tiles predicted for predictSeconds ahead and those next
-    // to the tiles this frame lacked, filled in what is left.
+    // to the tiles this frame found missing, filled in what is left.
     void prefetchAhead(int frame, const PlaybackQuality& quality, FrameStats& stats) {
         const double slackLeft = 0.95 * budget_ - stats.wallSeconds;
         const bool retry = framesWithoutPrediction_ >= options_.predictRetryFrames &&

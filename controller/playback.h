@@ -2,7 +2,7 @@
 // every frame gets 1 / fps seconds. The dynamic phase runs first and never waits: probes
 // whose tiles are missing read the finest coarser level resident (the six coarsest levels
 // of every map are filled with it, so there always is one). What is left of the frame's
-// time goes to static work, by benefit per cost: the tiles the frame lacked, coarser levels
+// time goes to static work, by benefit per cost: the tiles the frame found missing, coarser levels
 // first, then nothing more -- the rest is left for later frames (MultiphaseOptions::
 // frameBudgetSeconds). An object whose static phase is due again is drawn from its last
 // representation until its rebuild fits a frame's slack.
@@ -37,7 +37,7 @@ struct PlaybackOptions {
     double lookAheadSeconds = 0.5;
     // Prefetching in what is left of a frame after that: the tiles of the frame this many
     // seconds of scene time ahead, predicted at 1/predictDivisor of the image each way
-    // (claim 11), then those next to the tiles this frame lacked (claim 10). Off: none.
+    // (claim 11), then those next to the tiles this frame found missing (claim 10). Off: none.
     bool prefetch = true;
     // The pre-roll also fills the tiles predicted for the frames of this many seconds of
     // scene time after the first (every third frame, at half the size), as far as the cache
@@ -53,7 +53,7 @@ struct PlaybackOptions {
     // long; after this many frames without one, one starts when half its cost fits, so
     // that one slow prediction does not keep every later one away.
     int predictRetryFrames = 15;
-    // Tiles a frame lacked and had no time left to fill go to a worker thread at idle
+    // Tiles a frame found missing and had no time left to fill go to a worker thread at idle
     // priority, which fills them outside the frames' dynamic phase: while the frame's image
     // is written, a prediction's probes run, and between frames (background_filler.h).
     // backgroundDuringFrames: also alongside the dynamic phase. Measured at 640x360 on 2

@@ -1,6 +1,6 @@
 // tile_filler.h -- the controller's one loop that fills shader-map tiles: for a frame at
-// constant quality (everything its probes lacked, at once), within a frame budget (the
-// tiles a frame lacked, coarser first, until its time is spent), and for prefetching (tiles
+// constant quality (every tile its probes found missing, at once), within a frame budget (the
+// tiles a frame found missing, coarser first, until its time is spent), and for prefetching (tiles
 // guessed for frames ahead, in a frame's slack). Each tile is filled by the static phase
 // (StaticPhase::fill: each map's tiles in one batch, maps in parallel); what differs
 // between the callers is only their limits (FillLimits): a deadline, and how the tile
@@ -86,7 +86,7 @@ class TileFiller {
 // into stats.tiles.
 void recordResidency(const TilePools& pools, FrameStats& stats);
 
-// A budgeted frame's lacking tiles in the order its fills take them: coarser levels first
+// A budgeted frame's missing tiles in the order its fills take them: coarser levels first
 // (a tile there serves four times the surface of one a level finer, and, built from its
 // children where they are resident, costs no more), in the order asked within a level.
 void orderCoarsestFirst(std::vector<TileRequest>& tiles);

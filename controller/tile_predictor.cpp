@@ -41,13 +41,13 @@ std::vector<TileRequest> TilePredictor::predict(int frame, const RenderOptions& 
     phase_.begin(state_, drawn, layout_, o);
     // Abandoned in rasterization: no visibility to trust, so nothing predicted. In
     // shading: the finished bands' tiles stand.
-    std::vector<TileRequest> lacking;
-    if (!phase_.abandoned()) lacking = phase_.shade(true);
+    std::vector<TileRequest> missing;
+    if (!phase_.abandoned()) missing = phase_.shade(true);
     abandoned_ = phase_.abandoned();
     const double spent =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     seconds = abandoned_ ? std::max(seconds, spent) : spent;
-    return lacking;
+    return missing;
 }
 
 }  // namespace mpshade

@@ -1,6 +1,6 @@
 // tile_prefetch.cpp -- MultiphaseRenderer's prefetching mechanisms (the policy that calls
 // them is controller/playback.h; the tiles predicted for a frame ahead come from
-// controller/tile_predictor.h): tiles next to those recently lacked (patent claim 10:
+// controller/tile_predictor.h): tiles next to those recently found missing (patent claim 10:
 // adjacency), tiles filled in a frame's slack, and whether what was prefetched was read.
 #include <algorithm>
 #include <chrono>
@@ -16,7 +16,7 @@ using Clock = std::chrono::steady_clock;
 
 std::vector<TileRequest> MultiphaseRenderer::adjacentTiles() const {
     std::vector<TileRequest> out;
-    for (const TileRequest& r : lastLacking_) {
+    for (const TileRequest& r : lastMissing_) {
         const ObjectRepresentation* rep = slots_[r.object].representation.get();
         if (!rep || !rep->map) continue;
         const ShaderMap& map = *rep->map;

@@ -31,7 +31,7 @@ struct BandRange {
 };
 
 // A band's shading points and their results. Kept while the band is unfinished (its points
-// whose probes lacked tiles are shaded again after the fill, the rest are not) and reused
+// whose probes found tiles missing are shaded again after the fill, the rest are not) and reused
 // from frame to frame.
 struct BandPoints {
     bool built = false;

@@ -82,16 +82,16 @@ struct DynamicPhase::Band {
         std::vector<ObjectFrameCost> costs;  // per object
 
         // Every point of a fresh band, each object's as runs of the band's own arrays; the
-        // points whose probes lacked tiles go to stillPending.
+        // points whose probes found tiles missing go to stillPending.
         void shadeFresh(std::span<const ObjectView> views, const ProbeOptions& probe,
-                        bool stopAtMissing, BandPoints& pts, std::vector<TileRequest>& lacking);
+                        bool stopAtMissing, BandPoints& pts, std::vector<TileRequest>& missing);
         // After a fill, the points still pending (in order, so grouped by object), gathered
         // into batches and their results scattered back.
         void shadePending(std::span<const ObjectView> views, const ProbeOptions& probe,
-                          bool stopAtMissing, BandPoints& pts, std::vector<TileRequest>& lacking);
-        // What shading object o's points cost, and the tiles its probes lacked.
+                          bool stopAtMissing, BandPoints& pts, std::vector<TileRequest>& missing);
+        // What shading object o's points cost, and the tiles its probes found missing.
         void addObjectCosts(size_t o, const SurfaceShadingCounters& c, Clock::time_point began,
-                            std::vector<TileRequest>& lacking);
+                            std::vector<TileRequest>& missing);
     };
     std::vector<BandPoints> states;
     tbb::enumerable_thread_specific<Scratch> scratch;
@@ -99,7 +99,7 @@ struct DynamicPhase::Band {
 
 void DynamicPhase::Band::Scratch::shadeFresh(std::span<const ObjectView> views,
                                              const ProbeOptions& probe, bool stopAtMissing,
-                                             BandPoints& pts, std::vector<TileRequest>& lacking) {
+                                             BandPoints& pts, std::vector<TileRequest>& missing) {
     for (size_t o = 0; o + 1 < pts.objectStart.size(); ++o) {
         const size_t begin = pts.objectStart[o], end = pts.objectStart[o + 1];
         if (begin == end) continue;
@@ -116,13 +116,13 @@ void DynamicPhase::Band::Scratch::shadeFresh(std::span<const ObjectView> views,
                 for (size_t i = 0; i < m; ++i)
                     if (batchMissed[i]) stillPending.push_back(static_cast<uint32_t>(b + i));
         }
-        addObjectCosts(o, c, began, lacking);
+        addObjectCosts(o, c, began, missing);
     }
 }
 
 void DynamicPhase::Band::Scratch::shadePending(std::span<const ObjectView> views,
                                                const ProbeOptions& probe, bool stopAtMissing,
-                                               BandPoints& pts, std::vector<TileRequest>& lacking) {
+                                               BandPoints& pts, std::vector<TileRequest>& missing) {
     batchFacet.resize(kBatch);
     batchX.resize(kBatch), batchY.resize(kBatch);
     batchColor.resize(3 * kBatch), batchOpacity.resize(3 * kBatch);
@@ -158,15 +158,15 @@ void DynamicPhase::Band::Scratch::shadePending(std::span<const ObjectView> views
                 }
             }
         }
-        addObjectCosts(o, c, began, lacking);
+        addObjectCosts(o, c, began, missing);
         first = last;
     }
 }
 
 void DynamicPhase::Band::Scratch::addObjectCosts(size_t o, const SurfaceShadingCounters& c,
                                                  Clock::time_point began,
-                                                 std::vector<TileRequest>& lacking) {
-    for (const TileKey& key : surface.missing) lacking.push_back({static_cast<uint32_t>(o), key});
+                                                 std::vector<TileRequest>& missing) {
+    for (const TileKey& key : surface.missing) missing.push_back({static_cast<uint32_t>(o), key});
     ObjectFrameCost& cost = costs[o];
     cost.shadeSeconds += secondsSince(began);
     cost.instructions += c.instructions;
@@ -323,19 +323,19 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
                           frame_->index);
     if (stats_.raster.abandoned) return {};  // no visibility to shade
     ++stats_.shadePasses;
-    tbb::enumerable_thread_specific<std::vector<TileRequest>> lacking;
+    tbb::enumerable_thread_specific<std::vector<TileRequest>> missing;
     WorkDeadline deadline(options_.deadline);
     tbb::parallel_for(size_t{0}, bandDone_.size(), [&](size_t b) {
         if (bandDone_[b] || deadline.passed()) return;
         const ScopedSpan task(options_.trace, "band", PhaseKind::Dynamic, SpanLevel::Task, -1,
                               frame_->index);
-        shadeBand(b, acceptFallbacks, lacking.local());
+        shadeBand(b, acceptFallbacks, missing.local());
     });
     abandoned_ = abandoned_ || deadline.missed();
     std::vector<TileRequest> all;
-    for (const std::vector<TileRequest>& l : lacking) all.insert(all.end(), l.begin(), l.end());
+    for (const std::vector<TileRequest>& l : missing) all.insert(all.end(), l.begin(), l.end());
     sortUniqueTiles(all);
-    for (const TileRequest& r : all) ++costs_[r.object].tilesLacked;
+    for (const TileRequest& r : all) ++costs_[r.object].tilesMissing;
     if (complete()) {
         // Sum the per-thread counters once every band is done.
         for (Band::Scratch& s : scratch_->scratch) {
@@ -363,9 +363,9 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
 }
 
 // 1. The band's shading points, once per frame; 2. each object's points in batches, those
-// whose probes lacked tiles staying pending (the band then keeps its points until a later
+// whose probes found tiles missing staying pending (the band then keeps its points until a later
 // pass); 3. once none is pending, the band composited.
-void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& lacking) {
+void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& missing) {
     // A band keeps points of its own only while it waits for tiles: shaded in one pass, it
     // uses its thread's buffers and keeps nothing.
     Band::Scratch& s = scratch_->scratch.local();
@@ -382,14 +382,14 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     s.batchMissed.resize(kBatch);
     s.stillPending.clear();
     if (pts.fresh) {
-        s.shadeFresh(views_, options_.probe, !acceptFallbacks, pts, lacking);
+        s.shadeFresh(views_, options_.probe, !acceptFallbacks, pts, missing);
         pts.fresh = false;
     } else {
-        s.shadePending(views_, options_.probe, !acceptFallbacks, pts, lacking);
+        s.shadePending(views_, options_.probe, !acceptFallbacks, pts, missing);
     }
     pts.pending.swap(s.stillPending);
     if (!pts.pending.empty()) {
-        // Shaded again once the lacking tiles are filled: the band keeps these buffers.
+        // Shaded again once the missing tiles are filled: the band keeps these buffers.
         if (&pts == &s.work) std::swap(s.work, scratch_->states[band]);
         return;
     }

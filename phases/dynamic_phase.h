@@ -4,7 +4,7 @@
 // what each sample sees (surface_points.h), composited front to back and filtered into
 // pixels.
 //
-// Shading runs in bands of pixel rows, in parallel. A band whose probes lack shader-map
+// Shading runs in bands of pixel rows, in parallel. A band whose probes find shader-map
 // tiles is left unshaded and the tiles are handed back, so a caller wanting constant
 // quality fills them and calls shade() again (only those bands are redone); a caller
 // keeping a frame rate accepts the coarser levels instead (acceptFallbacks).
@@ -78,7 +78,7 @@ struct ObjectFrameCost {
     uint64_t instructions = 0;   // dynamic shader instructions, times lanes
     double shadeSeconds = 0.0;   // probing and shading its points, summed over threads
     uint64_t probes = 0, probeFallbacks = 0;
-    uint64_t tilesLacked = 0;  // distinct tiles its probes asked for that were not resident
+    uint64_t tilesMissing = 0;  // distinct tiles its probes asked for that were not resident
     // Combined representation: the longest projected facet edge among its visible
     // clusters, in pixels (the static phase dices again beyond maxEdgePixels).
     float longestEdgePixels = 0.0f;
@@ -130,9 +130,9 @@ class DynamicPhase {
     // stay alive and unchanged until finish().
     void begin(const FrameState& frame, std::span<const ObjectRepresentation* const> objects,
                std::shared_ptr<const SampleLayout> layout, const DynamicOptions& options);
-    // Shades the bands not yet shaded. Returns the tiles lacking, deduplicated; with
-    // acceptFallbacks every band is done (lacking tiles fell back to coarser levels),
-    // otherwise bands that lacked tiles stay undone until a later call.
+    // Shades the bands not yet shaded. Returns the missing tiles, deduplicated; with
+    // acceptFallbacks every band is done (missing tiles fell back to coarser levels),
+    // otherwise bands that missed tiles stay undone until a later call.
     std::vector<TileRequest> shade(bool acceptFallbacks = false);
     bool complete() const;
     // The deadline passed first: rasterization stopped short (the frame cannot be shaded),
@@ -149,7 +149,7 @@ class DynamicPhase {
 
   private:
     struct Band;
-    void shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& lacking);
+    void shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& missing);
 
     const Scene& scene_;
     const FrameState* frame_ = nullptr;

@@ -68,19 +68,19 @@ struct StaticFrameStats {
     }
 };
 
-// The shader maps' tiles: the distinct tiles this frame's probes asked for that were not
-// resident (over every shading pass), those dropped to keep the maps under their memory
-// budget, and what stays resident after the frame (tiles and bytes, all maps; a snapshot,
-// so a sum of frames keeps the last).
+// The shader maps' tiles: the missing tiles (the distinct tiles this frame's probes asked
+// for that were not resident, over every shading pass; stats.json's tiles_requested), those
+// dropped to keep the maps under their memory budget, and what stays resident after the
+// frame (tiles and bytes, all maps; a snapshot, so a sum of frames keeps the last).
 struct TileStats {
-    uint64_t requested = 0;
+    uint64_t missing = 0;
     uint64_t evicted = 0;
     uint64_t resident = 0;
     uint64_t residentBytes = 0;
     uint64_t residentPinnedBytes = 0;  // of residentBytes: the always-resident levels'
 
     TileStats& operator+=(const TileStats& o) {
-        requested += o.requested;
+        missing += o.missing;
         evicted += o.evicted;
         resident = o.resident;
         residentBytes = o.residentBytes;
@@ -90,7 +90,7 @@ struct TileStats {
 };
 
 // A frame budget (MultiphaseOptions::frameBudgetSeconds; `mpshade play`): the budget,
-// whether the frame's work fit it, the tiles its probes lacked that were left for later
+// whether the frame's work fit it, the tiles its probes found missing that were left for later
 // frames, and the objects whose static phase was due but put off (they were drawn from
 // their last representation).
 struct BudgetStats {
@@ -102,7 +102,7 @@ struct BudgetStats {
 };
 
 // Prefetching in the frame's slack (playback.h): tiles predicted by a low-resolution look
-// at a frame ahead (claim 11) and next to tiles lacked (claim 10), those filled; and of the
+// at a frame ahead (claim 11) and next to missing tiles (claim 10), those filled; and of the
 // tiles prefetched before, those this frame's probes read first (used) and those dropped,
 // or left unread for MultiphaseOptions::prefetchPatienceFrames, unread (wasted).
 struct PrefetchStats {

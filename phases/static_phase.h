@@ -103,7 +103,7 @@ class StaticPhase {
     // (the dicing survey's estimate, before any budget): for choosing a representation.
     double combinedFacets(size_t object, const ObjectState& state, const CameraState& camera) const;
 
-    // Fills the requested tiles lacking from the representations' maps: each map's tiles
+    // Fills the requested tiles missing from the representations' maps: each map's tiles
     // in one batch (finest level first), maps in parallel.
     void fill(std::span<const TileRequest> requests,
               std::span<const ObjectRepresentation* const> representations, StaticCosts& costs,

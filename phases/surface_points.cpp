@@ -151,16 +151,16 @@ void chartQueries(const ObjectView& view, const FacetMesh& mesh, const SurfacePo
 }
 
 // Step 5: the static n-tuple probed from the map into the batch's channels; the tiles the
-// probes lacked added to scratch.missing, sorted and without repeats. Returns how many
-// probes lacked a tile when stopping at missing ones (those points marked in `missed`).
+// probes found missing added to scratch.missing, sorted and without repeats. Returns how many
+// probes found a tile missing when stopping at missing ones (those points marked in `missed`).
 size_t probeChannels(const ShaderMap& map, const ProbeOptions& probe, bool stopAtMissing, size_t n,
                      size_t channels, uint8_t* missed, SurfaceShadingScratch& scratch,
                      SurfaceShadingCounters& counters) {
     scratch.probed.resize(n * channels);
-    scratch.lacking.resize(8192);
+    scratch.reported.resize(8192);
     ProbeResidency residency;
-    residency.missing = scratch.lacking.data();
-    residency.capacity = scratch.lacking.size();
+    residency.missing = scratch.reported.data();
+    residency.capacity = scratch.reported.size();
     residency.stopAtMissing = stopAtMissing;
     residency.queryMissed = stopAtMissing ? missed : nullptr;
     probeShaderMap(map, probe, {scratch.queries.data(), n}, scratch.probed.data(), &residency);
@@ -171,7 +171,7 @@ size_t probeChannels(const ShaderMap& map, const ProbeOptions& probe, bool stopA
         auto packedLess = [](const TileKey& x, const TileKey& y) {
             return x.packed() < y.packed();
         };
-        const auto first = scratch.lacking.begin();
+        const auto first = scratch.reported.begin();
         const auto last = first + static_cast<std::ptrdiff_t>(residency.count);
         std::sort(first, last, packedLess);
         const auto end = std::unique(first, last);

@@ -46,8 +46,8 @@ struct SurfaceShadingScratch {
     std::vector<ProbeQuery> queries;
     std::vector<float> probed, workspace;
     std::vector<float> b1, b2, derivatives;  // per point: barycentric weights; 4 derivatives
-    std::vector<TileKey> lacking;            // the probes' report buffer
-    std::vector<TileKey> missing;            // lacking tiles of the calls since it was cleared
+    std::vector<TileKey> reported;           // the probes' report buffer
+    std::vector<TileKey> missing;            // missing tiles of the calls since it was cleared
 };
 
 struct SurfaceShadingCounters {
@@ -59,10 +59,10 @@ struct SurfaceShadingCounters {
 };
 
 // Shades points.n points of `view`'s object into color and opacity (3 floats per point
-// each, sanitized: compositing.h). Tiles the probes lacked are added to scratch.missing.
-// With stopAtMissing, a point whose probes lacked a tile gets missed[i] = 1 and a
+// each, sanitized: compositing.h). Tiles the probes found missing are added to scratch.missing.
+// With stopAtMissing, a point whose probes found a tile missing gets missed[i] = 1 and a
 // meaningless result (it is to be shaded again once the tiles are filled); otherwise
-// lacking tiles fall back to coarser levels. Returns how many points missed.
+// missing tiles fall back to coarser levels. Returns how many points missed.
 size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, bool stopAtMissing,
                           const SurfacePoints& points, float* color, float* opacity,
                           uint8_t* missed, SurfaceShadingScratch& scratch,

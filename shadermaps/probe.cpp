@@ -81,7 +81,7 @@ struct Prober {
     mutable uint64_t cachedKey[2] = {~uint64_t{0}, ~uint64_t{0}};
     mutable int cachedSlot[2] = {-1, -1};
     mutable uint64_t fastProbes = 0;  // bilinear probes on the fast path, for residency
-    mutable bool missed = false;      // the current query lacked a tile
+    mutable bool missed = false;      // the current query found a tile missing
     // The fast path's constants: per level its width and its tiles per side; the tile's
     // geometry; float storage with no recency to report.
     float levelRes[32] = {};
@@ -92,7 +92,7 @@ struct Prober {
     // Tiles prefetched lately, by slot (direct-mapped).
     static constexpr unsigned kPrefetchMemory = 256;
     mutable int prefetched[kPrefetchMemory];
-    // Lacking tiles reported lately (direct-mapped by key).
+    // Missing tiles reported lately (direct-mapped by key).
     static constexpr int kReportedBits = 7;
     mutable uint64_t reported[1 << kReportedBits];
     bool fast = false;
@@ -213,8 +213,8 @@ struct Prober {
         return lastSlot[p];
     }
 
-    // Reports a lacking tile unless it was reported lately: the taps of a frame's probes
-    // that lack tiles ask for the same few again and again, and each report costs its
+    // Reports a missing tile unless it was reported lately: the taps of a frame's probes
+    // that find tiles missing ask for the same few again and again, and each report costs its
     // caller a sort (a camera outrunning its fills had spent 11% of a frame sorting them).
     void report(const TileKey& key) const {
         const uint64_t packed = key.packed();
@@ -343,7 +343,7 @@ struct Prober {
                     fastProbes += static_cast<uint64_t>(n);
                     return;
                 }
-                // The whole line lacks its tile: it falls back as a line, to the next
+                // The whole line finds its tile missing: it falls back as a line, to the next
                 // coarser level's fast path, as its taps one by one would (each is the same
                 // bilinear probe of that level at the same chart point), for one lookup
                 // instead of two a tap -- a frame whose camera outruns its fills had shaded

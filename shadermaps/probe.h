@@ -20,9 +20,9 @@
 //
 // Residency: a probe never fills and never allocates. A bilinear probe whose tile is not
 // resident uses the finest resident coarser level, records the fallback, and reports the
-// tile it lacked into the caller's buffer (while it has room); the tiles it did read go
+// tile it found missing into the caller's buffer (while it has room); the tiles it did read go
 // to a second buffer, for the tile cache's recency. With `stopAtMissing` (a caller that
-// will fill what was lacking and probe again, as `render` does) it reports the lacking
+// will fill what was missing and probe again, as `render` does) it reports the missing
 // tile and looks no further: the result is then meaningless, and no coarser tile is
 // reported that the repeated probe would not need.
 #pragma once
@@ -67,7 +67,7 @@ struct ProbeQuery {
 };
 
 struct ProbeResidency {
-    TileKey* missing = nullptr;  // caller's buffer for tiles that were lacking
+    TileKey* missing = nullptr;  // caller's buffer for tiles that were missing
     size_t capacity = 0;
     size_t count = 0;        // written to missing (duplicates possible)
     uint64_t fallbacks = 0;  // bilinear probes answered from a coarser level
@@ -76,8 +76,9 @@ struct ProbeResidency {
     size_t touchedCapacity = 0;
     size_t touchedCount = 0;  // written to touched; a tile read twice in a row is written once
     bool stopAtMissing = false;
-    uint64_t missingProbes = 0;      // bilinear probes that found their tile lacking
-    uint8_t* queryMissed = nullptr;  // caller's buffer, one per query: 1 where it lacked a tile
+    uint64_t missingProbes = 0;  // bilinear probes that found their tile missing
+    uint8_t* queryMissed =
+        nullptr;  // caller's buffer, one per query: 1 where it found a tile missing
 };
 
 // Writes queries.size() * map.channels() floats to out, query by query.

@@ -70,7 +70,7 @@ struct ShaderMapOptions {
     // Fill those levels at construction, so a probe always finds data to fall back to (a
     // caller that keeps a frame rate). false: they are filled when first asked for, like
     // any tile, and then never evicted -- for a caller that fills every tile its probes
-    // lack before it shades (constant quality, `render`), which never falls back.
+    // find missing before it shades (constant quality, `render`), which never falls back.
     bool fillPinnedUpFront = true;
     bool seamless = true;  // borders from the neighbouring chart; false: clamp to edge
 };

@@ -345,10 +345,10 @@ TEST(MultiphaseRenderer, PixelRateShadesOncePerPixelAndSurface) {
     // At 4 samples a pixel point's footprint (half a pixel) is a sample's (1 / sqrt(4)):
     // the same map levels, so about as many tiles (a pixel's point at the pixel centre
     // reaches a few fewer at the edges of what is seen).
-    RecordProperty("tiles_sample", std::to_string(sample.tiles.requested));
-    RecordProperty("tiles_pixel", std::to_string(pixel.tiles.requested));
-    EXPECT_GT(pixel.tiles.requested, sample.tiles.requested * 3 / 4);
-    EXPECT_LE(pixel.tiles.requested, sample.tiles.requested);
+    RecordProperty("tiles_sample", std::to_string(sample.tiles.missing));
+    RecordProperty("tiles_pixel", std::to_string(pixel.tiles.missing));
+    EXPECT_GT(pixel.tiles.missing, sample.tiles.missing * 3 / 4);
+    EXPECT_LE(pixel.tiles.missing, sample.tiles.missing);
 }
 
 TEST(MultiphaseRenderer, QuadRateShadesOncePerTwoByTwoPixelsAndSurface) {
@@ -375,7 +375,7 @@ TEST(MultiphaseRenderer, QuadRateShadesOncePerTwoByTwoPixelsAndSurface) {
     EXPECT_GT(psnr, 22.5);
     // A point's footprint is a whole pixel, twice the per-pixel one: a level coarser, so
     // about a quarter of the tiles.
-    EXPECT_LT(quad.tiles.requested * 2, pixel.tiles.requested);
+    EXPECT_LT(quad.tiles.missing * 2, pixel.tiles.missing);
 }
 
 TEST(MultiphaseRenderer, WholePixelShortcutGivesTheSamePointsBitForBit) {

@@ -43,15 +43,15 @@ TEST(Playback, WithTimeEnoughAFrameIsTheConstantQualityFrame) {
     FrameStats first, second;
     const Image coarse = play.renderFrame(3, small(), first);
     // The first frame fell back (its maps held only their coarsest levels), then filled
-    // every tile it lacked in the time left.
+    // every tile it found missing in the time left.
     EXPECT_GT(first.dynamic.probeFallbacks, 0u);
-    EXPECT_GT(first.tiles.requested, 0u);
+    EXPECT_GT(first.tiles.missing, 0u);
     EXPECT_EQ(first.budget.tilesDeferred, 0u);
     EXPECT_TRUE(first.budget.deadlineMet);
     EXPECT_EQ(first.budget.seconds, 60.0);
     const Image fine = play.renderFrame(3, small(), second);
     EXPECT_EQ(second.dynamic.probeFallbacks, 0u);
-    EXPECT_EQ(second.tiles.requested, 0u);
+    EXPECT_EQ(second.tiles.missing, 0u);
 
     MultiphaseOptions constant;
     constant.singlePhaseFrames = false;
@@ -77,8 +77,8 @@ TEST(Playback, NoTimeLeftDefersTilesAndRebuildsButDrawsEveryFrame) {
         const Image image = play.renderFrame(frame, small(), stats);
         EXPECT_EQ(stats.staticWork.work.runs, 0);
         EXPECT_EQ(stats.staticWork.work.tilesFilled, 0u);
-        EXPECT_GT(stats.tiles.requested, 0u);
-        EXPECT_EQ(stats.budget.tilesDeferred, stats.tiles.requested);
+        EXPECT_GT(stats.tiles.missing, 0u);
+        EXPECT_EQ(stats.budget.tilesDeferred, stats.tiles.missing);
         EXPECT_GT(stats.dynamic.probeFallbacks, 0u);
         if (frame == 40) {
             EXPECT_GE(stats.budget.rebuildsDeferred, 1);
@@ -90,8 +90,8 @@ TEST(Playback, NoTimeLeftDefersTilesAndRebuildsButDrawsEveryFrame) {
 
 TEST(Playback, DeferredTilesAreFilledInTheBackgroundForTheNextFrames) {
     const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
-    // No time for fills in any frame: what frame 4 lacked goes to the background filler,
-    // which fills it while nothing else runs; frame 4 again then lacks nothing, and is the
+    // No time for fills in any frame: what frame 4 found missing goes to the background filler,
+    // which fills it while nothing else runs; frame 4 again then finds missing nothing, and is the
     // constant-quality frame (from objects built for the same views).
     MultiphaseOptions o = budgeted(1e-6, 0.0);
     o.backgroundFills = true;
@@ -108,7 +108,7 @@ TEST(Playback, DeferredTilesAreFilledInTheBackgroundForTheNextFrames) {
     const Image image = play.renderFrame(4, small(), stats);
     // At least those (the worker may also have filled some of frame 3's queue meanwhile).
     EXPECT_GE(stats.background.tilesFilled, deferred);
-    EXPECT_EQ(stats.tiles.requested, 0u);
+    EXPECT_EQ(stats.tiles.missing, 0u);
     EXPECT_EQ(stats.dynamic.probeFallbacks, 0u);
     MultiphaseOptions constant;
     constant.singlePhaseFrames = false;
@@ -231,7 +231,7 @@ TEST(Playback, AnObjectEnteringTheViewIsBuiltBeforeItsFirstFrame) {
 TEST(Playback, AnObjectEnteringTheViewHasItsTilesBeforeItsFrames) {
     // Large enough that the ball reads finer levels than the always-resident ones: a
     // prediction of the frame ahead, in the slack, fills what the next frames read;
-    // without prefetching they lack it.
+    // without prefetching it is missing.
     const Scene scene = loadScene(writePanScene());
     PlaybackOptions options;
     options.render.width = 256;
@@ -257,16 +257,16 @@ TEST(Playback, AnObjectEnteringTheViewHasItsTilesBeforeItsFrames) {
     ASSERT_GT(k, 0u);
     ASSERT_EQ(without[k].objectsDrawn, 2u);
     // Over the frames that see it (its first shows a sliver: the always-resident levels
-    // serve it), measured 19 tiles lacked with prefetching against 87 without.
-    uint64_t lackedWith = 0, lackedWithout = 0;
+    // serve it), measured 19 missing tiles with prefetching against 87 without.
+    uint64_t missingWith = 0, missingWithout = 0;
     for (size_t f = k; f < with.size(); ++f) {
-        lackedWith += with[f].tiles.requested;
-        lackedWithout += without[f].tiles.requested;
+        missingWith += with[f].tiles.missing;
+        missingWithout += without[f].tiles.missing;
     }
-    RecordProperty("lacked", std::to_string(lackedWith) + " with, " +
-                                 std::to_string(lackedWithout) + " without prefetching");
-    EXPECT_GT(lackedWithout, 20u);
-    EXPECT_LT(lackedWith * 2, lackedWithout);
+    RecordProperty("missing", std::to_string(missingWith) + " with, " +
+                                  std::to_string(missingWithout) + " without prefetching");
+    EXPECT_GT(missingWithout, 20u);
+    EXPECT_LT(missingWith * 2, missingWithout);
 }
 
 }  // namespace

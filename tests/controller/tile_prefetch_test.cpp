@@ -1,6 +1,6 @@
 // Prefetching (patent claims 10 and 11): a tile prefetched before the frame that reads it
-// is not lacked there and counts as used; one no frame reads counts as wasted; the
-// low-resolution prediction names the tiles the full frame will lack.
+// is not missing there and counts as used; one no frame reads counts as wasted; the
+// low-resolution prediction names the tiles the full frame will find missing.
 #include <algorithm>
 #include <chrono>
 
@@ -28,20 +28,20 @@ RenderOptions small() {
     return r;
 }
 
-// How many tiles frame `frame` lacks after frame 0, nothing prefetched.
-uint64_t tilesLacked(const Scene& scene, int frame) {
+// How many tiles frame `frame` finds missing after frame 0, nothing prefetched.
+uint64_t tilesMissing(const Scene& scene, int frame) {
     MultiphaseRenderer renderer(scene, budgeted());
     FrameStats stats;
     renderer.renderFrame(0, small(), stats);
     renderer.renderFrame(frame, small(), stats);
-    return stats.tiles.requested;
+    return stats.tiles.missing;
 }
 
-TEST(TilePrefetch, PrefetchedTilesAreNotLackedAndCountAsUsed) {
+TEST(TilePrefetch, PrefetchedTilesAreNotMissingAndCountAsUsed) {
     const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
     // Frame 16 after frame 0: the camera has orbited 30 degrees.
-    const uint64_t lackedWithout = tilesLacked(scene, 16);
-    ASSERT_GT(lackedWithout, 20u);
+    const uint64_t missingWithout = tilesMissing(scene, 16);
+    ASSERT_GT(missingWithout, 20u);
     // Predicted at the full size, and at half of it (footprints scaled to match the full
     // image's: a planted "no scaling" reads a level too coarse and fails here).
     for (int divisor : {1, 2}) {
@@ -60,11 +60,11 @@ TEST(TilePrefetch, PrefetchedTilesAreNotLackedAndCountAsUsed) {
         FrameStats ahead;
         renderer.renderFrame(16, small(), ahead);
         RecordProperty(
-            "lacked_after_prediction_" + std::to_string(divisor),
-            std::to_string(ahead.tiles.requested) + " of " + std::to_string(lackedWithout));
+            "missing_after_prediction_" + std::to_string(divisor),
+            std::to_string(ahead.tiles.missing) + " of " + std::to_string(missingWithout));
         // The frame shades per sample at 4 samples: the same footprint as the prediction's
-        // per-pixel points (half a pixel), so it lacks little of what was predicted.
-        EXPECT_LT(ahead.tiles.requested * (divisor == 1 ? 4 : 2), lackedWithout) << divisor;
+        // per-pixel points (half a pixel), so little of what was predicted is missing.
+        EXPECT_LT(ahead.tiles.missing * (divisor == 1 ? 4 : 2), missingWithout) << divisor;
         EXPECT_GT(ahead.prefetch.used, slack.prefetch.filled / 2) << divisor;
         EXPECT_LE(ahead.prefetch.used, slack.prefetch.filled);
         EXPECT_EQ(ahead.prefetch.wasted, 0u);
@@ -155,13 +155,13 @@ TEST(TilePrefetch, PredictionPastItsDeadlineIsAbandoned) {
     EXPECT_EQ(predictor.predict(16, small(), 1, untimedSeconds).size(), whole.size());
 }
 
-TEST(TilePrefetch, NeighboursOfLackedTilesAreAdjacentAndNotResident) {
+TEST(TilePrefetch, NeighboursOfMissingTilesAreAdjacentAndNotResident) {
     const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
     MultiphaseRenderer renderer(scene, budgeted());
     FrameStats stats;
     renderer.renderFrame(0, small(), stats);
     renderer.renderFrame(1, small(), stats);
-    ASSERT_GT(stats.tiles.requested, 0u);
+    ASSERT_GT(stats.tiles.missing, 0u);
     const std::vector<TileRequest> adjacent = renderer.adjacentTiles();
     ASSERT_FALSE(adjacent.empty());
     for (const TileRequest& r : adjacent) {

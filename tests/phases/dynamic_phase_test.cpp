@@ -1,6 +1,6 @@
 // The dynamic phase (dynamic_phase.h) on its own: front-to-back compositing over the
 // background at every shading rate against numbers worked by hand, one shading point per
-// sample, pixel or 2x2 block, and the band protocol: bands whose probes lack tiles stay
+// sample, pixel or 2x2 block, and the band protocol: bands whose probes find tiles missing stay
 // undone, hand their tiles back, and once those are filled come out as if the tiles had been
 // resident from the start.
 #include <algorithm>
@@ -173,28 +173,28 @@ TEST(DynamicPhase, SurfacesOfOneObjectAtTwoDepthsGetAPointEach) {
     EXPECT_EQ(phase.stats().shadingPoints, expected);
 }
 
-TEST(DynamicPhase, BandsLackingTilesWaitForThemAndMatchAFrameWithTheTilesResident) {
+TEST(DynamicPhase, BandsMissingTilesWaitForThemAndMatchAFrameWithTheTilesResident) {
     // The vase's objects as shader maps with only their always-resident levels (if that):
-    // the first pass hands back the tiles its probes lacked and leaves those bands undone;
+    // the first pass hands back the tiles its probes found missing and leaves those bands undone;
     // once they are filled, the next pass finishes, bit for bit as a frame shaded with every
     // tile already resident.
     Frame f(test::sourcePath("examples/vase/scene.json"), Representation::ShaderMap, 64, 36);
     DynamicPhase phase(f.scene);
     phase.begin(f.state, f.drawn, f.layout, f.options(ShadingRate::Pixel));
-    std::vector<TileRequest> lacking = phase.shade();
-    ASSERT_FALSE(lacking.empty());
+    std::vector<TileRequest> missing = phase.shade();
+    ASSERT_FALSE(missing.empty());
     EXPECT_FALSE(phase.complete());
     EXPECT_EQ(phase.stats().shadePasses, 1);
-    for (size_t k = 1; k < lacking.size(); ++k)  // deduplicated, in order
-        EXPECT_TRUE(lacking[k - 1].object < lacking[k].object ||
-                    (lacking[k - 1].object == lacking[k].object &&
-                     lacking[k - 1].key.packed() < lacking[k].key.packed()));
+    for (size_t k = 1; k < missing.size(); ++k)  // deduplicated, in order
+        EXPECT_TRUE(missing[k - 1].object < missing[k].object ||
+                    (missing[k - 1].object == missing[k].object &&
+                     missing[k - 1].key.packed() < missing[k].key.packed()));
     int passes = 1;
-    while (!lacking.empty() && passes < 8) {
+    while (!missing.empty() && passes < 8) {
         StaticCosts costs;
-        f.statics.fill(lacking, f.drawn, costs);
-        EXPECT_EQ(costs.tilesFilled, lacking.size());
-        lacking = phase.shade();
+        f.statics.fill(missing, f.drawn, costs);
+        EXPECT_EQ(costs.tilesFilled, missing.size());
+        missing = phase.shade();
         ++passes;
     }
     ASSERT_TRUE(phase.complete());
@@ -210,9 +210,9 @@ TEST(DynamicPhase, AcceptingFallbacksFinishesInOnePassFromCoarserLevels) {
     Frame f(test::sourcePath("examples/vase/scene.json"), Representation::ShaderMap, 64, 36);
     DynamicPhase phase(f.scene);
     phase.begin(f.state, f.drawn, f.layout, f.options(ShadingRate::Pixel));
-    const std::vector<TileRequest> lacking = phase.shade(true);
+    const std::vector<TileRequest> missing = phase.shade(true);
     EXPECT_TRUE(phase.complete());
-    EXPECT_FALSE(lacking.empty());
+    EXPECT_FALSE(missing.empty());
     EXPECT_GT(phase.stats().probeFallbacks, 0u);
     EXPECT_LE(phase.stats().probeFallbacks, phase.stats().probes);
     for (float v : phase.samples().rgba) ASSERT_TRUE(std::isfinite(v));

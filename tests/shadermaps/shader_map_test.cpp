@@ -261,7 +261,7 @@ TEST(ShaderMap, FelineLinesFallBackLikeTheirTaps) {
 }
 
 // The levels a probe of footprint k level-0 texels (an isotropic query) reads, observed
-// through the tiles it reports lacking from a map holding only its 1 x 1 level.
+// through the tiles it reports missing from a map holding only its 1 x 1 level.
 std::set<int> levelsRead(const MapFixture& f, ProbeFilter filter, float k) {
     ShaderMapOptions options;
     options.resolution = 1024;
@@ -353,7 +353,7 @@ TEST(ShaderMap, AlwaysResidentLevelsFilledUpFrontOrWhenFirstAsked) {
     EXPECT_EQ(eager.residentTiles(), 9u);
     ShaderMap lazy(f.surface, *f.kernel, f.uniforms, lazyOptions);
     EXPECT_EQ(lazy.residentTiles(), 0u);
-    // A footprint of 16 level-0 texels reads level 4 (16 x 16 texels, one tile): lacking,
+    // A footprint of 16 level-0 texels reads level 4 (16 x 16 texels, one tile): missing,
     // reported, then filled -- and, being always resident, never offered for eviction.
     ProbeOptions probe;
     probe.filter = ProbeFilter::Trilinear;
