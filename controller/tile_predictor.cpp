@@ -21,9 +21,8 @@ std::vector<TileRequest> TilePredictor::predict(int frame, const RenderOptions& 
     const int height = std::max(1, full.height / divisor);
     const int spp = full.samplesPerPixel;
     state_ = frameStateAt(renderer_.resources(), frame, width, height, 1);
-    if (!layout_ || !layout_->matches(width, height, 1, options.seed, options.filter))
-        layout_ =
-            std::make_shared<const SampleLayout>(width, height, 1, options.seed, options.filter);
+    const std::shared_ptr<const SampleLayout> layout =
+        layouts_.get(width, height, 1, options.seed, options.filter);
     std::vector<const ObjectRepresentation*> drawn(scene.objects.size(), nullptr);
     for (size_t i = 0; i < drawn.size(); ++i) {
         const ObjectRepresentation* rep = renderer_.representation(i);
@@ -38,7 +37,7 @@ std::vector<TileRequest> TilePredictor::predict(int frame, const RenderOptions& 
                        (0.5f * static_cast<float>(divisor));
     o.shadingRate = ShadingRate::Pixel;
     o.deadline = deadline;
-    phase_.begin(state_, drawn, layout_, o);
+    phase_.begin(state_, drawn, layout, o);
     // Abandoned in rasterization: no visibility to trust, so nothing predicted. In
     // shading: the finished bands' tiles stand.
     std::vector<TileRequest> missing;

@@ -34,7 +34,7 @@ class TilePredictor {
   private:
     const MultiphaseRenderer& renderer_;
     DynamicPhase phase_;
-    std::shared_ptr<const SampleLayout> layout_;
+    SampleLayoutCache layouts_;
     FrameState state_;  // read by phase_ until the next predict()
     bool abandoned_ = false;
 };
