@@ -107,11 +107,13 @@ MultiphaseOptions multiphaseOptions(const RenderCommandOptions& options) {
 // --compare: the frame against the reference's (and with --truth-spp both against a truth
 // of many more samples: the error each makes, rather than how far apart they are), added
 // to the frame's stats.json entry and reported.
+// `ref` is the reference's image, reused frame to frame as the multi-phase one is (a fresh
+// image's page faults would be timed as the reference's).
 void compareFrame(int frame, const Image& image, const FrameStats& stats,
                   const RenderOptions& render, const RenderCommandOptions& options,
-                  ReferenceRenderer& reference, nlohmann::json& entry) {
+                  ReferenceRenderer& reference, Image& ref, nlohmann::json& entry) {
     FrameStats refStats;
-    const Image ref = reference.renderFrame(frame, render, refStats);
+    reference.renderFrame(frame, render, refStats, ref);
     const ImageError err = compareImages(image, ref);
     entry["reference"] = referenceFrameJson(stats, refStats, err);
     const char* newline = isatty(STDERR_FILENO) ? "\n" : "";
@@ -193,7 +195,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         writeTextFile(std::filesystem::path(options.outDir) / "stats.json", doc.dump(2) + "\n");
     };
     const InterruptWatch watch;
-    Image image;  // reused frame to frame
+    Image image, referenceImage;  // reused frame to frame
     for (int frame = first; frame < last; ++frame) {
         FrameStats stats;
         renderer.renderFrame(frame, render, stats, image, [&](int done, int total) {
@@ -201,7 +203,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
         });
         writeFrameImages(image, options.outDir, frame);
         nlohmann::json entry = renderFrameJson(scene, stats, multiphase, image);
-        if (options.compare) compareFrame(frame, image, stats, render, options, *reference, entry);
+        if (options.compare)
+            compareFrame(frame, image, stats, render, options, *reference, referenceImage, entry);
         frames.push_back(entry);
         writeStats();
         if (interrupted()) break;

@@ -7,10 +7,12 @@
 #include <string>
 
 #include <benchmark/benchmark.h>
+#include <tbb/task_arena.h>
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
 
 #include "controller/multiphase_renderer.h"
+#include "controller/stage_limits.h"
 #include "controller/tile_predictor.h"
 #include "phases/facet_rasterizer.h"
 #include "phases/fixed_point_warp.h"
@@ -105,16 +107,20 @@ void frameReference(benchmark::State& state, const char* path) {
     FrameFixture f(path);
     f.reference = std::make_unique<ReferenceRenderer>(f.scene);
     FrameStats stats;
-    for (auto _ : state)
-        benchmark::DoNotOptimize(f.reference->renderFrame(1, f.options, stats).rgba.data());
+    Image image;  // reused frame to frame, as render and play do
+    for (auto _ : state) {
+        f.reference->renderFrame(1, f.options, stats, image);
+        benchmark::DoNotOptimize(image.rgba.data());
+    }
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * stats.samples));
 }
 
 // The timed loop's frame, in a function of its own so instruction counts can be taken of it
 // alone: valgrind --tool=callgrind --toggle-collect='*steadyFrame*'.
-__attribute__((noinline)) Image steadyFrame(MultiphaseRenderer& multi, const RenderOptions& options,
-                                            FrameStats& stats) {
-    return multi.renderFrame(1, options, stats);
+// The image is reused frame to frame, as render and play reuse it.
+__attribute__((noinline)) void steadyFrame(MultiphaseRenderer& multi, const RenderOptions& options,
+                                           FrameStats& stats, Image& image) {
+    multi.renderFrame(1, options, stats, image);
 }
 
 void frameMultiphase(benchmark::State& state, const char* path, int representation, int rate) {
@@ -126,8 +132,11 @@ void frameMultiphase(benchmark::State& state, const char* path, int representati
     FrameStats stats;
     f.multi->renderFrame(0, f.options, stats);  // the static phase
     f.multi->renderFrame(1, f.options, stats);  // frame 1's tiles
-    for (auto _ : state)
-        benchmark::DoNotOptimize(steadyFrame(*f.multi, f.options, stats).rgba.data());
+    Image image;
+    for (auto _ : state) {
+        steadyFrame(*f.multi, f.options, stats, image);
+        benchmark::DoNotOptimize(image.rgba.data());
+    }
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * stats.samples));
     state.counters["facets"] = static_cast<double>(stats.dynamic.facets);
     state.counters["static_runs_in_loop"] = stats.staticWork.work.runs;
@@ -138,6 +147,11 @@ void frameMultiphase(benchmark::State& state, const char* path, int representati
     state.counters["shading_points"] = static_cast<double>(stats.shadedPoints);
     state.counters["probes_per_point"] =
         stats.shadedPoints ? static_cast<double>(stats.dynamic.probes) / stats.shadedPoints : 0.0;
+    // Each stage in nanoseconds per sample per core (stage_limits.h), the last frame's.
+    MachineLimits cores;
+    cores.cores = std::max(1, tbb::this_task_arena::max_concurrency());
+    for (const StageCost& c : dynamicStageCosts({stats}, f.options.samplesPerPixel, cores))
+        state.counters["ns_" + c.name.substr(0, c.name.find(' '))] = c.nsPerSample;
 }
 
 // Facets per covered pixel, at the example's own size (a count, not a timing): stored in

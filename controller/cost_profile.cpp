@@ -93,6 +93,8 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
     p.spp = ro.samplesPerPixel;
     p.threads = trace.threads();
     p.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    p.machine = measureMachineLimits();
+    p.stages = dynamicStageCosts(p.frames, p.spp, p.machine);
     return p;
 }
 
@@ -143,6 +145,27 @@ std::string profileMarkdown(const CostProfile& p) {
             "for itself); their time is in the total only.\n\n",
             singlePhase);
 
+    if (!p.stages.empty()) {
+        md += "## The dynamic phase against the machine\n\n";
+        md += format(
+            "Per sample per core: a stage's wall time times the %d cores sharing it, over the "
+            "frame's samples (the median of the steady frames). The bound is the time the "
+            "bytes the stage must stream take at the memory bandwidth measured now "
+            "(%.1f GB/s, every core copying): a stage near it is memory-bound, one far above "
+            "it computes (or waits on memory it does not stream).\n\n",
+            p.machine.cores, p.machine.bytesPerSecond / 1e9);
+        md +=
+            "| stage | ns per sample | bytes per sample | bound, ns | times the bound | "
+            "dynamic instructions per sample |\n| --- | --- | --- | --- | --- | --- |\n";
+        for (const StageCost& c : p.stages)
+            md += format("| %s | %.1f | %.0f | %.2f | %.1f | %s |\n", c.name.c_str(), c.nsPerSample,
+                         c.bytesPerSample, c.boundNsPerSample,
+                         c.boundNsPerSample > 0.0 ? c.nsPerSample / c.boundNsPerSample : 0.0,
+                         c.instructionsPerSample > 0.0
+                             ? format("%.0f", c.instructionsPerSample).c_str()
+                             : "");
+        md += "\n";
+    }
     md += "## Per object\n\n";
     md +=
         "| object | representation | static runs | static ms | shading ms per frame drawn | "

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "controller/multiphase_renderer.h"
+#include "controller/stage_limits.h"
 #include "controller/trace_recorder.h"
 
 namespace mpshade {
@@ -53,6 +54,9 @@ struct CostProfile {
     double wallSeconds = 0.0;
     std::vector<FrameStats> frames;
     std::vector<ObjectProfile> objects;
+    // The dynamic phase's stages per sample against the machine (stage_limits.h).
+    MachineLimits machine;
+    std::vector<StageCost> stages;
 };
 
 // Profiles frames [first, last) of `scene`; progress(frame) after each.
@@ -64,7 +68,8 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
 // "geometry" (a static part not worth storing), "facets" or "shadermap".
 std::string representationName(const MultiphaseRenderer& renderer, size_t object);
 
-// profile.md: the run, per frame static against dynamic, per object its costs.
+// profile.md: the run, static against dynamic, the dynamic stages against the machine, per
+// object and per frame their costs.
 std::string profileMarkdown(const CostProfile& profile);
 
 }  // namespace mpshade

@@ -1,0 +1,70 @@
+// The dynamic stages per sample against the machine (stage_limits.h), from frame stats
+// whose figures are worked out by hand: the steady frames chosen, nanoseconds per sample per
+// core, the bytes each stage must stream and their time at a given bandwidth.
+#include <gtest/gtest.h>
+
+#include "controller/stage_limits.h"
+
+namespace mpshade {
+namespace {
+
+FrameStats frame(double shadeSeconds, int staticRuns) {
+    FrameStats f;
+    f.samples = 1000000;
+    f.dynamic.warpSeconds = 0.001;
+    f.dynamic.rasterSeconds = 0.002;
+    f.dynamic.shadeSeconds = shadeSeconds;
+    f.dynamic.resolveSeconds = 0.004;
+    f.dynamic.verticesWarped = 500000;
+    f.dynamic.shadingPoints = 250000;
+    f.dynamic.instructions = 30000000;
+    f.staticWork.work.runs = staticRuns;
+    return f;
+}
+
+TEST(StageLimits, SteadyFramesPerSamplePerCoreAgainstTheBandwidth) {
+    // Two cores at 10 GB/s. The first frame ran the static phase and is left out; the
+    // median of the steady frames' shading is 0.010 s: 20 ns a sample per core.
+    const MachineLimits machine{2, 1e10};
+    FrameStats single = frame(0.5, 0);
+    single.singlePhase = true;
+    const std::vector<FrameStats> frames = {frame(0.9, 3), frame(0.010, 0), frame(0.012, 0),
+                                            frame(0.008, 0), single};
+    const std::vector<StageCost> c = dynamicStageCosts(frames, 4, machine);
+    ASSERT_EQ(c.size(), 5u);
+    EXPECT_EQ(c[0].name, "warp");
+    EXPECT_DOUBLE_EQ(c[0].nsPerSample, 2.0);      // 1 ms x 2 cores / 1e6 samples
+    EXPECT_DOUBLE_EQ(c[0].bytesPerSample, 11.0);  // 22 bytes x 0.5 vertices a sample
+    EXPECT_DOUBLE_EQ(c[1].nsPerSample, 4.0);
+    EXPECT_DOUBLE_EQ(c[1].bytesPerSample, 21.0);
+    EXPECT_DOUBLE_EQ(c[1].boundNsPerSample, 4.2);  // 21 bytes x 2 cores / 10 GB/s
+    EXPECT_EQ(c[2].name, "shade");
+    EXPECT_DOUBLE_EQ(c[2].nsPerSample, 20.0);
+    EXPECT_DOUBLE_EQ(c[2].bytesPerSample, 29.0 + 80.0 * 0.25);
+    EXPECT_DOUBLE_EQ(c[2].instructionsPerSample, 30.0);
+    EXPECT_DOUBLE_EQ(c[3].nsPerSample, 8.0);
+    EXPECT_DOUBLE_EQ(c[3].bytesPerSample, 40.0 + 20.0 / 4);
+    EXPECT_EQ(c[4].name, "dynamic phase");
+    EXPECT_DOUBLE_EQ(c[4].nsPerSample, 2.0 + 4.0 + 20.0 + 8.0);
+}
+
+TEST(StageLimits, WithoutASteadyFrameEveryMultiphaseFrameButTheFirst) {
+    const MachineLimits machine{1, 1e10};
+    const std::vector<FrameStats> frames = {frame(0.9, 2), frame(0.002, 1), frame(0.004, 1)};
+    const std::vector<StageCost> c = dynamicStageCosts(frames, 1, machine);
+    ASSERT_EQ(c.size(), 5u);
+    EXPECT_DOUBLE_EQ(c[2].nsPerSample, 3.0);  // the median of 2 and 4 ns
+    FrameStats single = frame(0.5, 0);
+    single.singlePhase = true;
+    EXPECT_TRUE(dynamicStageCosts({single}, 1, machine).empty());
+}
+
+TEST(StageLimits, TheMeasuredBandwidthIsPlausible) {
+    const MachineLimits m = measureMachineLimits();
+    EXPECT_GE(m.cores, 1);
+    EXPECT_GT(m.bytesPerSecond, 1e8);   // above 100 MB/s
+    EXPECT_LT(m.bytesPerSecond, 1e13);  // below 10 TB/s
+}
+
+}  // namespace
+}  // namespace mpshade
