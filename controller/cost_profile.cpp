@@ -28,6 +28,7 @@ double mb(uint64_t bytes) {
 std::string representationName(const MultiphaseRenderer& renderer, size_t object) {
     const ObjectReport& r = renderer.report(object);
     if (r.kind == Representation::Auto) return "none (never seen)";
+    if (r.kind == Representation::Direct) return "direct";
     if (renderer.factored(object).staticPart.channelOutputs.empty()) return "geometry";
     return r.kind == Representation::Facets ? "facets" : "shadermap";
 }

@@ -65,7 +65,7 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
                          const std::function<void(int)>& progress = {});
 
 // The representation of object `object` as reports name it: "none (never seen)",
-// "geometry" (a static part not worth storing), "facets" or "shadermap".
+// "geometry" (a static part not worth storing), "facets", "shadermap" or "direct".
 std::string representationName(const MultiphaseRenderer& renderer, size_t object);
 
 // profile.md: the run, static against dynamic, the dynamic stages against the machine, per

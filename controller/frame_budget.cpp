@@ -37,8 +37,9 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
             const Representation kind =
                 planner_.choose(i, slot, f, ahead.objects[i], ahead.camera, ahead.spp, dynamic, in);
             const RepresentationChoice estimate = chooseRepresentation(in, options_.costModel);
-            const double cost = kind == Representation::Facets ? estimate.facetsStaticSeconds
-                                                               : estimate.mapStaticSeconds;
+            const double cost = kind == Representation::Facets      ? estimate.facetsStaticSeconds
+                                : kind == Representation::ShaderMap ? estimate.mapStaticSeconds
+                                                                    : 0.0;
             // Half as much again, as rebuilds are admitted: an estimate, not a measure.
             if (secondsSince(start) + 1.5 * cost > seconds) continue;
             const ScopedSpan span(options_.trace, "build ahead", PhaseKind::Static,

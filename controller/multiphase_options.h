@@ -34,6 +34,10 @@ struct MultiphaseOptions {
     size_t mapMemoryBytes = size_t{96} << 20;
     // Forces every object's representation (tests, benchmarks); unset: the scene's.
     std::optional<Representation> representation;
+    // Never slower than single-phase, per object: an object the scene leaves to auto whose
+    // stored representation measures costlier a frame than the reference, two frames
+    // running, goes direct (static_run_triggers.h, compareWithReference).
+    bool directWhenSlower = true;
     // A frame whose due static work, with the dynamic frames it would serve, is estimated
     // to cost more than rendering those frames single-phase is rendered by the reference
     // renderer instead, and nothing is built (a camera cut every frame, a short request).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 
 #include <tbb/parallel_for.h>
@@ -147,11 +148,14 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
 // and its sample layout.
 void MultiphaseRenderer::beginFrame(int frame, const RenderOptions& options, FrameStats& stats) {
     stats = FrameStats{};
+    compareLastFrameWithReference();
     const RenderOptions o = options.resolved(scene_.settings);
     frame_ = frameStateAt(resources_, frame, o.width, o.height, o.samplesPerPixel);
     for (ObjectSlot& slot : slots_) {
         slot.frameStaticSeconds = 0.0;
         slot.frameDynamic = ObjectFrameCost{};
+        slot.builtThisFrame = false;
+        slot.frameTilesFilled = 0;
     }
     if (filler_) {
         // Held while this frame's static work runs; no probe runs now either, so the
@@ -178,6 +182,34 @@ void MultiphaseRenderer::beginFrame(int frame, const RenderOptions& options, Fra
         options_.trace->span("sample layout", PhaseKind::Dynamic, SpanLevel::Phase, asked,
                              Clock::now(), -1, frame);
     dynamicOptions_ = dynamicOptionsFor(options);
+}
+
+// The last frame's work for each object drawn from a stored representation, against what
+// the reference would have spent on it, both in the cost model's terms
+// (static_run_triggers.h): objects the scene leaves to auto.
+void MultiphaseRenderer::compareLastFrameWithReference() {
+    if (!options_.directWhenSlower || options_.representation || frame_.spp == 0) return;
+    const RepresentationCostModel& m = options_.costModel;
+    const ShaderMapOptions& maps = static_.options().shaderMap;
+    const double texelsPerTile = std::pow(maps.tileSize + 2.0 * maps.border, 2.0);
+    const double samplesPerPoint = dynamicOptions_.shadingRate == ShadingRate::Sample ? 1.0
+                                   : dynamicOptions_.shadingRate == ShadingRate::Pixel
+                                       ? frame_.spp
+                                       : 4.0 * frame_.spp;
+    for (size_t i = 0; i < slots_.size(); ++i) {
+        const ObjectSlot& slot = slots_[i];
+        if (scene_.objects[i].representation != Representation::Auto || !slot.representation)
+            continue;
+        const FactoredShader& f = factored(i);
+        const double points = static_cast<double>(slot.frameDynamic.shadingPoints);
+        const bool map = slot.representation->kind == Representation::ShaderMap;
+        const double stored = 1e-9 * (static_cast<double>(slot.frameTilesFilled) * texelsPerTile *
+                                          (f.staticCost * m.nsPerCostUnit + m.geometryPointNs) +
+                                      points * (map ? m.mapPointNs : m.vertexPointNs));
+        const double reference = 1e-9 * points * samplesPerPoint *
+                                 (m.referenceSampleNs + m.referenceNsPerCostUnit * f.originalCost);
+        compareWithReference(slots_[i], stored, reference, static_.shading(i).directAllowed);
+    }
 }
 
 // 1-2. The objects in view, and of them those whose static phase is due, with why.
@@ -261,6 +293,7 @@ void MultiphaseRenderer::buildDue(const FramePlan& plan, FrameStats& stats) {
         slot.representation =
             static_.build(i, slot.kind, frame_.objects[i], frame_.camera, frame_.uniforms[i],
                           slot.representation.get(), costs[k]);
+        slot.builtThisFrame = true;
     });
     for (size_t k = 0; k < plan.due.size(); ++k) {
         const size_t i = plan.due[k];
@@ -341,8 +374,10 @@ void MultiphaseRenderer::countFills(const TileFillResult& fills, FrameStats& sta
     stats.staticWork.work += fills.costs;
     stats.controllerSeconds += fills.roomSeconds;
     stats.tiles.evicted += fills.evicted;
-    for (size_t i = 0; i < fills.objectTiles.size(); ++i)
+    for (size_t i = 0; i < fills.objectTiles.size(); ++i) {
         slots_[i].report.staticCosts.tilesFilled += fills.objectTiles[i];
+        slots_[i].frameTilesFilled += fills.objectTiles[i];
+    }
     for (size_t i = 0; i < fills.timing.objectSeconds.size(); ++i) {
         slots_[i].frameStaticSeconds += fills.timing.objectSeconds[i];
         slots_[i].report.staticCosts.seconds += fills.timing.objectSeconds[i];

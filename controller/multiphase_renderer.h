@@ -96,6 +96,7 @@ class MultiphaseRenderer : public Renderer {
     void buildDue(const FramePlan& plan, FrameStats& stats);
     void shadeAndFill(FramePlan& plan, FrameStats& stats, const ProgressFn& progress);
     void recordFrame(const FramePlan& plan, FrameStats& stats);
+    void compareLastFrameWithReference();
     void render(int frame, const RenderOptions& options, FrameStats& stats,
                 const ProgressFn& progress);
 

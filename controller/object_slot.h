@@ -47,6 +47,13 @@ struct ObjectSlot {
     // threads; its dynamic work (all zero when not drawn or rendered single-phase).
     double frameStaticSeconds = 0.0;
     ObjectFrameCost frameDynamic;
+    bool builtThisFrame = false;
+    uint64_t frameTilesFilled = 0;  // the last frame's, for its map
+    // Never slower than single-phase (static_run_triggers.h): the frames running its stored
+    // representation cost more than the reference would have; once enough, it goes direct.
+    int framesSlowerThanReference = 0;
+    bool goesDirect = false;
+    float measuredMs = 0.0f, referenceMs = 0.0f;  // the last frame's, estimated CPU ms
     ObjectReport report;
 };
 

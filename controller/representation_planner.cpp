@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -80,6 +81,26 @@ Representation RepresentationPlanner::choose(size_t i, ObjectSlot& slot, int fra
                                              ObjectCostInputs& in) const {
     const Representation asked = forced_.value_or(scene_.objects[i].representation);
     in = costInputs(i, slot, frame, state, camera, spp, dynamic);
+    if (slot.goesDirect && asked == Representation::Auto) {
+        char text[320];
+        std::snprintf(text, sizeof text,
+                      "auto: direct; its stored representation's work, frames running, cost "
+                      "%.1f ms of CPU a frame where the reference would spend %.1f ms on it "
+                      "(the cost model's figures for the tiles filled and points shaded)",
+                      slot.measuredMs, slot.referenceMs);
+        slot.report.reason = text;
+        return Representation::Direct;
+    }
+    if (asked == Representation::Direct && !statics_.shading(i).directAllowed) {
+        slot.report.reason =
+            "the scene asks for direct, but its shader traces occlusion rays from the shading "
+            "point, which facets at the geometric tolerance would start inside the surface: "
+            "auto instead";
+        in.combinedFacets = statics_.combinedFacets(i, state, camera);
+        const RepresentationChoice choice = chooseRepresentation(in, model_);
+        slot.report.reason += " (" + choice.reason + ")";
+        return choice.kind;
+    }
     if (asked == Representation::Facets)
         in.combinedFacets = statics_.combinedFacets(i, state, camera);
     if (asked != Representation::Auto) {
@@ -127,12 +148,14 @@ bool RepresentationPlanner::singlePhasePays(std::span<const size_t> due,
         const double facets =
             (k >= 0 ? c.facetsStaticSeconds : 0.0) + frames * c.facetsFrameSeconds;
         const double map = (k >= 0 ? c.mapStaticSeconds : 0.0) + frames * c.mapFrameSeconds;
+        const double direct = frames * c.directFrameSeconds;
+        const Representation kind = k >= 0 ? slot.kind : slot.representation->kind;
         if (k >= 0 && leastCost)
-            multi += std::min(facets, map);  // whichever representation is cheaper
+            multi += std::min(facets, map);  // whichever stored representation is cheaper
         else
-            multi += (k >= 0 ? slot.kind : slot.representation->kind) == Representation::Facets
-                         ? facets
-                         : map;
+            multi += kind == Representation::Facets   ? facets
+                     : kind == Representation::Direct ? direct
+                                                      : map;
         single += frames * c.singlePhaseFrameSeconds;
     }
     return single < multi;

@@ -14,6 +14,12 @@ std::optional<StaticRunDue> staticRunDue(uint32_t object, const ObjectSlot& slot
     due.object = object;
     const ObjectRepresentation* rep = slot.representation.get();
     if (!rep) return due;  // first seen
+    if (slot.goesDirect && rep->kind != Representation::Direct) {
+        due.cause = StaticRunDue::SlowerThanReference;
+        due.measured = slot.measuredMs;
+        due.threshold = slot.referenceMs;
+        return due;
+    }
     const glm::vec3 forward =
         glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
     const ObjectRepresentation::RangeCheck range = rep->checkRange(state.eye, forward);
@@ -46,6 +52,21 @@ std::optional<StaticRunDue> staticRunDue(uint32_t object, const ObjectSlot& slot
         return std::nullopt;
     }
     return due;
+}
+
+void compareWithReference(ObjectSlot& slot, double storedSeconds, double referenceSeconds,
+                          bool directAllowed, int slowFrames) {
+    const ObjectRepresentation* rep = slot.representation.get();
+    // A frame that built the object fills its first tiles: that is the build's cost, paid
+    // once, and says nothing of the frames after.
+    if (!rep || !slot.frameDynamic.drawn || slot.builtThisFrame ||
+        rep->kind == Representation::Direct || !directAllowed || slot.goesDirect)
+        return;
+    slot.measuredMs = static_cast<float>(1e3 * storedSeconds);
+    slot.referenceMs = static_cast<float>(1e3 * referenceSeconds);
+    slot.framesSlowerThanReference =
+        storedSeconds > referenceSeconds ? slot.framesSlowerThanReference + 1 : 0;
+    if (slot.framesSlowerThanReference >= slowFrames) slot.goesDirect = true;
 }
 
 std::vector<size_t> admitRebuilds(std::span<const size_t> due, std::span<const ObjectSlot> slots,

@@ -23,6 +23,9 @@ struct StaticRunDue {
         FacetsTooLong,
         ImageSize,
         StaticInput,  // measured: the largest move of an input over its span (static_inputs.h)
+        // Its stored representation cost more a frame than the reference would spend on it,
+        // frames running (static_run_triggers.h): measured and threshold in ms of CPU time.
+        SlowerThanReference,
     };
     uint32_t object = 0;
     Cause cause = FirstSeen;
@@ -45,6 +48,8 @@ inline const char* staticRunCauseName(StaticRunDue::Cause cause) {
             return "image height changed";
         case StaticRunDue::StaticInput:
             return "an animated input of its static part moved";
+        case StaticRunDue::SlowerThanReference:
+            return "its stored representation cost more than the reference would: direct";
     }
     return "unknown";
 }

@@ -30,6 +30,9 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     const double runs = in.haveMap ? 0.0 : in.coveredPixels * texelsPerPixel + pinnedTexels;
     const double mapStatic = runs * staticPointNs;
     const double mapFrame = points * model.mapPointNs;
+    // Direct: the whole shader at every point, nothing stored.
+    const double directFrame =
+        points * (model.directPointNs + in.originalCostUnits * model.directNsPerCostUnit);
 
     RepresentationChoice c;
     c.facetsSeconds = (facetsStatic + frames * facetsFrame) * 1e-9;
@@ -38,6 +41,8 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     c.facetsFrameSeconds = facetsFrame * 1e-9;
     c.mapStaticSeconds = mapStatic * 1e-9;
     c.mapFrameSeconds = mapFrame * 1e-9;
+    c.directFrameSeconds = directFrame * 1e-9;
+    c.directSeconds = frames * c.directFrameSeconds;
     c.singlePhaseFrameSeconds =
         in.coveredPixels * static_cast<double>(in.samplesPerPixel) *
         (in.originalCostUnits * model.referenceNsPerCostUnit + model.referenceSampleNs) * 1e-9;

@@ -81,6 +81,27 @@ bool readsFrame(const IrProgram& program, const ShaderBinding& binding) {
     return false;
 }
 
+// Occlusion rays leave from the shading point: from a facet at the geometric tolerance, up
+// to a quarter pixel inside the exact surface they are traced against, they would hit it.
+bool castsRays(const IrProgram& program) {
+    for (const Inst& inst : program.insts)
+        if (inst.op == Op::Occlusion) return true;
+    return false;
+}
+
+// The VertexAttributes rows a program reads, in the order it first reads them.
+std::vector<int> geometryRowsOf(const IrProgram& program) {
+    std::vector<int> rows;
+    for (const Inst& inst : program.insts) {
+        if (inst.op != Op::Global) continue;
+        const int row = rowOf(static_cast<GlobalId>(inst.imm));
+        if (row < 0) continue;
+        for (int k = 0; k < inst.nout; ++k)
+            if (std::find(rows.begin(), rows.end(), row + k) == rows.end()) rows.push_back(row + k);
+    }
+    return rows;
+}
+
 // Per-thread scratch for the static shading of vertices.
 struct VertexScratch {
     ShadingBatch batch;
@@ -104,15 +125,11 @@ StaticPhase::StaticPhase(const Scene& scene, const SceneResources& resources,
         s->opaque = isOpaque(s->factored.dynamicPart);
         s->closed = isClosed(*obj.surface);
         s->staticReadsFrame = readsFrame(s->factored.staticPart, binding);
-        for (const Inst& inst : s->factored.dynamicPart.insts) {
-            if (inst.op != Op::Global) continue;
-            const int row = rowOf(static_cast<GlobalId>(inst.imm));
-            if (row < 0) continue;
-            for (int k = 0; k < inst.nout; ++k)
-                if (std::find(s->geometryRows.begin(), s->geometryRows.end(), row + k) ==
-                    s->geometryRows.end())
-                    s->geometryRows.push_back(row + k);
-        }
+        s->geometryRows = geometryRowsOf(s->factored.dynamicPart);
+        s->directKernel = resources.object(objects_.size()).kernel;
+        s->directRows = geometryRowsOf(s->directKernel->program());
+        s->directOpaque = isOpaque(s->directKernel->program());
+        s->directAllowed = !castsRays(s->directKernel->program());
         objects_.push_back(std::move(s));
     }
 }
@@ -183,18 +200,18 @@ float longestEdgePixels(const FacetMesh& mesh, const ObjectState& state,
     return static_cast<float>(std::sqrt(static_cast<double>(longest))) / 256.0f;
 }
 
-// The vertex attributes: the geometry the dynamic part reads, and with `runStatic` (a
+// The vertex attributes: the geometry rows the dynamic kernel reads, and with `runStatic` (a
 // combined representation) the n-tuple of mesh.channels the static part computes at each
 // vertex. Returns the static shader instructions run.
-uint64_t shadeVertices(const ObjectShading& obj, const DicedSurface& diced,
-                       const ObjectState& state, const ShadingUniforms& uniforms, bool runStatic,
-                       FacetMesh& mesh) {
+uint64_t shadeVertices(const ObjectShading& obj, const std::vector<int>& geometryRows,
+                       const DicedSurface& diced, const ObjectState& state,
+                       const ShadingUniforms& uniforms, bool runStatic, FacetMesh& mesh) {
     const size_t staticChannels = static_cast<size_t>(mesh.channels);
     const size_t n = mesh.attributeChartPoint.size();
     VertexAttributes& attr = mesh.attributes;
     attr.count = n;
     attr.rows.assign(VertexAttributes::kGeometryRows + staticChannels, {});
-    for (int row : obj.geometryRows) attr.rows[static_cast<size_t>(row)].resize(n);
+    for (int row : geometryRows) attr.rows[static_cast<size_t>(row)].resize(n);
     for (size_t c = 0; c < staticChannels; ++c)
         attr.rows[VertexAttributes::kGeometryRows + c].resize(n);
     tbb::enumerable_thread_specific<VertexScratch> scratch;
@@ -209,7 +226,7 @@ uint64_t shadeVertices(const ObjectShading& obj, const DicedSurface& diced,
             const ChartPoint& at = mesh.attributeChartPoint[begin + i];
             const glm::vec3 I = glm::normalize(g.P - state.eye);
             b.batch.setPoint(i, g, at, I);
-            for (int row : obj.geometryRows) {
+            for (int row : geometryRows) {
                 // VertexAttributes rows follow the shading batch's first 15 rows, then
                 // u v s t (the batch's rows U..T, after I).
                 const int src = row < VertexAttributes::U ? row : row + 3;
@@ -232,7 +249,7 @@ uint64_t shadeVertices(const ObjectShading& obj, const DicedSurface& diced,
 // Dices the surface for the view's range, moves the facets into the representation, and
 // shades its vertices; a combined representation also measures its longest edge, a
 // separate one gets a shader map (the previous one, still valid, or a new one with its
-// always-resident levels).
+// always-resident levels), a direct one the whole shader as its dynamic kernel.
 std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Representation kind,
                                                          const ObjectState& state,
                                                          const CameraState& camera,
@@ -243,13 +260,15 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     const ObjectShading& obj = *objects_[index];
     const SceneObject& sceneObject = scene_.objects[index];
     const Surface& surface = *sceneObject.surface;
+    const bool direct = kind == Representation::Direct;
     const bool useMap = kind == Representation::ShaderMap;
+    const bool combined = !useMap && !direct;
     const DicingView view = dicingView(state, camera);
-    const DicingOptions& dicing = useMap ? options_.separateDicing : options_.combinedDicing;
+    const DicingOptions& dicing = combined ? options_.combinedDicing : options_.separateDicing;
     DicedSurface diced = diceSurface(surface, view, sceneObject.range, dicing);
 
     auto rep = std::make_unique<ObjectRepresentation>();
-    rep->kind = useMap ? Representation::ShaderMap : Representation::Facets;
+    rep->kind = combined ? Representation::Facets : kind;
     rep->representativeEye = state.eye;
     rep->representativeForward = view.forward;
     rep->center = surfaceBounds(surface).center();
@@ -257,9 +276,9 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     rep->frustumCulled = dicing.frustumCull;
     rep->imageHeight = camera.height;
     rep->maxEdgePixels = 0.0f;
-    rep->dynamicKernel = obj.dynamicKernel;
-    rep->geometryRows = obj.geometryRows;
-    rep->opaque = obj.opaque;
+    rep->dynamicKernel = direct ? obj.directKernel : obj.dynamicKernel;
+    rep->geometryRows = direct ? obj.directRows : obj.geometryRows;
+    rep->opaque = direct ? obj.directOpaque : obj.opaque;
     rep->closed = obj.closed;
     rep->charts = diced.charts;
     rep->patches = diced.patches;
@@ -269,14 +288,17 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     FacetMesh& mesh = rep->mesh;
     takeDicedMesh(diced, mesh);
     const size_t channels = obj.factored.staticPart.channelOutputs.size();
-    mesh.channels = useMap ? 0 : static_cast<int>(channels);
+    mesh.channels = combined ? static_cast<int>(channels) : 0;
     // The survey between grid points can miss a little, so the facets are diced again when
     // their edges outgrow P/2 or, if dicing overshot it, what they started at.
-    if (!useMap)
+    if (combined)
         rep->maxEdgePixels =
             std::max(dicing.maxEdgePixels, 1.05f * longestEdgePixels(mesh, state, camera));
-    costs.instructions += shadeVertices(obj, diced, state, uniforms, !useMap, mesh);
-    if (!useMap) {
+    costs.instructions +=
+        shadeVertices(obj, rep->geometryRows, diced, state, uniforms, combined, mesh);
+    if (direct) {
+        // Nothing static: the dynamic phase runs the whole shader.
+    } else if (combined) {
         costs.programRuns += mesh.attributeChartPoint.size();
     } else if (channels == 0) {
         // Nothing static is stored (factoring.h, storeAboveCost): no map to make.

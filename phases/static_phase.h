@@ -35,6 +35,13 @@ struct ObjectShading {
     std::shared_ptr<const ShaderKernel> dynamicKernel;
     // VertexAttributes rows the dynamic part reads (P and I come from the facet itself).
     std::vector<int> geometryRows;
+    // A direct representation's dynamic kernel: the whole shader as the reference runs it
+    // (shared with SceneResources), the rows it reads, whether its Oi is 1, and whether it
+    // may run on facets at all (not if it traces occlusion rays from the shading point).
+    std::shared_ptr<const ShaderKernel> directKernel;
+    std::vector<int> directRows;
+    bool directOpaque = true;
+    bool directAllowed = true;
     bool opaque = true;   // the dynamic part's Oi is the constant 1
     bool closed = false;  // the surface bounds a solid
     // The static part reads the view, the time or an animated input (through bake()): its

@@ -73,7 +73,11 @@ struct ObjectTransform {
 // n-tuple per vertex (combined), a shader map probed per sample on facets only as fine as
 // the geometric error allows (separate), or whichever costs less for the frames the
 // object is seen in (auto).
-enum class Representation { Auto, Facets, ShaderMap };
+// How an object's static phase stores it (docs/multiphase.md): auto picks; facets carry the
+// static n-tuple per vertex (combined); a shader map holds it (separate); direct stores
+// nothing static and the dynamic phase runs the whole shader on facets diced to the
+// geometric tolerance (for objects a stored n-tuple costs more than it saves).
+enum class Representation { Auto, Facets, ShaderMap, Direct };
 
 struct RangeOptions {
     float distanceFactor = 2.0f;  // the view distance may change by this factor

@@ -472,9 +472,11 @@ class SceneLoader {
                 obj.representation = Representation::ShaderMap;
             else if (rep == "facets")
                 obj.representation = Representation::Facets;
+            else if (rep == "direct")
+                obj.representation = Representation::Direct;
             else if (rep != "auto")
                 r->fail("unknown representation '" + rep +
-                        "' (expected auto, facets or shadermap)");
+                        "' (expected auto, facets, shadermap or direct)");
         }
         if (auto r = o.optional("shadermap_resolution"))
             obj.shadermapResolution = r->integer(1, 1 << 20);

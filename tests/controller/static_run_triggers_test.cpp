@@ -97,6 +97,52 @@ TEST(StaticRunDue, CombinedFacetsPastPOverTwoAreDueAtTheBoundNot) {
     EXPECT_FALSE(map.due());
 }
 
+TEST(CompareWithReference, TwoFramesRunningCostlierThanTheReferenceGoDirect) {
+    BuiltForThisView b(Representation::ShaderMap);
+    b.slot.frameDynamic.drawn = true;
+    // At the reference's cost exactly: not slower.
+    compareWithReference(b.slot, 0.010, 0.010, true);
+    EXPECT_EQ(b.slot.framesSlowerThanReference, 0);
+    compareWithReference(b.slot, 0.011, 0.010, true);
+    EXPECT_EQ(b.slot.framesSlowerThanReference, 1);
+    EXPECT_FALSE(b.slot.goesDirect);
+    // A frame that built the object counts neither way; a cheaper frame starts again.
+    b.slot.builtThisFrame = true;
+    compareWithReference(b.slot, 0.5, 0.010, true);
+    EXPECT_EQ(b.slot.framesSlowerThanReference, 1);
+    b.slot.builtThisFrame = false;
+    compareWithReference(b.slot, 0.009, 0.010, true);
+    EXPECT_EQ(b.slot.framesSlowerThanReference, 0);
+    compareWithReference(b.slot, 0.020, 0.010, true);
+    compareWithReference(b.slot, 0.030, 0.010, true);
+    EXPECT_TRUE(b.slot.goesDirect);
+    EXPECT_FLOAT_EQ(b.slot.measuredMs, 30.0f);
+    EXPECT_FLOAT_EQ(b.slot.referenceMs, 10.0f);
+    // Then it is due, as SlowerThanReference, with both figures.
+    const std::optional<StaticRunDue> d = b.due();
+    ASSERT_TRUE(d);
+    EXPECT_EQ(d->cause, StaticRunDue::SlowerThanReference);
+    EXPECT_FLOAT_EQ(d->measured, 30.0f);
+    EXPECT_FLOAT_EQ(d->threshold, 10.0f);
+}
+
+TEST(CompareWithReference, NeverForShadersTracingRaysNorObjectsNotDrawnOrAlreadyDirect) {
+    BuiltForThisView rays(Representation::ShaderMap);
+    rays.slot.frameDynamic.drawn = true;
+    BuiltForThisView hidden(Representation::ShaderMap);
+    BuiltForThisView direct(Representation::Direct);
+    direct.slot.frameDynamic.drawn = true;
+    for (int frame = 0; frame < 4; ++frame) {
+        compareWithReference(rays.slot, 1.0, 0.01, false);
+        compareWithReference(hidden.slot, 1.0, 0.01, true);
+        compareWithReference(direct.slot, 1.0, 0.01, true);
+    }
+    EXPECT_FALSE(rays.slot.goesDirect);
+    EXPECT_FALSE(hidden.slot.goesDirect);
+    EXPECT_FALSE(direct.slot.goesDirect);
+    EXPECT_FALSE(rays.due());
+}
+
 TEST(AdmitRebuilds, CheapestFirstWhileHalfAsMuchAgainFitsAtTheBoundaryToo) {
     // Object 0 never built; 1, 2, 3 built with last runs of 0.04, 0.01, 0.02 s. With 0.045 s
     // left: 2 (0.015) then 3 (0.03, leaving exactly 0) fit; 1 (0.06) does not.
