@@ -66,7 +66,9 @@ void compareWithReference(ObjectSlot& slot, double storedSeconds, double referen
     slot.referenceMs = static_cast<float>(1e3 * referenceSeconds);
     slot.framesSlowerThanReference =
         storedSeconds > referenceSeconds ? slot.framesSlowerThanReference + 1 : 0;
-    if (slot.framesSlowerThanReference >= slowFrames) slot.goesDirect = true;
+    // Far over (more than 4 times), one frame is evidence enough.
+    if (slot.framesSlowerThanReference >= slowFrames || storedSeconds > 4.0 * referenceSeconds)
+        slot.goesDirect = true;
 }
 
 std::vector<size_t> admitRebuilds(std::span<const size_t> due, std::span<const ObjectSlot> slots,

@@ -30,12 +30,13 @@ std::optional<StaticRunDue> staticRunDue(uint32_t object, const ObjectSlot& slot
 // stored representation (facets or a shader map) whose work that frame -- the tiles filled
 // for it and the points shaded; a frame that built it does not count -- costs more
 // (`storedSeconds`) than the reference renderer would have spent on its samples
-// (`referenceSeconds`) counts a slow frame; `slowFrames` running make it go direct
-// (slot.goesDirect, then due as SlowerThanReference). Both are the cost model's figures for the
-// frame's measured counts, not clock time, so the same frames make the same choice on every machine
-// and run. An oblique floor whose footprints fill dozens of texels per covered pixel is the case: a
-// direct representation runs the whole shader on facets at the geometric tolerance and
-// stores nothing. Shaders that trace occlusion rays (not `directAllowed`) stay stored.
+// (`referenceSeconds`) counts a slow frame. `slowFrames` running, or one more than 4 times
+// over, make it go direct (slot.goesDirect, then due as SlowerThanReference). Both figures
+// are the cost model's for the frame's measured counts, not clock time, so the same frames
+// make the same choice on every machine and run. An oblique floor whose footprints fill
+// dozens of texels per covered pixel is the case: a direct representation runs the whole
+// shader on facets at the geometric tolerance and stores nothing. Shaders that trace
+// occlusion rays (not `directAllowed`) stay stored.
 void compareWithReference(ObjectSlot& slot, double storedSeconds, double referenceSeconds,
                           bool directAllowed, int slowFrames = 2);
 

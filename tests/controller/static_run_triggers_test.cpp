@@ -126,6 +126,16 @@ TEST(CompareWithReference, TwoFramesRunningCostlierThanTheReferenceGoDirect) {
     EXPECT_FLOAT_EQ(d->threshold, 10.0f);
 }
 
+TEST(CompareWithReference, OneFrameMoreThanFourTimesOverGoesDirectAtOnce) {
+    BuiltForThisView atFour(Representation::ShaderMap), past(Representation::ShaderMap);
+    atFour.slot.frameDynamic.drawn = past.slot.frameDynamic.drawn = true;
+    compareWithReference(atFour.slot, 0.040, 0.010, true);  // four times exactly: one frame
+    EXPECT_FALSE(atFour.slot.goesDirect);
+    EXPECT_EQ(atFour.slot.framesSlowerThanReference, 1);
+    compareWithReference(past.slot, std::nextafter(0.040, 1.0), 0.010, true);
+    EXPECT_TRUE(past.slot.goesDirect);
+}
+
 TEST(CompareWithReference, NeverForShadersTracingRaysNorObjectsNotDrawnOrAlreadyDirect) {
     BuiltForThisView rays(Representation::ShaderMap);
     rays.slot.frameDynamic.drawn = true;
