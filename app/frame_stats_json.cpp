@@ -135,6 +135,11 @@ nlohmann::json objectReportsJson(const MultiphaseRenderer& renderer) {
                            {"facet_bytes", r.facetBytes},
                            {"resident_tiles", r.residentTiles},
                            {"map_bytes", r.mapBytes}});
+        // The direct rule's last priced frame (static_run_triggers.h): CPU ms by the model.
+        const ObjectSlot& slot = renderer.slot(i);
+        if (slot.referenceMs > 0.0f)
+            objects.back()["priced_ms_per_frame"] = {{"stored", slot.measuredMs},
+                                                     {"reference", slot.referenceMs}};
     }
     return objects;
 }

@@ -84,6 +84,8 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
         o.staticInstructions = r.staticCosts.instructions;
         o.tilesFilled = r.staticCosts.tilesFilled;
         o.residentTiles = r.residentTiles;
+        o.pricedStoredMs = renderer.slot(i).measuredMs;
+        o.pricedReferenceMs = renderer.slot(i).referenceMs;
         o.facets = r.facets;
         o.facetBytes = r.facetBytes;
         o.mapBytes = r.mapBytes;
@@ -186,8 +188,16 @@ std::string profileMarkdown(const CostProfile& p) {
             static_cast<double>(o.dynamicInstructions) / drawn, mb(o.facetBytes + o.mapBytes));
     }
     md += "\nWhy each representation:\n\n";
-    for (const ObjectProfile& o : p.objects)
-        if (!o.reason.empty()) md += "- " + o.name + ": " + o.reason + "\n";
+    for (const ObjectProfile& o : p.objects) {
+        if (o.reason.empty()) continue;
+        md += "- " + o.name + ": " + o.reason;
+        if (o.pricedReferenceMs > 0.0 && o.representation != "direct")
+            md += format(
+                " (last priced frame: its stored representation's work %.1f ms of CPU, the "
+                "reference's on the same samples %.1f ms)",
+                o.pricedStoredMs, o.pricedReferenceMs);
+        md += "\n";
+    }
 
     md += "\n## Per frame\n\n";
     md +=

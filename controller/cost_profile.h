@@ -44,6 +44,9 @@ struct ObjectProfile {
     uint64_t facets = 0;  // of its last representation
     uint64_t facetBytes = 0, mapBytes = 0;
     std::vector<double> staticSecondsPerFrame, shadeSecondsPerFrame;  // per profiled frame
+    // The direct rule's last priced frame (static_run_triggers.h), CPU ms by the cost model:
+    // the stored representation's work, and the reference's on the same samples (0: none).
+    double pricedStoredMs = 0.0, pricedReferenceMs = 0.0;
 };
 
 struct CostProfile {

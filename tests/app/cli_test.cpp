@@ -106,6 +106,32 @@ TEST(Cli, MultiphaseComparesWithTheReference) {
     EXPECT_GT(pixels.avg[3], 0.3f);
 }
 
+TEST(Cli, TheGrazingFloorGoesDirectAndSaysWhy) {
+    // Its map's fills price far above the reference's work within a frame of being built:
+    // from frame 2 the floor is direct, the frame that switched says why, and the object's
+    // report gives the priced figures and the reason.
+    const std::string out = tempDir("grazing_direct");
+    const CliRun run = mpshade(
+        "render examples/hard/grazing_floor.json --frames 0:4 --size 96x54 "
+        "--compare --out " +
+        out);
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    std::ifstream statsFile(out + "/stats.json");
+    const nlohmann::json stats = nlohmann::json::parse(statsFile);
+    const nlohmann::json& ground = stats["objects"][0];
+    EXPECT_EQ(ground["representation"], "direct");
+    EXPECT_NE(ground["reason"].get<std::string>().find("reference"), std::string::npos);
+    EXPECT_GT(ground["priced_ms_per_frame"]["stored"].get<double>(),
+              4.0 * ground["priced_ms_per_frame"]["reference"].get<double>());
+    bool switched = false;
+    for (const auto& frame : stats["frames"])
+        for (const auto& due : frame["static_runs_due"])
+            switched =
+                switched || due["cause"].get<std::string>().find("direct") != std::string::npos;
+    EXPECT_TRUE(switched);
+    EXPECT_EQ(stats["frames"][3]["tiles_filled"], 0);
+}
+
 // The value of a PSNR in eval.json: a number, or "inf" for an exact match.
 double psnrValue(const nlohmann::json& v) {
     if (v.is_string() && v == "inf") return INFINITY;
