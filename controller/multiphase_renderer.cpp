@@ -192,10 +192,8 @@ void MultiphaseRenderer::compareLastFrameWithReference() {
     const RepresentationCostModel& m = options_.costModel;
     const ShaderMapOptions& maps = static_.options().shaderMap;
     const double texelsPerTile = std::pow(maps.tileSize + 2.0 * maps.border, 2.0);
-    const double samplesPerPoint = dynamicOptions_.shadingRate == ShadingRate::Sample ? 1.0
-                                   : dynamicOptions_.shadingRate == ShadingRate::Pixel
-                                       ? frame_.spp
-                                       : 4.0 * frame_.spp;
+    const double samplesPerPoint =
+        frame_.spp / shadingPointsPerPixel(dynamicOptions_.shadingRate, frame_.spp);
     for (size_t i = 0; i < slots_.size(); ++i) {
         const ObjectSlot& slot = slots_[i];
         if (scene_.objects[i].representation != Representation::Auto || !slot.representation)
@@ -204,10 +202,10 @@ void MultiphaseRenderer::compareLastFrameWithReference() {
         const double points = static_cast<double>(slot.frameDynamic.shadingPoints);
         const bool map = slot.representation->kind == Representation::ShaderMap;
         const double stored = 1e-9 * (static_cast<double>(slot.frameTilesFilled) * texelsPerTile *
-                                          (f.staticCost * m.nsPerCostUnit + m.geometryPointNs) +
+                                          staticRunNs(m, f.staticCost) +
                                       points * (map ? m.mapPointNs : m.vertexPointNs));
-        const double reference = 1e-9 * points * samplesPerPoint *
-                                 (m.referenceSampleNs + m.referenceNsPerCostUnit * f.originalCost);
+        const double reference =
+            1e-9 * points * samplesPerPoint * referenceNsPerSample(m, f.originalCost);
         compareWithReference(slots_[i], stored, reference, static_.shading(i).directAllowed);
     }
 }

@@ -5,14 +5,25 @@
 
 namespace mpshade {
 
+double shadingPointsPerPixel(ShadingRate rate, int samplesPerPixel) {
+    return rate == ShadingRate::Sample ? static_cast<double>(samplesPerPixel)
+                                       : (rate == ShadingRate::Pixel ? 1.0 : 0.25);
+}
+
+double staticRunNs(const RepresentationCostModel& model, double staticCostUnits) {
+    return staticCostUnits * model.nsPerCostUnit + model.geometryPointNs;
+}
+
+double referenceNsPerSample(const RepresentationCostModel& model, double originalCostUnits) {
+    return originalCostUnits * model.referenceNsPerCostUnit + model.referenceSampleNs;
+}
+
 RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                                           const RepresentationCostModel& model) {
     const double frames = std::max(1, in.frames);
-    const double staticPointNs = in.staticCostUnits * model.nsPerCostUnit + model.geometryPointNs;
-    const double pointsPerPixel = in.shadingRate == ShadingRate::Sample
-                                      ? static_cast<double>(in.samplesPerPixel)
-                                      : (in.shadingRate == ShadingRate::Pixel ? 1.0 : 0.25);
-    const double points = in.coveredPixels * pointsPerPixel;
+    const double staticPointNs = staticRunNs(model, in.staticCostUnits);
+    const double points =
+        in.coveredPixels * shadingPointsPerPixel(in.shadingRate, in.samplesPerPixel);
     // Combined: a vertex per two facets, shaded again at every run.
     const double facetsStatic =
         0.5 * in.combinedFacets * staticPointNs * std::max(1, in.combinedRuns);
@@ -42,10 +53,8 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
     c.mapStaticSeconds = mapStatic * 1e-9;
     c.mapFrameSeconds = mapFrame * 1e-9;
     c.directFrameSeconds = directFrame * 1e-9;
-    c.directSeconds = frames * c.directFrameSeconds;
-    c.singlePhaseFrameSeconds =
-        in.coveredPixels * static_cast<double>(in.samplesPerPixel) *
-        (in.originalCostUnits * model.referenceNsPerCostUnit + model.referenceSampleNs) * 1e-9;
+    c.singlePhaseFrameSeconds = in.coveredPixels * static_cast<double>(in.samplesPerPixel) *
+                                referenceNsPerSample(model, in.originalCostUnits) * 1e-9;
     char text[320];
     std::string tooBig;
     if (in.channels == 0) {

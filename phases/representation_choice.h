@@ -86,17 +86,25 @@ struct RepresentationChoice {
     Representation kind = Representation::ShaderMap;
     std::string reason;
     double facetsSeconds = 0.0, mapSeconds = 0.0;  // estimated over the frames seen
-    double directSeconds = 0.0;                    // (its static work is only dicing)
     // Of those: the static work due now, and each frame's dynamic work, per kind.
     double facetsStaticSeconds = 0.0, facetsFrameSeconds = 0.0;
     double mapStaticSeconds = 0.0, mapFrameSeconds = 0.0;
-    double directFrameSeconds = 0.0;
+    double directFrameSeconds = 0.0;  // (a direct representation's static work is dicing)
     // The reference renderer's estimate for one frame of the object.
     double singlePhaseFrameSeconds = 0.0;
 };
 
 RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                                           const RepresentationCostModel& model = {});
+
+// The model's unit prices, which the estimate above and the controller's pricing of a
+// frame's measured work (static_run_triggers.h) share: the shading points a pixel holds at
+// `rate`; one run of a static part of `staticCostUnits` (a vertex or a map texel, its
+// surface point included), ns; one sample of the reference renderer for a shader of
+// `originalCostUnits`, ns.
+double shadingPointsPerPixel(ShadingRate rate, int samplesPerPixel);
+double staticRunNs(const RepresentationCostModel& model, double staticCostUnits);
+double referenceNsPerSample(const RepresentationCostModel& model, double originalCostUnits);
 
 // Whether a shader map of the object fits at all (its always-resident tiles); if not, the
 // reason, and the object is rendered with facets even where the scene asks for a map.
