@@ -85,6 +85,8 @@ const BadScene kBadScenes[] = {
      "coordinates must be within 1e8 of the origin (found 1e38)"},
     {"scale_1e-30", "", "objects[0].transform.scale", 0, 0,
      "expected a length in [1e-8, 1e8], found 1e-30"},
+    {"unknown_representation", "", "objects[0].representation", 0, 0,
+     "unknown representation 'directly' (expected auto, facets, shadermap or direct)"},
     {"bad_shading_rate", "", "settings.shading_rate", 0, 0,
      "unknown shading_rate 'octant' (expected sample, pixel or quad)"},
     {"plane_1e30", "", "objects[0].geometry.size[0]", 0, 0,
