@@ -7,12 +7,18 @@ ObjectVariability variabilityOf(const Scene& scene, const SceneObject& object) {
     const Camera& cam = scene.camera;
     v.cameraMoves = cam.eye.varies() || cam.target.varies() || cam.up.varies();
     v.transformAnimated = object.transform.animated();
+    // Lights reach the shader in object space (scene_state.cpp, lightsAt): a point light's
+    // position there follows every part of the transform, but a distant light's direction
+    // only its rotation -- translation leaves directions alone and the scale is uniform.
+    // An ambient light has neither: only its color can change.
+    const bool rotationAnimated = object.transform.rotate.varies();
     for (const Light& light : scene.lights) {
         const bool animated = light.animated();
         v.lightAnimated.push_back(animated);
-        // An ambient light has no position: only its color can change.
-        v.lightMovesRelative.push_back(
-            light.kind == LightKind::Ambient ? animated : animated || v.transformAnimated);
+        bool moves = animated;
+        if (light.kind == LightKind::Distant) moves = animated || rotationAnimated;
+        if (light.kind == LightKind::Point) moves = animated || v.transformAnimated;
+        v.lightMovesRelative.push_back(moves);
     }
     for (const ParamValue& p : object.params)
         if (p.value.varies()) v.animatedParams.push_back(p.name);

@@ -14,8 +14,11 @@ namespace mpshade {
 struct ObjectVariability {
     bool cameraMoves = false;  // eye or target keyed: I and E vary
     bool transformAnimated = false;
-    std::vector<bool> lightMovesRelative;  // per scene light
-    std::vector<bool> lightAnimated;       // per scene light: any field keyed
+    // Per scene light: its object-space data changes (a point light: the light or any part of
+    // the transform animated; a distant one: the light or the rotation; an ambient one: the
+    // light).
+    std::vector<bool> lightMovesRelative;
+    std::vector<bool> lightAnimated;  // per scene light: any field keyed
     std::vector<std::string> animatedParams;
     bool timeVaries = true;  // `time` is always an input while the scene has more than one frame
 };

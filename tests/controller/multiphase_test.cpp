@@ -15,6 +15,7 @@
 #include "controller/multiphase_renderer.h"
 #include "phases/image_compare.h"
 #include "phases/reference_renderer.h"
+#include "scene/variability.h"
 #include "scene_fixtures.h"
 #include "test_support.h"
 
@@ -153,6 +154,39 @@ TEST(MultiphaseRenderer, ShaderMapRepresentationMatchesTheReference) {
     ASSERT_NE(rep->map, nullptr);
     EXPECT_EQ(rep->mesh.channels, 0);
     EXPECT_GT(rep->map->channels(), 0);
+}
+
+// The vase under its distant light, sliding or turning over the scene's two seconds, in a
+// shader map, against the reference at its last frame: sliding leaves the light's direction
+// in object space alone, so its diffuse light stays stored; turning moves it, so it is
+// shaded every frame. Either way the last frame must match. (Had turning kept the light
+// stored, the lit side would turn with the vase: 18 dB.)
+TEST(MultiphaseRenderer, DistantLightStoredWhileTheObjectOnlySlides) {
+    for (const bool turns : {false, true}) {
+        Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+        SceneObject& vase = scene.objects[0];
+        vase.representation = Representation::ShaderMap;
+        vase.shadermapResolution = 64;
+        const float end = scene.settings.duration;
+        if (turns) {
+            vase.transform.rotate.times = {0.0f, end};
+            vase.transform.rotate.values = {glm::vec4(0, 1, 0, 30), glm::vec4(0, 1, 0, 120)};
+        } else {
+            vase.transform.translate.times = {0.0f, end};
+            vase.transform.translate.values = {glm::vec3(0.0f), glm::vec3(0.8f, 0.0f, 0.3f)};
+        }
+        EXPECT_EQ(bindingOf(scene, vase).lights[1].movesRelativeToObject, turns);
+        ReferenceRenderer reference(scene);
+        MultiphaseRenderer multi(scene, machineryOnly());
+        const RenderOptions options = smallFrame();
+        FrameStats rs, ms;
+        const int last = scene.frameCount() - 1;
+        (void)multi.renderFrame(0, options, ms);  // the static phase at the first frame
+        const Image got = multi.renderFrame(last, options, ms);
+        const Image ref = reference.renderFrame(last, options, rs);
+        const ImageError e = compareImages(got, ref);
+        EXPECT_GT(e.psnr, 32.0) << (turns ? "turning" : "sliding");
+    }
 }
 
 TEST(MultiphaseRenderer, DirectRunsTheWholeShaderAsTheReferenceDoes) {

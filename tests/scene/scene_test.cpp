@@ -319,7 +319,11 @@ TEST(Variability, FollowsWhatTheSceneAnimates) {
           "params": { "k": 2, "c": { "keys": [ { "t": 0, "value": [1, 0, 0] }, { "t": 1, "value": [0, 1, 0] } ] } } },
         { "name": "moving", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s",
           "params": { "c": { "keys": [ { "t": 0, "value": 1 }, { "t": 1, "value": 1 } ] } },
-          "keys": [ { "t": 0, "translate": [0, 0, 0] }, { "t": 1, "translate": [1, 0, 0] } ] } ]
+          "keys": [ { "t": 0, "translate": [0, 0, 0] }, { "t": 1, "translate": [1, 0, 0] } ] },
+        { "name": "spinning", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s",
+          "keys": [ { "t": 0, "rotate": [0, 1, 0, 0] }, { "t": 1, "rotate": [0, 1, 0, 30] } ] },
+        { "name": "growing", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s",
+          "keys": [ { "t": 0, "scale": 1 }, { "t": 1, "scale": 2 } ] } ]
     })");
     const Scene scene = loadScene(path);
     const ObjectVariability still = variabilityOf(scene, scene.objects[0]);
@@ -329,9 +333,16 @@ TEST(Variability, FollowsWhatTheSceneAnimates) {
     EXPECT_EQ(still.animatedParams, std::vector<std::string>{"c"});
     const ObjectVariability moving = variabilityOf(scene, scene.objects[1]);
     EXPECT_TRUE(moving.transformAnimated);
-    // The distant light is fixed in the world but moves relative to a moving object; an
-    // ambient light has no position.
-    EXPECT_EQ(moving.lightMovesRelative, (std::vector<bool>{false, true, true}));
+    // Translation moves the point light relative to the object, not the distant light's
+    // direction; an ambient light has no position.
+    EXPECT_EQ(moving.lightMovesRelative, (std::vector<bool>{false, false, true}));
+    // Rotation turns the distant light's direction in object space.
+    const ObjectVariability spinning = variabilityOf(scene, scene.objects[2]);
+    EXPECT_TRUE(spinning.transformAnimated);
+    EXPECT_EQ(spinning.lightMovesRelative, (std::vector<bool>{false, true, true}));
+    // A uniform scale keeps directions; the point light's object-space position scales.
+    const ObjectVariability growing = variabilityOf(scene, scene.objects[3]);
+    EXPECT_EQ(growing.lightMovesRelative, (std::vector<bool>{false, false, true}));
     // Keys with equal values do not animate.
     EXPECT_TRUE(moving.animatedParams.empty());
     const ShaderBinding b = bindingOf(scene, scene.objects[0]);
