@@ -51,7 +51,7 @@ ObjectCostInputs RepresentationPlanner::costInputs(size_t i, const ObjectSlot& s
     in.pinnedTiles = static_cast<double>(in.charts) * 9.0;
     in.pinnedBytes = in.pinnedTiles * tile * tile *
                      static_cast<double>(shading.factored.staticPart.channelOutputs.size()) *
-                     sizeof(float);
+                     (mapOptions.halfPrecision || obj.shadermapHalf ? 2.0 : 4.0);
     in.haveMap = slot.representation && slot.representation->map;
     in.pinnedUpFront = mapOptions.fillPinnedUpFront;
     // The screen area: the object's bounding sphere, projected, within the screen.

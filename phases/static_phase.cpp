@@ -327,6 +327,7 @@ std::shared_ptr<ShaderMap> StaticPhase::makeShaderMap(size_t index,
     while (resolution < cap && resolution < (1 << 20)) resolution *= 2;
     mapOptions.resolution = resolution;
     mapOptions.tileSize = std::min(mapOptions.tileSize, resolution);
+    mapOptions.halfPrecision = mapOptions.halfPrecision || sceneObject.shadermapHalf;
     return std::make_shared<ShaderMap>(
         *sceneObject.surface, *obj.staticKernel, uniforms, mapOptions,
         pools_.forTileBytes(ShaderMap::tileBytesFor(mapOptions, static_cast<int>(channels))));

@@ -94,6 +94,9 @@ struct SceneObject {
     ObjectTransform transform;
     Representation representation = Representation::Auto;
     int shadermapResolution = 0;  // a cap on level 0's texels per chart side; 0: the limit, 2^20
+    // The shader map's channels as binary16 (shadermaps/half_float.h: relative error 2^-11,
+    // finite up to 65504): half the memory; false: float.
+    bool shadermapHalf = false;
     RangeOptions range;
 };
 

@@ -404,7 +404,7 @@ class SceneLoader {
 
     void object(const JsonNode& o) {
         o.allowKeys({"name", "geometry", "shader", "params", "transform", "keys", "representation",
-                     "shadermap_resolution", "range"});
+                     "shadermap_resolution", "shadermap_precision", "range"});
         SceneObject obj;
         obj.name = o["name"].string();
         if (obj.name.empty()) o["name"].fail("an object name must not be empty");
@@ -480,6 +480,13 @@ class SceneLoader {
         }
         if (auto r = o.optional("shadermap_resolution"))
             obj.shadermapResolution = r->integer(1, 1 << 20);
+        if (auto r = o.optional("shadermap_precision")) {
+            const std::string precision = r->string();
+            if (precision == "half")
+                obj.shadermapHalf = true;
+            else if (precision != "float")
+                r->fail("unknown precision '" + precision + "' (expected float or half)");
+        }
         if (auto r = o.optional("range")) {
             r->allowKeys({"distance_factor", "angle"});
             if (auto d = r->optional("distance_factor")) {

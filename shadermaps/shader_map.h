@@ -183,6 +183,8 @@ class ShaderMap {
     const uint16_t* tileHalves(int slot) const {
         return options_.halfPrecision ? reinterpret_cast<const uint16_t*>(tileData(slot)) : nullptr;
     }
+    // The same storage, untyped: binary16 or float as options().halfPrecision says.
+    const unsigned char* tileStorage(int slot) const { return tileData(slot); }
     int stride() const { return stride_; }
     // The slot holding texel (i, j) of a level (clamped to the level), or -1 if that tile is
     // not resident; (li, lj) receive the texel's position in the tile's storage.

@@ -189,6 +189,29 @@ TEST(MultiphaseRenderer, DistantLightStoredWhileTheObjectOnlySlides) {
     }
 }
 
+// shadermap_precision "half": the same frame within binary16's rounding, its maps in half
+// the bytes.
+TEST(MultiphaseRenderer, HalfPrecisionMapsMatchFloatOnesInHalfTheBytes) {
+    Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    for (SceneObject& o : scene.objects) o.representation = Representation::ShaderMap;
+    const RenderOptions options = smallFrame();
+    FrameStats stats;
+    MultiphaseRenderer full(scene, machineryOnly());
+    const Image a = full.renderFrame(3, options, stats);
+    for (SceneObject& o : scene.objects) o.shadermapHalf = true;
+    MultiphaseRenderer half(scene, machineryOnly());
+    const Image b = half.renderFrame(3, options, stats);
+    const ImageError e = compareImages(b, a);
+    EXPECT_GT(e.psnr, 60.0);
+    EXPECT_GT(e.rmse, 0.0);  // read, rounded
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+        const ShaderMap& f = *full.representation(i)->map;
+        const ShaderMap& h = *half.representation(i)->map;
+        EXPECT_TRUE(h.options().halfPrecision);
+        EXPECT_EQ(2 * h.tileBytes(), f.tileBytes());
+    }
+}
+
 TEST(MultiphaseRenderer, DirectRunsTheWholeShaderAsTheReferenceDoes) {
     // The grazing floor direct: the reference's own shader on the interpolated geometry of a
     // plane, so the same samples shade to within rounding of the reference's (measured 52 dB
