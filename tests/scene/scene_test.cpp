@@ -299,7 +299,8 @@ TEST_P(ExampleScenes, LoadAndBind) {
 
 INSTANTIATE_TEST_SUITE_P(All, ExampleScenes,
                          ::testing::Values("examples/vase/scene.json", "examples/teapot/scene.json",
-                                           "examples/courtyard/scene.json"));
+                                           "examples/courtyard/scene.json",
+                                           "examples/vase/lamplight.json"));
 
 std::string writeScene(const std::string& name, const std::string& json) {
     const std::string dir = ::testing::TempDir() + "mpshade_scene_test/";
