@@ -64,6 +64,8 @@ nlohmann::json renderFrameJson(const Scene& scene, const FrameStats& stats, bool
     entry["shade_passes"] = stats.dynamic.shadePasses;
     entry["probes"] = stats.dynamic.probes;
     entry["probe_fallbacks"] = stats.dynamic.probeFallbacks;
+    entry["view_reused"] = stats.dynamic.viewReused;
+    entry["points_replayed"] = stats.dynamic.pointsReplayed;
     entry["tiles_from_children"] = stats.staticWork.work.tilesFromChildren;
     entry["texels_filled"] = stats.staticWork.work.texelsFilled;
     entry["resident_tiles"] = stats.tiles.resident;
@@ -102,6 +104,8 @@ nlohmann::json playFrameJson(const Scene& scene, const FrameStats& s,
           {"older_representations", s.budget.rebuildsDeferred}}},
         {"deferred", {{"tiles", s.budget.tilesDeferred}, {"rebuilds", s.budget.rebuildsDeferred}}},
         {"probe_hits", s.dynamic.probes - s.dynamic.probeFallbacks},
+        {"view_reused", s.dynamic.viewReused},
+        {"points_replayed", s.dynamic.pointsReplayed},
         {"controller_seconds", s.controllerSeconds},
         {"prefetch",
          {{"predicted", s.prefetch.predicted},

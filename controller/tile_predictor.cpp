@@ -31,6 +31,7 @@ std::vector<TileRequest> TilePredictor::predict(int frame, const RenderOptions& 
     }
     DynamicOptions o = current;
     o.trace = nullptr;
+    o.reuseBytes = 0;  // a prediction is its probes' missing tiles: every point must probe
     // The same world footprint as the full image's points: a low-resolution pixel is
     // `divisor` full ones, and a per-pixel point's footprint is half a pixel.
     o.footprintScale = current.footprintScale * footprintPixels(current.shadingRate, spp) /

@@ -11,6 +11,7 @@
 
 #include "phases/band_points.h"
 #include "phases/compositing.h"
+#include "phases/view_reuse.h"
 #include "phases/work_deadline.h"
 
 namespace mpshade {
@@ -83,8 +84,15 @@ struct DynamicPhase::Band {
 
         // Every point of a fresh band, each object's as runs of the band's own arrays; the
         // points whose probes found tiles missing go to stillPending.
-        void shadeFresh(std::span<const ObjectView> views, const ProbeOptions& probe,
-                        bool stopAtMissing, BandPoints& pts, std::vector<TileRequest>& missing);
+        // With `keep`, each batch's inputs are appended to it, and false is returned if any
+        // batch missed a tile or read a coarser level (the inputs are then not the band's).
+        bool shadeFresh(std::span<const ObjectView> views, const ProbeOptions& probe,
+                        bool stopAtMissing, BandPoints& pts, std::vector<TileRequest>& missing,
+                        const InputLayout& layout, BandInputs* keep);
+        // Every point of a band whose view held still, on the inputs it kept: the same
+        // batches shadeFresh made, the dynamic shader alone.
+        void replay(std::span<const ObjectView> views, BandPoints& pts, const InputLayout& layout,
+                    const BandInputs& kept);
         // After a fill, the points still pending (in order, so grouped by object), gathered
         // into batches and their results scattered back.
         void shadePending(std::span<const ObjectView> views, const ProbeOptions& probe,
@@ -94,12 +102,15 @@ struct DynamicPhase::Band {
                             std::vector<TileRequest>& missing);
     };
     std::vector<BandPoints> states;
+    std::vector<BandInputs> inputs;  // per band, while the view holds still (view_reuse.h)
     tbb::enumerable_thread_specific<Scratch> scratch;
 };
 
-void DynamicPhase::Band::Scratch::shadeFresh(std::span<const ObjectView> views,
+bool DynamicPhase::Band::Scratch::shadeFresh(std::span<const ObjectView> views,
                                              const ProbeOptions& probe, bool stopAtMissing,
-                                             BandPoints& pts, std::vector<TileRequest>& missing) {
+                                             BandPoints& pts, std::vector<TileRequest>& missing,
+                                             const InputLayout& layout, BandInputs* keep) {
+    bool whole = true;
     for (size_t o = 0; o + 1 < pts.objectStart.size(); ++o) {
         const size_t begin = pts.objectStart[o], end = pts.objectStart[o + 1];
         if (begin == end) continue;
@@ -109,14 +120,39 @@ void DynamicPhase::Band::Scratch::shadeFresh(std::span<const ObjectView> views,
         for (size_t b = begin; b < end; b += kBatch) {
             const size_t m = std::min(kBatch, end - b);
             const SurfacePoints batch{&pts.facet[b], &pts.x[b], &pts.y[b], m};
+            const uint64_t fallbacks = c.fallbacks;
             const size_t missed =
                 shadeSurfacePoints(views[o], probe, stopAtMissing, batch, &pts.color[3 * b],
                                    &pts.opacity[3 * b], batchMissed.data(), surface, c);
             if (missed > 0)
                 for (size_t i = 0; i < m; ++i)
                     if (batchMissed[i]) stillPending.push_back(static_cast<uint32_t>(b + i));
+            whole = whole && missed == 0 && c.fallbacks == fallbacks;
+            if (keep && whole) keep->append(surface.batch, layout.rows[o], layout.channels[o], m);
         }
         addObjectCosts(o, c, began, missing);
+    }
+    return whole;
+}
+
+void DynamicPhase::Band::Scratch::replay(std::span<const ObjectView> views, BandPoints& pts,
+                                         const InputLayout& layout, const BandInputs& kept) {
+    size_t cursor = 0;
+    for (size_t o = 0; o + 1 < pts.objectStart.size(); ++o) {
+        const size_t begin = pts.objectStart[o], end = pts.objectStart[o + 1];
+        if (begin == end) continue;
+        const auto began = Clock::now();
+        SurfaceShadingCounters c;
+        surface.missing.clear();
+        for (size_t b = begin; b < end; b += kBatch) {
+            const size_t m = std::min(kBatch, end - b);
+            surface.batch.resize(m, layout.channels[o]);
+            kept.restore(surface.batch, layout.rows[o], layout.channels[o], m, cursor);
+            runDynamicShader(views[o], m, &pts.color[3 * b], &pts.opacity[3 * b], surface, c);
+        }
+        std::vector<TileRequest> none;
+        addObjectCosts(o, c, began, none);
+        costs[o].pointsReplayed += end - begin;
     }
 }
 
@@ -230,14 +266,64 @@ void DynamicPhase::begin(const FrameState& frame,
                          std::span<const ObjectRepresentation* const> objects,
                          std::shared_ptr<const SampleLayout> layout,
                          const DynamicOptions& options) {
-    auto start = Clock::now();
     frame_ = &frame;
     objects_.assign(objects.begin(), objects.end());
     layout_ = std::move(layout);
     options_ = options;
     stats_ = DynamicFrameStats{};
+    costs_.assign(objects_.size(), ObjectFrameCost{});
+    compareWithLastView();
+    warpObjects();
+    if (reusing_) {
+        // The visibility buffer is the last frame's, which saw the same.
+        abandoned_ = false;
+    } else {
+        rasterizeObjects();
+    }
+    prepareBands();
+}
+
+// Whether this frame sees what the last one did (view_reuse.h): then it reuses the
+// visibility and the bands' kept inputs. Bands keep inputs at a frame whose view held
+// still since the last, or at the first: a camera in motion never pays for keeping them.
+void DynamicPhase::compareWithLastView() {
     const size_t n = objects_.size();
-    costs_.assign(n, ObjectFrameCost{});
+    ViewKey key;
+    key.camera = frame_->camera;
+    key.layout = layout_.get();
+    key.shadingRate = static_cast<int>(options_.shadingRate);
+    key.footprintScale = options_.footprintScale;
+    key.probe = options_.probe;
+    key.bandRows = options_.bandRows;
+    key.wholePixelShortcut = options_.wholePixelShortcut;
+    key.serials.assign(n, 0);
+    key.placements.assign(n, glm::mat4(0.0f));
+    for (size_t i = 0; i < n; ++i)
+        if (objects_[i]) {
+            key.serials[i] = objects_[i]->serial;
+            key.placements[i] = frame_->objects[i].objectToWorld;
+        }
+    const bool still = haveLastView_ && key == lastView_;
+    reusing_ = options_.reuseBytes > 0 && still && lastViewWhole_;
+    keeping_ = options_.reuseBytes > 0 && (still || !haveLastView_);
+    lastView_ = std::move(key);
+    haveLastView_ = true;
+    stats_.viewReused = reusing_;
+    inputLayout_.rows.assign(n, {});
+    inputLayout_.channels.assign(n, 0);
+    for (size_t i = 0; i < n; ++i)
+        if (objects_[i]) {
+            inputLayout_.rows[i] = shadingInputRows(*objects_[i]);
+            inputLayout_.channels[i] = shadingChannels(*objects_[i]);
+        }
+}
+
+// Each drawn object's view of the frame; and, unless the last frame's visibility serves,
+// its vertices warped to the screen and its clusters culled.
+void DynamicPhase::warpObjects() {
+    const auto start = Clock::now();
+    const FrameState& frame = *frame_;
+    const size_t n = objects_.size();
     warps_.resize(n);
     warped_.resize(n);
     clusterVisible_.resize(n);
@@ -250,19 +336,25 @@ void DynamicPhase::begin(const FrameState& frame,
     const glm::vec3 ddx = (2.0f * tx / static_cast<float>(camera.width)) * camera.right;
     const glm::vec3 ddy = (-2.0f * ty / static_cast<float>(camera.height)) * camera.up;
     const float footprint =
-        options.footprintScale * footprintPixels(options.shadingRate, layout_->spp());
+        options_.footprintScale * footprintPixels(options_.shadingRate, layout_->spp());
     tbb::parallel_for(size_t{0}, n, [&](size_t i) {
         const ObjectRepresentation* rep = objects_[i];
         if (!rep) return;
-        const ScopedSpan task(options.trace, "warp object", PhaseKind::Dynamic, SpanLevel::Task,
+        const ScopedSpan task(options_.trace, "warp object", PhaseKind::Dynamic, SpanLevel::Task,
                               static_cast<int64_t>(i), frame.index);
         const ObjectState& state = frame.objects[i];
         const FacetMesh& mesh = rep->mesh;
-        warps_[i] = std::make_unique<FixedPointWarp>(state.objectToWorld, camera, mesh.format);
-        warps_[i]->warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.positionCount(),
-                        warped_[i]);
-        cullBack_[i] = backFacesHidden(*rep, *scene_.objects[i].surface, state, camera) ? 1 : 0;
-        clusterVisibility(mesh, state, camera, cullBack_[i] != 0, clusterVisible_[i]);
+        ObjectFrameCost& c = costs_[i];
+        c.drawn = true;
+        c.facets = mesh.facetCount();
+        if (!reusing_) {
+            warps_[i] = std::make_unique<FixedPointWarp>(state.objectToWorld, camera, mesh.format);
+            warps_[i]->warp(mesh.qx.data(), mesh.qy.data(), mesh.qz.data(), mesh.positionCount(),
+                            warped_[i]);
+            cullBack_[i] = backFacesHidden(*rep, *scene_.objects[i].surface, state, camera) ? 1 : 0;
+            clusterVisibility(mesh, state, camera, cullBack_[i] != 0, clusterVisible_[i]);
+            c.verticesWarped = mesh.positionCount();
+        }
         ObjectView& v = views_[i];
         v.rep = rep;
         v.uniforms = &frame.uniforms[i];
@@ -272,10 +364,6 @@ void DynamicPhase::begin(const FrameState& frame,
         v.dx = toObject * ddx;
         v.dy = toObject * ddy;
         v.footprintScale = footprint;
-        ObjectFrameCost& c = costs_[i];
-        c.drawn = true;
-        c.facets = mesh.facetCount();
-        c.verticesWarped = mesh.positionCount();
     });
     for (size_t i = 0; i < n; ++i)
         if (objects_[i]) {
@@ -284,11 +372,14 @@ void DynamicPhase::begin(const FrameState& frame,
             stats_.facetBytes += objects_[i]->bytes();
         }
     stats_.warpSeconds = secondsSince(start);
-    if (options.trace)
-        options.trace->span("warp", PhaseKind::Dynamic, SpanLevel::Phase, start, Clock::now(), -1,
-                            frame.index);
+    if (options_.trace)
+        options_.trace->span("warp", PhaseKind::Dynamic, SpanLevel::Phase, start, Clock::now(), -1,
+                             frame.index);
+}
 
-    start = Clock::now();
+void DynamicPhase::rasterizeObjects() {
+    const auto start = Clock::now();
+    const size_t n = objects_.size();
     std::vector<RasterObject> raster(n);
     for (size_t i = 0; i < n; ++i) {
         const ObjectRepresentation* rep = objects_[i];
@@ -301,23 +392,42 @@ void DynamicPhase::begin(const FrameState& frame,
                      clusterVisible_[i].data(),
                      rep->kind == Representation::Facets ? &costs_[i].longestEdgePixels : nullptr};
     }
-    RasterOptions rasterOptions = options.raster;
-    rasterOptions.deadline = options.deadline;
-    rasterizer_.rasterize(raster, *layout_, camera.zFar, rasterOptions, visibility_, stats_.raster);
+    RasterOptions rasterOptions = options_.raster;
+    rasterOptions.deadline = options_.deadline;
+    rasterizer_.rasterize(raster, *layout_, frame_->camera.zFar, rasterOptions, visibility_,
+                          stats_.raster);
     abandoned_ = stats_.raster.abandoned;
+    lastViewWhole_ = !abandoned_;
     stats_.rasterSeconds = secondsSince(start);
-    if (options.trace)
-        options.trace->span("rasterize", PhaseKind::Dynamic, SpanLevel::Phase, start, Clock::now(),
-                            -1, frame.index);
+    if (options_.trace)
+        options_.trace->span("rasterize", PhaseKind::Dynamic, SpanLevel::Phase, start, Clock::now(),
+                             -1, frame_->index);
+}
+
+// The bands to shade: every one undone; a band keeps its points and inputs only while the
+// view holds still.
+void DynamicPhase::prepareBands() {
     if (samples_.layout != layout_) {
         samples_.reset(layout_);
         uniform_.assign(static_cast<size_t>(layout_->width()) * layout_->height(), 0);
     }
-    const int bands = (layout_->height() + options_.bandRows - 1) / options_.bandRows;
-    bandDone_.assign(static_cast<size_t>(bands), 0);
-    scratch_->states.resize(static_cast<size_t>(bands));
-    for (BandPoints& points : scratch_->states) points.built = false;
-    for (Band::Scratch& s : scratch_->scratch) s.costs.assign(n, ObjectFrameCost{});
+    const size_t bands =
+        static_cast<size_t>((layout_->height() + options_.bandRows - 1) / options_.bandRows);
+    bandDone_.assign(bands, 0);
+    scratch_->states.resize(bands);
+    scratch_->inputs.resize(bands);
+    keptBytes_ = 0;
+    for (size_t b = 0; b < bands; ++b) {
+        BandInputs& kept = scratch_->inputs[b];
+        if (reusing_ && kept.valid() && scratch_->states[b].built) {
+            keptBytes_ += kept.bytes();
+            continue;
+        }
+        kept.invalidate();
+        if (options_.reuseBytes == 0) kept.release();
+        scratch_->states[b].built = false;
+    }
+    for (Band::Scratch& s : scratch_->scratch) s.costs.assign(objects_.size(), ObjectFrameCost{});
 }
 
 bool DynamicPhase::complete() const {
@@ -352,17 +462,19 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
                 costs_[i].shadeSeconds += s.costs[i].shadeSeconds;
                 costs_[i].probes += s.costs[i].probes;
                 costs_[i].probeFallbacks += s.costs[i].probeFallbacks;
+                costs_[i].pointsReplayed += s.costs[i].pointsReplayed;
                 s.costs[i] = ObjectFrameCost{};
             }
             stats_.instructions += s.counters.instructions;
             stats_.nonFinite += s.counters.nonFinite;
             s.counters = SurfaceShadingCounters{};
         }
-        stats_.shadingPoints = stats_.probes = stats_.probeFallbacks = 0;
+        stats_.shadingPoints = stats_.probes = stats_.probeFallbacks = stats_.pointsReplayed = 0;
         for (const ObjectFrameCost& c : costs_) {
             stats_.shadingPoints += c.shadingPoints;
             stats_.probes += c.probes;
             stats_.probeFallbacks += c.probeFallbacks;
+            stats_.pointsReplayed += c.pointsReplayed;
         }
     }
     stats_.shadeSeconds += secondsSince(start);
@@ -373,23 +485,34 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
 // whose probes found tiles missing staying pending (the band then keeps its points until a later
 // pass); 3. once none is pending, the band composited.
 void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& missing) {
-    // A band keeps points of its own only while it waits for tiles: shaded in one pass, it
-    // uses its thread's buffers and keeps nothing.
     Band::Scratch& s = scratch_->scratch.local();
-    BandPoints& pts = scratch_->states[band].built ? scratch_->states[band] : s.work;
     const size_t objects = objects_.size();
     if (s.costs.size() != objects) s.costs.assign(objects, ObjectFrameCost{});
     const int row0 = static_cast<int>(band) * options_.bandRows;
     const BandRange range(*layout_, visibility_.layers, row0,
                           std::min(layout_->height(), row0 + options_.bandRows));
+    BandInputs& kept = scratch_->inputs[band];
+    if (reusing_ && kept.valid() && scratch_->states[band].built) {
+        BandPoints& pts = scratch_->states[band];
+        s.replay(views_, pts, inputLayout_, kept);
+        finishBand(band, range, pts, s.costs);
+        return;
+    }
+    // A band keeps points of its own while it waits for tiles, or while the view holds
+    // still; otherwise it uses its thread's buffers and keeps nothing.
+    BandPoints& pts = scratch_->states[band].built ? scratch_->states[band] : s.work;
     if (!pts.built)
         buildBandPoints(*layout_, visibility_, range, objects,
                         {options_.shadingRate, options_.wholePixelShortcut}, pts, s.points);
 
     s.batchMissed.resize(kBatch);
     s.stillPending.clear();
+    bool keep = false;
     if (pts.fresh) {
-        s.shadeFresh(views_, options_.probe, !acceptFallbacks, pts, missing);
+        if (keeping_) kept.start();
+        keep = s.shadeFresh(views_, options_.probe, !acceptFallbacks, pts, missing, inputLayout_,
+                            keeping_ ? &kept : nullptr) &&
+               keeping_;
         pts.fresh = false;
     } else {
         s.shadePending(views_, options_.probe, !acceptFallbacks, pts, missing);
@@ -398,15 +521,33 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     if (!pts.pending.empty()) {
         // Shaded again once the missing tiles are filled: the band keeps these buffers.
         if (&pts == &s.work) std::swap(s.work, scratch_->states[band]);
+        s.work.built = false;
         return;
     }
-
-    compositeBand(pts, range, visibility_, layout_->spp(), scene_.settings.background,
-                  samples_.rgba.data(), uniform_.data());
-    for (size_t o = 0; o < objects; ++o)
-        s.costs[o].shadingPoints += pts.objectStart[o + 1] - pts.objectStart[o];
+    if (keep && (keptBytes_ += kept.bytes()) <= options_.reuseBytes) {
+        kept.finish();
+        if (&pts == &s.work) std::swap(s.work, scratch_->states[band]);
+        s.work.built = false;
+        finishBand(band, range, scratch_->states[band], s.costs);
+        return;
+    }
+    // Over the budget, or the view moving: the storage goes. A band that found tiles
+    // missing keeps it for the next frame's attempt.
+    if (keep || !keeping_)
+        kept.release();
+    else
+        kept.invalidate();
+    finishBand(band, range, pts, s.costs);
     pts.built = false;
     if (&pts != &s.work) std::swap(s.work, pts);  // its buffers go back to the thread
+}
+
+void DynamicPhase::finishBand(size_t band, const BandRange& range, const BandPoints& pts,
+                              std::vector<ObjectFrameCost>& costs) {
+    compositeBand(pts, range, visibility_, layout_->spp(), scene_.settings.background,
+                  samples_.rgba.data(), uniform_.data());
+    for (size_t o = 0; o < objects_.size(); ++o)
+        costs[o].shadingPoints += pts.objectStart[o + 1] - pts.objectStart[o];
     bandDone_[band] = 1;
 }
 

@@ -18,6 +18,7 @@
 // pixel per pixel, times footprintScale.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -25,12 +26,14 @@
 #include <span>
 #include <vector>
 
+#include "phases/band_points.h"
 #include "phases/facet_rasterizer.h"
 #include "phases/object_representation.h"
 #include "phases/phase_trace.h"
 #include "phases/sample_pattern.h"
 #include "phases/scene_resources.h"
 #include "phases/surface_points.h"
+#include "phases/view_reuse.h"
 
 namespace mpshade {
 
@@ -60,6 +63,12 @@ struct DynamicOptions {
     // dynamic phase worth less than a deadline, as a prediction in a frame's slack is
     // (overrides raster.deadline). Default never.
     std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+    // A frame that sees the scene exactly as the last one did (the same camera, placements,
+    // representations, layout and the options above) runs the dynamic shader alone, on
+    // the inputs each band kept (view_reuse.h): the same bits as shading afresh. Bands keep
+    // them at a frame whose view held still since the last (or at the first), up to this
+    // many bytes in all (about 60 a shading point); 0: never.
+    size_t reuseBytes = size_t{256} << 20;
 };
 
 // A shading point's probe footprint in pixels at `rate` with `spp` samples per pixel, before
@@ -78,7 +87,8 @@ struct ObjectFrameCost {
     uint64_t instructions = 0;   // dynamic shader instructions, times lanes
     double shadeSeconds = 0.0;   // probing and shading its points, summed over threads
     uint64_t probes = 0, probeFallbacks = 0;
-    uint64_t tilesMissing = 0;  // distinct tiles its probes asked for that were not resident
+    uint64_t tilesMissing = 0;    // distinct tiles its probes asked for that were not resident
+    uint64_t pointsReplayed = 0;  // of shadingPoints: shaded on inputs kept from the last frame
     // Combined representation: the longest projected facet edge among its visible
     // clusters, in pixels (the static phase dices again beyond maxEdgePixels).
     float longestEdgePixels = 0.0f;
@@ -96,6 +106,10 @@ struct DynamicFrameStats {
     RasterStats raster;
     uint64_t shadingPoints = 0, instructions = 0, nonFinite = 0;
     uint64_t probes = 0, probeFallbacks = 0;
+    // The frame saw what the last one did and reused its visibility (no warp, no
+    // rasterization); of shadingPoints, those shaded on kept inputs.
+    bool viewReused = false;
+    uint64_t pointsReplayed = 0;
 
     // The phase's wall time on the rendering thread: warp, rasterize, shade, resolve.
     double seconds() const { return warpSeconds + rasterSeconds + shadeSeconds + resolveSeconds; }
@@ -114,6 +128,8 @@ struct DynamicFrameStats {
         nonFinite += o.nonFinite;
         probes += o.probes;
         probeFallbacks += o.probeFallbacks;
+        viewReused = viewReused || o.viewReused;
+        pointsReplayed += o.pointsReplayed;
         return *this;
     }
 };
@@ -149,7 +165,14 @@ class DynamicPhase {
 
   private:
     struct Band;
+    void compareWithLastView();
+    void warpObjects();
+    void rasterizeObjects();
+    void prepareBands();
     void shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& missing);
+    // Composites a band whose points are all shaded and counts them in `costs` (per object).
+    void finishBand(size_t band, const BandRange& range, const BandPoints& pts,
+                    std::vector<ObjectFrameCost>& costs);
 
     const Scene& scene_;
     const FrameState* frame_ = nullptr;
@@ -168,6 +191,13 @@ class DynamicPhase {
     std::vector<uint8_t> bandDone_;
     bool abandoned_ = false;
     std::unique_ptr<Band> scratch_;
+    // The last frame's view (view_reuse.h); whether its visibility is whole; whether this
+    // frame reuses it, and whether its bands keep their inputs.
+    ViewKey lastView_;
+    bool haveLastView_ = false, lastViewWhole_ = false;
+    bool reusing_ = false, keeping_ = false;
+    InputLayout inputLayout_;
+    std::atomic<size_t> keptBytes_{0};
     DynamicFrameStats stats_;
     std::vector<ObjectFrameCost> costs_;
 };

@@ -1,12 +1,18 @@
 #include "phases/object_representation.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
 namespace mpshade {
+
+uint64_t newRepresentationSerial() {
+    static std::atomic<uint64_t> next{1};
+    return next.fetch_add(1, std::memory_order_relaxed);
+}
 
 bool ObjectRepresentation::inRange(const glm::vec3& eye, const glm::vec3& forward) const {
     return checkRange(eye, forward).fiducial == RangeCheck::None;

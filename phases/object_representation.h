@@ -12,6 +12,7 @@
 // Read-only once built: the dynamic phase only reads it, so frames may share it.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,7 +26,12 @@
 
 namespace mpshade {
 
+// A number no other representation made in this process has: the dynamic phase knows by it
+// that a frame draws the very representation an earlier one did.
+uint64_t newRepresentationSerial();
+
 struct ObjectRepresentation {
+    uint64_t serial = newRepresentationSerial();
     Representation kind = Representation::Facets;  // Facets or ShaderMap, never Auto
     std::string reason;                            // why this kind
 

@@ -189,6 +189,35 @@ size_t probeChannels(const ShaderMap& map, const ProbeOptions& probe, bool stopA
 
 }  // namespace
 
+void runDynamicShader(const ObjectView& view, size_t n, float* color, float* opacity,
+                      SurfaceShadingScratch& scratch, SurfaceShadingCounters& counters) {
+    ShadingBatch& batch = scratch.batch;
+    ShadingCounters shading;
+    view.rep->dynamicKernel->run(*view.uniforms, batch.in, n, batch.out, scratch.workspace,
+                                 shading);
+    counters.instructions += shading.instructions;
+    for (size_t i = 0; i < n; ++i) {
+        float ci[3], oi[3];
+        for (int k = 0; k < 3; ++k) ci[k] = batch.out.Ci[k][i], oi[k] = batch.out.Oi[k][i];
+        if (!sanitizeShade(ci, oi)) ++counters.nonFinite;
+        for (int k = 0; k < 3; ++k) color[3 * i + k] = ci[k], opacity[3 * i + k] = oi[k];
+    }
+}
+
+std::vector<int> shadingInputRows(const ObjectRepresentation& rep) {
+    std::vector<int> rows = {ShadingBatch::P, ShadingBatch::P + 1, ShadingBatch::P + 2,
+                             ShadingBatch::I, ShadingBatch::I + 1, ShadingBatch::I + 2};
+    for (int row : rep.geometryRows) rows.push_back(row < VertexAttributes::U ? row : row + 3);
+    std::sort(rows.begin(), rows.end());
+    rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+    return rows;
+}
+
+size_t shadingChannels(const ObjectRepresentation& rep) {
+    return rep.map ? static_cast<size_t>(rep.map->channels())
+                   : static_cast<size_t>(rep.mesh.channels);
+}
+
 // Steps 1-5 fill the dynamic shader's inputs; step 6 runs it and makes its results finite.
 size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, bool stopAtMissing,
                           const SurfacePoints& points, float* color, float* opacity,
@@ -199,8 +228,7 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
     const VertexAttributes& attr = mesh.attributes;
     const bool useMap = rep.map != nullptr;
     const size_t n = points.n;
-    const size_t channels =
-        useMap ? static_cast<size_t>(rep.map->channels()) : static_cast<size_t>(mesh.channels);
+    const size_t channels = shadingChannels(rep);
     ShadingBatch& batch = scratch.batch;
     batch.resize(n, channels);
     if (useMap) scratch.queries.resize(n);
@@ -241,15 +269,7 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
         missedCount =
             probeChannels(*rep.map, probe, stopAtMissing, n, channels, missed, scratch, counters);
 
-    ShadingCounters shading;
-    rep.dynamicKernel->run(*view.uniforms, batch.in, n, batch.out, scratch.workspace, shading);
-    counters.instructions += shading.instructions;
-    for (size_t i = 0; i < n; ++i) {
-        float ci[3], oi[3];
-        for (int k = 0; k < 3; ++k) ci[k] = batch.out.Ci[k][i], oi[k] = batch.out.Oi[k][i];
-        if (!sanitizeShade(ci, oi)) ++counters.nonFinite;
-        for (int k = 0; k < 3; ++k) color[3 * i + k] = ci[k], opacity[3 * i + k] = oi[k];
-    }
+    runDynamicShader(view, n, color, opacity, scratch, counters);
     if (missedCount > 0) {
         missedCount = 0;
         for (size_t i = 0; i < n; ++i) missedCount += missed[i];

@@ -328,7 +328,7 @@ TEST(Cli, BadInputExitsTwoNamingThePlace) {
         // 16384^2 pixels at 1024 samples: refused by the estimate before any allocation.
         {"render examples/vase/scene.json --size 16384x16384 --spp 1024 --out /tmp/x",
          "mpshade: --size/--spp: error: 16384x16384 pixels at 1024 samples (multiphase) needs "
-         "about 660"},
+         "about 742"},
         {"render examples/vase/scene.json --memory-mb 100 --out /tmp/x",
          "mpshade: examples/vase/scene.json: settings: error: 480x270 pixels at 4 samples "
          "(multiphase) needs about 0.5 GB, over the memory limit of 0.1 GB (--memory-mb)"},
