@@ -70,6 +70,7 @@ DynamicOptions MultiphaseRenderer::dynamicOptionsFor(const RenderOptions& option
     o.shadingRate =
         options.shadingRate.value_or(options_.shadingRate.value_or(scene_.settings.shadingRate));
     if (options.footprintScale > 0.0f) o.footprintScale = options.footprintScale;
+    if (!options.reuseStillView) o.reuseBytes = 0;
     return o;
 }
 

@@ -85,13 +85,15 @@ class Player {
     }
 
     // The regulator's ratios: the first frame again at every step, now warm (its objects
-    // built, its buffers allocated); each also fills what its own step reads.
+    // built, its buffers allocated); each also fills what its own step reads. Each shades
+    // afresh: the same view again would otherwise run on the inputs the last one kept.
     void calibrate(PlaybackSummary& summary) {
         std::vector<double> stepSeconds(static_cast<size_t>(regulator_.levels()));
         for (int k = 0; k < regulator_.levels(); ++k) {
             FrameStats s;
-            renderer_.renderFrame(options_.first, atStep(options_.render, regulator_.step(k), true),
-                                  s, image_);
+            RenderOptions fresh = atStep(options_.render, regulator_.step(k), true);
+            fresh.reuseStillView = false;
+            renderer_.renderFrame(options_.first, fresh, s, image_);
             stepSeconds[static_cast<size_t>(k)] = s.dynamic.seconds();
             summary.steps.push_back({regulator_.step(k), stepSeconds[static_cast<size_t>(k)], 0});
         }

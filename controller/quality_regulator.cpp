@@ -60,8 +60,11 @@ void QualityRegulator::calibrate(std::span<const double> seconds, double budget)
 
 void QualityRegulator::update(const FrameStats& stats, double budget) {
     const double dynamic = stats.dynamic.seconds();
-    // Neighbouring steps on consecutive frames: their ratio, measured on nearly one view.
-    if (lastLevel_ >= 0 && dynamic > 0.0 && lastDynamic_ > 0.0) {
+    const bool reused = stats.dynamic.viewReused;
+    // Neighbouring steps on consecutive frames: their ratio, measured on nearly one view --
+    // and both shaded afresh, or both on a still view's kept inputs: a frame that only runs
+    // the dynamic shader costs a fraction of one that shades afresh, whatever its step.
+    if (lastLevel_ >= 0 && dynamic > 0.0 && lastDynamic_ > 0.0 && reused == lastReused_) {
         const int below = std::max(lastLevel_, current_);
         if (std::abs(lastLevel_ - current_) == 1) {
             const double upper = lastLevel_ < current_ ? lastDynamic_ : dynamic;
@@ -72,6 +75,11 @@ void QualityRegulator::update(const FrameStats& stats, double budget) {
     const bool wasOver = lastLevel_ == current_ && lastDynamic_ > options_.slowDownAt * budget;
     lastLevel_ = current_;
     lastDynamic_ = dynamic;
+    lastReused_ = reused;
+    if (!reused) {
+        freshLevel_ = current_;
+        freshDynamic_ = dynamic;
+    }
     // One frame over the share may be the machine (a frame's time varies by a tenth or
     // more): a step down waits for a second one, unless the frame nearly took the budget.
     if (dynamic > options_.dropAt * budget || (dynamic > options_.slowDownAt * budget && wasOver)) {
@@ -83,7 +91,11 @@ void QualityRegulator::update(const FrameStats& stats, double budget) {
         calm_ = probeCalm_ = 0;
         return;
     }
-    const double predicted = dynamic * ratioAbove_[static_cast<size_t>(current_)];
+    // The step above's first frame shades afresh (its view is new to the kept inputs): on a
+    // still view, predicted from this step's last fresh frame, not from the replays.
+    const double base =
+        reused && freshLevel_ == current_ ? std::max(dynamic, freshDynamic_) : dynamic;
+    const double predicted = base * ratioAbove_[static_cast<size_t>(current_)];
     if (predicted >= options_.speedUpAt * budget) {
         calm_ = 0;
         probeCalm_ = predicted < options_.dropAt * budget ? probeCalm_ + 1 : 0;

@@ -19,7 +19,9 @@
 // predicting it under `dropAt` (to measure its ratio again). The ratios are measured: all of them
 // before the first frame (calibrate: one view rendered at every step), then each again whenever two
 // consecutive frames ran on neighbouring steps. The gap between the two shares and the wait keep it
-// from flickering between steps.
+// from flickering between steps. A frame on a still view's kept inputs (view_reuse.h) costs a
+// fraction of one shaded afresh: it measures no ratio against a fresh one, and the step
+// above, whose first frame shades afresh, is predicted from the last fresh frame.
 #pragma once
 
 #include <span>
@@ -78,8 +80,11 @@ class QualityRegulator {
     int current_ = 0;
     int calm_ = 0;
     int probeCalm_ = 0;   // frames in a row eligible for trying the step above
-    int lastLevel_ = -1;  // the previous frame's, and its dynamic seconds
+    int lastLevel_ = -1;  // the previous frame's, its dynamic seconds, whether it reused its view
     double lastDynamic_ = 0.0;
+    bool lastReused_ = false;
+    int freshLevel_ = -1;  // the last frame that shaded afresh (DynamicFrameStats::viewReused)
+    double freshDynamic_ = 0.0;
 };
 
 }  // namespace mpshade

@@ -30,6 +30,10 @@ struct RenderOptions {
     // 2 reads one mip level coarser than the shading points' footprint asks).
     std::optional<ShadingRate> shadingRate;
     float footprintScale = 0.0f;
+    // false: the multi-phase renderer shades this frame afresh even if it sees what the last
+    // one did, and keeps nothing for the next (DynamicOptions::reuseBytes): for a frame that
+    // measures what shading costs.
+    bool reuseStillView = true;
 
     // These options with every "0: the scene's" replaced by the scene's setting.
     RenderOptions resolved(const RenderSettings& settings) const {
@@ -55,8 +59,8 @@ class Renderer {
                              Image& image, const ProgressFn& progress = {}) = 0;
     // The per-sample results behind the frame, before filtering: for comparisons that must
     // not blur (coverage tests).
-    virtual SampleBuffer renderSamples(int frame, const RenderOptions& options,
-                                       FrameStats& stats, const ProgressFn& progress = {}) = 0;
+    virtual SampleBuffer renderSamples(int frame, const RenderOptions& options, FrameStats& stats,
+                                       const ProgressFn& progress = {}) = 0;
 
     Image renderFrame(int frame, const RenderOptions& options, FrameStats& stats,
                       const ProgressFn& progress = {}) {

@@ -167,5 +167,29 @@ TEST(QualityRegulator, AStepDownMeasuresTheRatioOfTheTwoSteps) {
     EXPECT_EQ(r.costRatioAbove(2), 4.0);  // not measured: the points' ratio
 }
 
+TEST(QualityRegulator, AStillViewsReplaysPredictFromTheLastFreshFrame) {
+    // At level 1 a fresh frame of 0.45 (x2 = 0.9: the step above would be late), then
+    // replays of 0.1 (x2 = 0.2 would fit): the step above's first frame is fresh, so it is
+    // neither stepped up to nor tried, and no ratio is measured between the fresh frame and
+    // the replays.
+    QualityRegulator r(ShadingRate::Sample, 1, exactShares());
+    const double seconds[] = {1.0, 0.5, 0.375, 0.25, 0.125};
+    r.calibrate(seconds, 1.0);
+    ASSERT_EQ(r.level(), 1);
+    r.update(frame(0.45), 1.0);
+    FrameStats replay = frame(0.1);
+    replay.dynamic.viewReused = true;
+    for (int k = 0; k < 40; ++k) r.update(replay, 1.0);
+    EXPECT_EQ(r.level(), 1);
+    EXPECT_DOUBLE_EQ(r.costRatioAbove(1), 2.0);
+    // A fresh frame at 0.24 (x2 fits) and its replays: up after the calm frames. The first
+    // frame there, fresh, measures no ratio against the replay before it.
+    r.update(frame(0.24), 1.0);
+    for (int k = 0; k < 7; ++k) r.update(replay, 1.0);
+    EXPECT_EQ(r.level(), 0);
+    r.update(frame(0.3), 1.0);
+    EXPECT_DOUBLE_EQ(r.costRatioAbove(1), 2.0);  // unchanged: 0.3 against a replay
+}
+
 }  // namespace
 }  // namespace mpshade
