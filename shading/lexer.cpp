@@ -208,6 +208,10 @@ class Lexer {
                 advance(1);
                 return;
             }
+        if (c == '"' || c == '\'')
+            fail(line_, col_,
+                 "strings are not part of the shading language: shaders are procedural and "
+                 "read no files (docs/shading-language.md)");
         const std::string shown = std::isprint(static_cast<unsigned char>(c))
                                       ? std::string(1, c)
                                       : "\\x" + std::to_string(static_cast<unsigned char>(c));

@@ -1,5 +1,6 @@
 #include "shading/lower.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -41,6 +42,46 @@ class Lowerer {
     }
 
     const FoldStats& stats() const { return b_.stats(); }
+
+    // The inputs a value depends on, for an error: "time", "P", "parameter 'k' (animated
+    // in this scene)", in the order first found.
+    std::string inputsReaching(int value) const {
+        const std::vector<int> defining = definingInstructions(program_);
+        std::vector<std::string> names;
+        auto add = [&](const std::string& n) {
+            if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+        };
+        std::vector<char> seen(defining.size(), 0);
+        std::vector<int> stack = {value};
+        while (!stack.empty()) {
+            const int v = stack.back();
+            stack.pop_back();
+            if (v < 0 || static_cast<size_t>(v) >= defining.size() || seen[static_cast<size_t>(v)])
+                continue;
+            seen[static_cast<size_t>(v)] = 1;
+            const int k = defining[static_cast<size_t>(v)];
+            if (k < 0) continue;
+            const Inst& in = program_.insts[static_cast<size_t>(k)];
+            if (in.op == Op::Global) {
+                add(globalName(static_cast<GlobalId>(in.imm)));
+            } else if (in.op == Op::Param) {
+                for (const AnimatedParam& ap : program_.animatedParams)
+                    if (ap.slot == in.imm)
+                        add("parameter '" + ap.name + "' (animated in this scene)");
+            } else if (in.op == Op::LightAmbient) {
+                add("ambient light " + std::to_string(in.imm) + " (animated in this scene)");
+            } else {
+                if (in.op == Op::Diffuse || in.op == Op::Specular || in.op == Op::Phong)
+                    add("light " + std::to_string(in.imm));
+                const int32_t* args = program_.argsOf(in);
+                for (int a = in.nargs - 1; a >= 0; --a) stack.push_back(args[a]);
+            }
+        }
+        std::string out;
+        for (size_t i = 0; i < names.size(); ++i)
+            out += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+        return names.empty() ? "a value that does not fold" : out;
+    }
 
   private:
     [[noreturn]] void fail(int line, int col, const std::string& msg) const {
@@ -544,7 +585,8 @@ class Lowerer {
                     if (!b_.constantValue(cond, c))
                         fail(s.value->line, s.value->column,
                              "the loop condition must be constant after folding (loops are "
-                             "unrolled)");
+                             "unrolled); it depends on " +
+                                 inputsReaching(cond));
                     if (c == 0.0f) break;
                     if (iteration >= limits_.maxLoopIterations)
                         fail(s.line, s.column,

@@ -1,5 +1,6 @@
 #include "shading/shader_compiler.h"
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -19,6 +20,9 @@ std::shared_ptr<const ShaderAst> compileShaderText(const std::string& file,
 }
 
 std::shared_ptr<const ShaderAst> loadShaderFile(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw InputError({path, 0, 0, {}}, "is a folder, not a shader file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError({path, 0, 0, {}}, "cannot open shader file");
     std::ostringstream text;

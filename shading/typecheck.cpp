@@ -287,8 +287,12 @@ class TypeChecker {
                 break;
             }
             case Stmt::Kind::ExprStmt:
+                // The language has no side effects: `bake(c);` or `noise(P);` alone would
+                // silently do nothing.
                 expr(*s.value);
-                break;
+                fail(s.line, s.column,
+                     "this statement does nothing: an expression alone has no effect (the "
+                     "language has no side effects); assign its value, as in 'float y = ...;'");
             case Stmt::Kind::If:
                 condition(*s.value, "if");
                 scopes_.emplace_back();
@@ -425,8 +429,23 @@ class TypeChecker {
                     ValueType t;
                     if (lookup(e.name, t))
                         fail(e.line, e.column, "'" + e.name + "' is a variable, not a function");
+                    if (e.name == "texture" || e.name == "environment")
+                        fail(e.line, e.column,
+                             "unknown function '" + e.name +
+                                 "': shaders are procedural and read no image files (use "
+                                 "noise, fbm, turbulence or cellnoise)");
                     fail(e.line, e.column, "unknown function '" + e.name + "'");
                 }
+                // bake() computes its whole argument in the static phase: a dynamic() in it
+                // would be silently overruled. (A bake() inside dynamic() is meaningful: that
+                // part stays stored, the rest is repeated.)
+                if (b == Builtin::Bake && !e.args.empty())
+                    if (const Expr* c = findCall(*e.args[0], "dynamic"))
+                        fail(c->line, c->column,
+                             "dynamic() inside bake() (line " + std::to_string(e.line) + ":" +
+                                 std::to_string(e.column) +
+                                 "): bake() computes its whole argument in the static phase, so "
+                                 "this dynamic() would have no effect; remove one of them");
                 std::vector<ValueType> args;
                 for (auto& a : e.args) args.push_back(expr(*a));
                 std::string why;
@@ -436,6 +455,14 @@ class TypeChecker {
             }
         }
         return ValueType::Void;
+    }
+
+    // The first call of `name` in e's tree, or null.
+    static const Expr* findCall(const Expr& e, const char* name) {
+        if (e.kind == Expr::Kind::Call && e.name == name) return &e;
+        for (const auto& a : e.args)
+            if (const Expr* c = findCall(*a, name)) return c;
+        return nullptr;
     }
 
     ShaderAst& ast_;

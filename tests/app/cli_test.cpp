@@ -423,6 +423,8 @@ TEST(Cli, FactorBadInput) {
          "mpshade: tests/data/bad_shaders/missing_semicolon.sl:3:5: error: expected ';' after the "
          "statement, found 'Ci'\n"},
         {"factor nowhere.sl", "mpshade: nowhere.sl: error: cannot open shader file\n"},
+        {"factor examples/shaders",
+         "mpshade: examples/shaders: error: is a folder, not a shader file\n"},
     };
     for (const BadRun& c : cases) {
         const CliRun run = mpshade(c.args);

@@ -68,7 +68,27 @@ const BadShader kBadShaders[] = {
     {"surface s() { Ci = occlusion(P, N, int(u)); }", 1, 36,
      "the occlusion ray count must be a constant"},
     {"surface s() { float a = 0; for (int i = 0; i < u; i += 1) { a += 1; } Ci = a; }", 1, 46,
-     "the loop condition must be constant after folding (loops are unrolled)"},
+     "the loop condition must be constant after folding (loops are unrolled); it depends on u"},
+    {"surface s() { float a = 0; for (int i = 0; i < time * P[1] + v; i += 1) { a += 1; } "
+     "Ci = a; }",
+     1, 46,
+     "the loop condition must be constant after folding (loops are unrolled); it depends on "
+     "time, P and v"},
+    {"surface s() { Ci = color(1); noise(P); }", 1, 30,
+     "this statement does nothing: an expression alone has no effect (the language has no side "
+     "effects); assign its value, as in 'float y = ...;'"},
+    {"surface s() { float x = u; bake(x); Ci = x; }", 1, 28,
+     "this statement does nothing: an expression alone has no effect (the language has no side "
+     "effects); assign its value, as in 'float y = ...;'"},
+    {"surface s() { Ci = bake(1 + dynamic(noise(P))); }", 1, 29,
+     "dynamic() inside bake() (line 1:20): bake() computes its whole argument in the static "
+     "phase, so this dynamic() would have no effect; remove one of them"},
+    {"surface s() { Ci = texture(\"bricks.tx\", s, t); }", 1, 28,
+     "strings are not part of the shading language: shaders are procedural and read no files "
+     "(docs/shading-language.md)"},
+    {"surface s() { Ci = texture(s, t); }", 1, 20,
+     "unknown function 'texture': shaders are procedural and read no image files (use noise, "
+     "fbm, turbulence or cellnoise)"},
     {"surface s() { float a = 0; for (int i = 0; i < 10; i += 0) { a += 1; } Ci = a; }", 1, 28,
      "the loop runs more than 4096 iterations"},
     {"surface s() { while (1) {} Ci = 1; }", 1, 15,
@@ -97,6 +117,26 @@ TEST(LanguageErrors, GoldenMessages) {
                       0u)
                 << e.what();
         }
+    }
+}
+
+TEST(LanguageErrors, AnAnimatedLoopBoundNamesItsParameter) {
+    // Constant at its default the loop unrolls; animated by the scene it cannot, and the
+    // message says which input is to blame.
+    auto ast = compileShaderText(
+        "k.sl",
+        "surface s(float k = 2) { float a = 0; for (int i = 0; i < k; i += 1) { a += 1; } "
+        "Ci = a; }");
+    EXPECT_NO_THROW(lowerShader(*ast, {}));
+    ShaderBinding b;
+    b.params["k"].kind = ParamBinding::Kind::Animated;
+    try {
+        lowerShader(*ast, b);
+        ADD_FAILURE() << "an animated loop bound was accepted";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.message(),
+                  "the loop condition must be constant after folding (loops are unrolled); it "
+                  "depends on parameter 'k' (animated in this scene)");
     }
 }
 
