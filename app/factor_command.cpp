@@ -104,10 +104,13 @@ void printFactoringJson(const FactorCommandOptions& options, const ShaderAst& as
                             {"op", opName(c.op)},
                             {"source", sourceLine(ast.source, c.line)}});
     }
-    nlohmann::json lines = nlohmann::json::array();
-    for (const DynamicLine& l : f.dynamicLines)
-        lines.push_back(
-            {{"line", l.line}, {"source", sourceLine(ast.source, l.line)}, {"chain", l.chain}});
+    auto linesJson = [&](const std::vector<DynamicLine>& from) {
+        nlohmann::json lines = nlohmann::json::array();
+        for (const DynamicLine& l : from)
+            lines.push_back(
+                {{"line", l.line}, {"source", sourceLine(ast.source, l.line)}, {"chain", l.chain}});
+        return lines;
+    };
     nlohmann::json doc = {{"shader", ast.name},
                           {"file", options.shader},
                           {"binding", bindingText},
@@ -124,7 +127,8 @@ void printFactoringJson(const FactorCommandOptions& options, const ShaderAst& as
                             {"dynamic", f.dynamicCost},
                             {"static_repeated", f.recomputedStaticCost}}},
                           {"dynamic_to_static_instructions", ratio},
-                          {"dynamic_lines", lines}};
+                          {"dynamic_lines", linesJson(f.dynamicLines)},
+                          {"baked_lines", linesJson(f.bakedLines)}};
     std::printf("%s\n", doc.dump(2).c_str());
 }
 
@@ -163,15 +167,25 @@ void printFactoring(const FactorCommandOptions& options, const ShaderAst& ast,
     if (f.staticInstructions > 0)
         std::printf("  dynamic/static   %12.2f %12.2f\n", ratio,
                     f.staticCost > 0 ? double(f.dynamicCost) / f.staticCost : 0.0);
+    auto printLines = [&](const std::vector<DynamicLine>& lines) {
+        for (const DynamicLine& l : lines) {
+            std::printf("  %3d | %s\n", l.line, sourceLine(ast.source, l.line).c_str());
+            std::string chain;
+            for (const std::string& step : l.chain)
+                chain += (chain.empty() ? "" : "\n        <- ") + step;
+            std::printf("        <- %s\n", chain.c_str());
+        }
+    };
     std::printf("\ndynamic lines (and the input that reaches them):\n");
     if (f.dynamicLines.empty())
         std::printf("  none: the whole shader is static for this binding\n");
-    for (const DynamicLine& l : f.dynamicLines) {
-        std::printf("  %3d | %s\n", l.line, sourceLine(ast.source, l.line).c_str());
-        std::string chain;
-        for (const std::string& step : l.chain)
-            chain += (chain.empty() ? "" : "\n        <- ") + step;
-        std::printf("        <- %s\n", chain.c_str());
+    printLines(f.dynamicLines);
+    if (!f.bakedLines.empty()) {
+        std::printf(
+            "\nbaked lines: stored, computed once by the static phase with the input that "
+            "reaches them frozen at its representative value (the time, view, parameter or "
+            "light of each static run; the object's range bounds the view's):\n");
+        printLines(f.bakedLines);
     }
     if (options.dump) {
         std::printf("\nstatic part:\n%s\ndynamic part:\n%s", f.staticPart.dump().c_str(),

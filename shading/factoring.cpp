@@ -209,38 +209,106 @@ std::string describeValue(const IrProgram& p, int32_t v) {
     return "";
 }
 
+// Per value: whether the frames compute it -- reached from Ci and Oi without passing through
+// a bake(), whose argument the static phase computes once, its dynamic inputs frozen.
+std::vector<char> computedPerFrame(const IrProgram& p, const std::vector<int>& defining) {
+    std::vector<char> reached(defining.size(), 0);
+    std::vector<int32_t> stack;
+    for (int k = 0; k < 3; ++k) stack.push_back(p.ci[k]), stack.push_back(p.oi[k]);
+    while (!stack.empty()) {
+        const int32_t v = stack.back();
+        stack.pop_back();
+        if (v < 0 || reached[static_cast<size_t>(v)]) continue;
+        reached[static_cast<size_t>(v)] = 1;
+        const int d = defining[static_cast<size_t>(v)];
+        if (d < 0) continue;
+        const Inst& inst = p.insts[static_cast<size_t>(d)];
+        if (inst.op == Op::Bake) continue;
+        for (int a = 0; a < inst.nargs; ++a) stack.push_back(p.argsOf(inst)[a]);
+    }
+    return reached;
+}
+
+// The steps from value `at` back to the dynamic input that reached it, each line once.
+std::vector<std::string> causeChain(const IrProgram& p, const BindingTimes& bt,
+                                    const std::vector<int>& defining, int32_t at) {
+    std::vector<std::string> chain;
+    int lastLine = -1;
+    for (int guard = 0; at >= 0 && guard < 64; ++guard) {
+        const Inst& def = p.insts[static_cast<size_t>(defining[static_cast<size_t>(at)])];
+        const int32_t cause = bt.cause[static_cast<size_t>(at)];
+        if (cause < 0) {
+            chain.push_back(bt.why[static_cast<size_t>(at)] + " (line " + std::to_string(def.line) +
+                            ":" + std::to_string(def.column) + ")");
+            break;
+        }
+        if (def.line != lastLine) {
+            const std::string name = describeValue(p, at);
+            chain.push_back(std::string(opName(def.op)) + (name.empty() ? "" : " -> " + name) +
+                            " at line " + std::to_string(def.line) + ":" +
+                            std::to_string(def.column));
+            lastLine = def.line;
+        }
+        at = cause;
+    }
+    return chain;
+}
+
+// Lines whose bake() freezes a dynamic input (the view, time, an animated parameter or a
+// moving light): the static phase computes them once, at its representative values.
+std::vector<DynamicLine> explainBakedLines(const IrProgram& p, const BindingTimes& bt) {
+    const std::vector<int> defining = definingInstructions(p);
+    std::map<int, DynamicLine> lines;
+    for (const Inst& inst : p.insts) {
+        if (inst.op != Op::Bake || inst.nargs < 1 || lines.count(inst.line)) continue;
+        const int32_t arg = p.argsOf(inst)[0];
+        if (bt.stage[static_cast<size_t>(arg)] != Stage::Dynamic) continue;
+        lines[inst.line] = {inst.line, causeChain(p, bt, defining, arg)};
+    }
+    std::vector<DynamicLine> out;
+    for (auto& [l, line] : lines) out.push_back(std::move(line));
+    return out;
+}
+
+// Per value: whether it is written inside a bake() on its own line. Shared with work the
+// frames do (the -I of a baked rim term and of a specular), it is still that line's baked
+// work: the per-frame use is reported where it is.
+std::vector<char> writtenInBake(const IrProgram& p, const std::vector<int>& defining) {
+    std::vector<char> inBake(defining.size(), 0);
+    std::vector<int32_t> stack;
+    for (const Inst& bake : p.insts) {
+        if (bake.op != Op::Bake) continue;
+        for (int a = 0; a < bake.nargs; ++a) stack.push_back(p.argsOf(bake)[a]);
+        while (!stack.empty()) {
+            const int32_t v = stack.back();
+            stack.pop_back();
+            const int d = v < 0 ? -1 : defining[static_cast<size_t>(v)];
+            if (d < 0 || inBake[static_cast<size_t>(v)]) continue;
+            const Inst& inst = p.insts[static_cast<size_t>(d)];
+            if (inst.line != bake.line) continue;
+            inBake[static_cast<size_t>(v)] = 1;
+            for (int a = 0; a < inst.nargs; ++a) stack.push_back(p.argsOf(inst)[a]);
+        }
+    }
+    return inBake;
+}
+
 std::vector<DynamicLine> explainDynamicLines(const IrProgram& p, const BindingTimes& bt) {
     const std::vector<int> defining = definingInstructions(p);
+    const std::vector<char> perFrame = computedPerFrame(p, defining);
+    const std::vector<char> inBake = writtenInBake(p, defining);
     std::map<int, DynamicLine> lines;
     for (const Inst& inst : p.insts) {
         const size_t v = static_cast<size_t>(inst.result);
         if (bt.stage[v] != Stage::Dynamic || inst.line <= 0 || lines.count(inst.line)) continue;
+        // Only under a bake(): computed in the static phase.
+        if (!perFrame[v] || inBake[v]) continue;
         // The inputs themselves (a parameter's declaration, a global) are the chain's end,
         // not a line the author wrote dynamic work on.
         if (inst.op == Op::Global || inst.op == Op::Param || inst.op == Op::LightAmbient) continue;
         DynamicLine line;
         line.line = inst.line;
-        // Follow the causes back to the dynamic input, naming each step once per line.
-        int32_t at = static_cast<int32_t>(v);
-        int lastLine = -1;
-        for (int guard = 0; at >= 0 && guard < 64; ++guard) {
-            const Inst& def = p.insts[static_cast<size_t>(defining[static_cast<size_t>(at)])];
-            const int32_t cause = bt.cause[static_cast<size_t>(at)];
-            if (cause < 0) {
-                line.chain.push_back(bt.why[static_cast<size_t>(at)] + " (line " +
-                                     std::to_string(def.line) + ":" + std::to_string(def.column) +
-                                     ")");
-                break;
-            }
-            if (def.line != lastLine) {
-                const std::string name = describeValue(p, at);
-                line.chain.push_back(std::string(opName(def.op)) +
-                                     (name.empty() ? "" : " -> " + name) + " at line " +
-                                     std::to_string(def.line) + ":" + std::to_string(def.column));
-                lastLine = def.line;
-            }
-            at = cause;
-        }
+        line.chain = causeChain(p, bt, defining, static_cast<int32_t>(v));
         lines[inst.line] = line;
     }
     std::vector<DynamicLine> out;
@@ -291,6 +359,7 @@ FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
     f.staticCost = programCost(f.staticPart);
     f.dynamicCost = programCost(f.dynamicPart);
     f.dynamicLines = explainDynamicLines(f.analyzed, f.times);
+    f.bakedLines = explainBakedLines(f.analyzed, f.times);
     return f;
 }
 

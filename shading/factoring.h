@@ -53,6 +53,9 @@ struct FactoredShader {
     // repeating it (FactorOptions::storeAboveCost); 0 when the cut's values are all stored.
     int recomputedStaticCost = 0;
     std::vector<DynamicLine> dynamicLines;
+    // Lines whose bake() freezes a dynamic input (its chain ends at the input): computed once
+    // by the static phase at its representative time, view, parameters and lights.
+    std::vector<DynamicLine> bakedLines;
 };
 
 FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,

@@ -352,6 +352,42 @@ TEST(Factoring, ExplainsWhyEachLineIsDynamic) {
     EXPECT_EQ(f.channels[0].line, 2);
 }
 
+TEST(Factoring, BakedLinesAreReportedAsBakedNotDynamic) {
+    // Lines 2 and 3 are stored (bake), though I and time reach them: they are baked lines,
+    // each naming the input it freezes, not dynamic ones. Line 4's specular shares line 2's
+    // -I and is dynamic.
+    auto ast = compileShaderText("rim.sl",
+                                 "surface r(float rate = 2) {\n"
+                                 "  float rim = bake(pow(1.0 - max(0.0, dot(N, -I)), 3.0));\n"
+                                 "  float pulse = bake(0.5 + 0.5 * sin(time * rate));\n"
+                                 "  Ci = color(rim * pulse) + specular(N, -I, 0.3);\n}");
+    const FactoredShader f = factorShader(*ast, fixedLights());
+    ASSERT_EQ(f.dynamicLines.size(), 1u);
+    EXPECT_EQ(f.dynamicLines[0].line, 4);
+    ASSERT_EQ(f.bakedLines.size(), 2u);
+    EXPECT_EQ(f.bakedLines[0].line, 2);
+    ASSERT_FALSE(f.bakedLines[0].chain.empty());
+    EXPECT_NE(f.bakedLines[0].chain.back().find("I, the direction from the eye"),
+              std::string::npos);
+    EXPECT_EQ(f.bakedLines[1].line, 3);
+    ASSERT_FALSE(f.bakedLines[1].chain.empty());
+    EXPECT_NE(f.bakedLines[1].chain.back().find("time changes every frame"), std::string::npos);
+    // Work on another line that only a bake() reads runs in the static phase too.
+    auto split = compileShaderText("ph.sl",
+                                   "surface p(float rate = 2) {\n"
+                                   "  float ph = time * rate;\n"
+                                   "  float pulse = bake(sin(ph));\n"
+                                   "  Ci = color(pulse) * noise(P * time);\n}");
+    const FactoredShader g = factorShader(*split, fixedLights());
+    ASSERT_EQ(g.dynamicLines.size(), 1u);
+    EXPECT_EQ(g.dynamicLines[0].line, 4);
+    ASSERT_EQ(g.bakedLines.size(), 1u);
+    EXPECT_EQ(g.bakedLines[0].line, 3);
+    // A bake of a static value freezes nothing: no baked line.
+    auto still = compileShaderText("n.sl", "surface n() { Ci = color(bake(noise(P))) * time; }");
+    EXPECT_TRUE(factorShader(*still, {}).bakedLines.empty());
+}
+
 // Random well-typed programs over random mixes of static and dynamic inputs, with
 // branches, loops and lighting.
 std::string randomShader(std::mt19937& rng, int statements) {
