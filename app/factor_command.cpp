@@ -52,46 +52,39 @@ ShaderBinding defaultBinding() {
     return b;
 }
 
-// The binding to factor for: --scene's --object (its parameters checked against the
-// shader's), or parameters at their defaults with a fixed ambient and distant light;
-// `described` says which.
-ShaderBinding bindingFor(const FactorCommandOptions& options, const ShaderAst& ast,
-                         std::string& described) {
-    ShaderBinding binding = defaultBinding();
-    described = "parameters at their defaults, a fixed ambient and a fixed distant light";
-    if (!options.scene.empty() || !options.object.empty()) {
-        if (options.scene.empty())
-            throw InputError({"--object", 0, 0, {}}, "--object needs --scene");
-        if (options.object.empty())
-            throw InputError({"--scene", 0, 0, {}}, "--scene needs --object NAME");
-        const Scene scene = loadScene(options.scene);
-        const SceneObject* object = nullptr;
-        std::string names;
-        for (const SceneObject& o : scene.objects) {
-            if (o.name == options.object) object = &o;
-            names += (names.empty() ? "" : ", ") + o.name;
-        }
-        if (!object)
-            throw InputError({"--object", 0, 0, {}}, "no object named '" + options.object +
-                                                         "' in " + options.scene +
-                                                         " (objects: " + names + ")");
-        for (const ParamValue& p : object->params) {
-            bool declared = false;
-            for (const ParamDecl& d : ast.params) declared = declared || d.name == p.name;
-            if (!declared)
-                throw InputError({options.shader, 0, 0, {}},
-                                 "object '" + object->name + "' binds parameter '" + p.name +
-                                     "', which this shader does not declare");
-        }
-        binding = bindingOf(scene, *object);
-        described = "object '" + object->name + "' in " + options.scene;
+// An object's binding, its parameters checked against the shader's declarations.
+ShaderBinding objectBinding(const Scene& scene, const SceneObject& object, const ShaderAst& ast,
+                            const std::string& shaderFile) {
+    for (const ParamValue& p : object.params) {
+        bool declared = false;
+        for (const ParamDecl& d : ast.params) declared = declared || d.name == p.name;
+        if (!declared)
+            throw InputError({shaderFile, 0, 0, {}}, "object '" + object.name +
+                                                         "' binds parameter '" + p.name +
+                                                         "', which this shader does not declare");
     }
-    return binding;
+    return bindingOf(scene, object);
+}
+
+const SceneObject& findObject(const Scene& scene, const FactorCommandOptions& options) {
+    std::string names;
+    for (const SceneObject& o : scene.objects) {
+        if (o.name == options.object) return o;
+        names += (names.empty() ? "" : ", ") + o.name;
+    }
+    throw InputError({"--object", 0, 0, {}}, "no object named '" + options.object + "' in " +
+                                                 options.scene + " (objects: " + names + ")");
+}
+
+bool sameFile(const std::string& a, const std::string& b) {
+    std::error_code ec;
+    return std::filesystem::equivalent(a, b, ec);
 }
 
 // --json: the factoring as one document.
-void printFactoringJson(const FactorCommandOptions& options, const ShaderAst& ast,
-                        const std::string& bindingText, const FactoredShader& f, double ratio) {
+nlohmann::json factoringJson(const std::string& shaderFile, const ShaderAst& ast,
+                             const std::string& bindingText, const FactoredShader& f,
+                             double ratio) {
     nlohmann::json channels = nlohmann::json::array();
     for (size_t k = 0; k < f.channels.size(); ++k) {
         const ChannelInfo& c = f.channels[k];
@@ -112,7 +105,7 @@ void printFactoringJson(const FactorCommandOptions& options, const ShaderAst& as
         return lines;
     };
     nlohmann::json doc = {{"shader", ast.name},
-                          {"file", options.shader},
+                          {"file", shaderFile},
                           {"binding", bindingText},
                           {"naive_width", f.naiveWidth},
                           {"chosen_width", f.chosenWidth},
@@ -129,15 +122,15 @@ void printFactoringJson(const FactorCommandOptions& options, const ShaderAst& as
                           {"dynamic_to_static_instructions", ratio},
                           {"dynamic_lines", linesJson(f.dynamicLines)},
                           {"baked_lines", linesJson(f.bakedLines)}};
-    std::printf("%s\n", doc.dump(2).c_str());
+    return doc;
 }
 
 // The factoring for a reader: the n-tuple's channels, the costs, the dynamic lines with
 // what reaches them, and with --dump both parts.
-void printFactoring(const FactorCommandOptions& options, const ShaderAst& ast,
-                    const std::string& bindingText, const FactoredShader& f, double ratio,
-                    int storeAboveCost) {
-    std::printf("%s (%s), factored for %s\n\n", ast.name.c_str(), options.shader.c_str(),
+void printFactoring(const FactorCommandOptions& options, const std::string& shaderFile,
+                    const ShaderAst& ast, const std::string& bindingText, const FactoredShader& f,
+                    double ratio, int storeAboveCost) {
+    std::printf("%s (%s), factored for %s\n\n", ast.name.c_str(), shaderFile.c_str(),
                 bindingText.c_str());
     std::printf("n-tuple: %d float%s (storing every static value a dynamic operation reads: %d)\n",
                 f.chosenWidth, f.chosenWidth == 1 ? "" : "s", f.naiveWidth);
@@ -195,19 +188,85 @@ void printFactoring(const FactorCommandOptions& options, const ShaderAst& ast,
 
 }  // namespace
 
-int runFactorCommand(const FactorCommandOptions& options) {
-    auto ast = loadShaderFile(options.shader);
-    std::string bindingText;
-    const ShaderBinding binding = bindingFor(options, *ast, bindingText);
+namespace {
+
+// One factoring, printed or added to `json`.
+void factorOne(const FactorCommandOptions& options, const std::string& shaderFile,
+               const ShaderAst& ast, const ShaderBinding& binding, const std::string& bindingText,
+               nlohmann::json* json) {
     FactorOptions factorOptions;
     factorOptions.storeAboveCost = options.storeAboveCost;
-    const FactoredShader f = factorShader(*ast, binding, factorOptions);
+    const FactoredShader f = factorShader(ast, binding, factorOptions);
     const double ratio =
         f.staticInstructions > 0 ? double(f.dynamicInstructions) / f.staticInstructions : 0.0;
-    if (options.json)
-        printFactoringJson(options, *ast, bindingText, f, ratio);
+    if (json)
+        *json = factoringJson(shaderFile, ast, bindingText, f, ratio);
     else
-        printFactoring(options, *ast, bindingText, f, ratio, factorOptions.storeAboveCost);
+        printFactoring(options, shaderFile, ast, bindingText, f, ratio,
+                       factorOptions.storeAboveCost);
+}
+
+}  // namespace
+
+int runFactorCommand(const FactorCommandOptions& options) {
+    if (options.scene.empty()) {
+        if (!options.object.empty())
+            throw InputError({"--object", 0, 0, {}}, "--object needs --scene");
+        if (options.shader.empty())
+            throw InputError({"factor", 0, 0, {}},
+                             "give a shader file, --scene SCENE (every object) or --scene SCENE "
+                             "--object NAME");
+        auto ast = loadShaderFile(options.shader);
+        nlohmann::json doc;
+        factorOne(options, options.shader, *ast, defaultBinding(),
+                  "parameters at their defaults, a fixed ambient and a fixed distant light",
+                  options.json ? &doc : nullptr);
+        if (options.json) std::printf("%s\n", doc.dump(2).c_str());
+        return 0;
+    }
+    const Scene scene = loadScene(options.scene);
+    if (!options.object.empty()) {
+        const SceneObject& object = findObject(scene, options);
+        // Without a shader file, the object's own; with one that is not the object's, that
+        // file on the object's binding (a what-if), said so.
+        std::shared_ptr<const ShaderAst> ast = object.shader;
+        std::string file = object.shader->file;
+        if (!options.shader.empty()) {
+            ast = loadShaderFile(options.shader);
+            file = options.shader;
+        }
+        const ShaderBinding binding = objectBinding(scene, object, *ast, file);
+        if (!options.shader.empty() && !sameFile(options.shader, object.shader->file))
+            std::fprintf(stderr,
+                         "mpshade: note: object '%s' uses %s; factoring %s on its binding "
+                         "instead\n",
+                         object.name.c_str(), object.shader->file.c_str(), options.shader.c_str());
+        nlohmann::json doc;
+        factorOne(options, file, *ast, binding, "object '" + object.name + "' in " + options.scene,
+                  options.json ? &doc : nullptr);
+        if (options.json) std::printf("%s\n", doc.dump(2).c_str());
+        return 0;
+    }
+    if (!options.shader.empty())
+        throw InputError({"--scene", 0, 0, {}},
+                         "--scene with a shader file needs --object NAME (without a shader "
+                         "file: every object, each with its own shader)");
+    // Every object of the scene, each with its own shader and binding.
+    nlohmann::json all = nlohmann::json::array();
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+        const SceneObject& object = scene.objects[i];
+        if (i > 0 && !options.json) std::printf("\n----\n\n");
+        nlohmann::json doc;
+        factorOne(options, object.shader->file, *object.shader,
+                  objectBinding(scene, object, *object.shader, object.shader->file),
+                  "object '" + object.name + "' in " + options.scene,
+                  options.json ? &doc : nullptr);
+        if (options.json) {
+            doc["object"] = object.name;
+            all.push_back(std::move(doc));
+        }
+    }
+    if (options.json) std::printf("%s\n", nlohmann::json{{"objects", all}}.dump(2).c_str());
     return 0;
 }
 

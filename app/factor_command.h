@@ -8,10 +8,14 @@
 
 namespace mpshade {
 
+// Three forms: a shader file alone (parameters at their defaults, a fixed ambient and
+// distant light); --scene with --object (the object's binding and, without a shader file,
+// its shader; a shader file that is not the object's is factored on its binding, with a
+// note); --scene alone (every object, each with its own shader and binding).
 struct FactorCommandOptions {
-    std::string shader;  // .sl file
+    std::string shader;  // .sl file; optional with --scene
     std::string scene;   // optional scene file
-    std::string object;  // object in the scene whose binding to use (required with scene)
+    std::string object;  // object in the scene whose binding to use
     bool json = false;   // machine-readable output
     bool dump = false;   // also print the IR of both parts
     // FactorOptions::storeAboveCost: stored values whose static work costs at most this

@@ -62,8 +62,10 @@ int main(int argc, char** argv) {
     mpshade::FactorCommandOptions factor;
     CLI::App* factorCmd = app.add_subcommand(
         "factor", "Split a shader into its static and dynamic parts for a scene binding");
-    factorCmd->add_option("shader", factor.shader, "Shader file (.sl)")->required();
-    factorCmd->add_option("--scene", factor.scene, "Scene whose binding to use (with --object)");
+    factorCmd->add_option("shader", factor.shader,
+                          "Shader file (.sl); with --scene and --object, default the object's");
+    factorCmd->add_option("--scene", factor.scene,
+                          "Scene whose binding to use: of --object, or of every object");
     factorCmd->add_option("--object", factor.object, "Object in the scene");
     factorCmd->add_flag("--json", factor.json, "Machine-readable output");
     factorCmd->add_flag("--dump", factor.dump, "Also print the IR of both parts");

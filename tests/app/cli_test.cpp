@@ -409,6 +409,32 @@ TEST(Cli, FactorBindingChangesTheCut) {
     EXPECT_EQ(cheap["cost"]["dynamic"], cheap["cost"]["unfactored"]);
 }
 
+TEST(Cli, FactorEveryObjectOrOneWithItsOwnShader) {
+    // --scene alone: every object with its own shader and binding; --object without a
+    // shader file: that object's; another file on an object's binding: factored, with a note.
+    const CliRun all = mpshade("factor --scene examples/vase/scene.json --json");
+    ASSERT_EQ(all.exitCode, 0) << all.output;
+    const nlohmann::json doc = nlohmann::json::parse(all.output);
+    ASSERT_EQ(doc["objects"].size(), 2u);
+    EXPECT_EQ(doc["objects"][0]["object"], "vase");
+    EXPECT_EQ(doc["objects"][0]["shader"], "marble");
+    EXPECT_EQ(doc["objects"][1]["object"], "floor");
+    EXPECT_EQ(doc["objects"][1]["shader"], "wood");
+    const nlohmann::json floor = nlohmann::json::parse(
+        mpshade("factor --scene examples/vase/scene.json --object floor --json").output);
+    nlohmann::json second = doc["objects"][1];
+    second.erase("object");
+    EXPECT_EQ(floor, second);
+    const CliRun whatIf = mpshade(
+        "factor examples/shaders/marble.sl --scene examples/vase/scene.json --object floor");
+    EXPECT_EQ(whatIf.exitCode, 0) << whatIf.output;
+    EXPECT_EQ(whatIf.output.rfind("mpshade: note: object 'floor' uses ", 0), 0u) << whatIf.output;
+    EXPECT_NE(whatIf.output.find("marble (examples/shaders/marble.sl), factored for object "
+                                 "'floor' in examples/vase/scene.json"),
+              std::string::npos)
+        << whatIf.output;
+}
+
 TEST(Cli, FactorBadInput) {
     const BadRun cases[] = {
         {"factor examples/shaders/marble.sl --scene examples/vase/scene.json --object urn",
@@ -425,6 +451,12 @@ TEST(Cli, FactorBadInput) {
         {"factor nowhere.sl", "mpshade: nowhere.sl: error: cannot open shader file\n"},
         {"factor examples/shaders",
          "mpshade: examples/shaders: error: is a folder, not a shader file\n"},
+        {"factor",
+         "mpshade: factor: error: give a shader file, --scene SCENE (every object) or --scene "
+         "SCENE --object NAME\n"},
+        {"factor examples/shaders/marble.sl --scene examples/vase/scene.json",
+         "mpshade: --scene: error: --scene with a shader file needs --object NAME (without a "
+         "shader file: every object, each with its own shader)\n"},
     };
     for (const BadRun& c : cases) {
         const CliRun run = mpshade(c.args);
