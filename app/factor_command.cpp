@@ -99,9 +99,20 @@ nlohmann::json factoringJson(const std::string& shaderFile, const ShaderAst& ast
     }
     auto linesJson = [&](const std::vector<DynamicLine>& from) {
         nlohmann::json lines = nlohmann::json::array();
-        for (const DynamicLine& l : from)
-            lines.push_back(
-                {{"line", l.line}, {"source", sourceLine(ast.source, l.line)}, {"chain", l.chain}});
+        for (const DynamicLine& l : from) {
+            nlohmann::json causes = nlohmann::json::array();
+            for (const DynamicCause& c : l.causes) {
+                nlohmann::json cause = {
+                    {"kind", c.kind}, {"why", c.why}, {"line", c.line}, {"column", c.column}};
+                if (!c.name.empty()) cause["name"] = c.name;
+                if (c.index >= 0) cause["index"] = c.index;
+                causes.push_back(std::move(cause));
+            }
+            lines.push_back({{"line", l.line},
+                             {"source", sourceLine(ast.source, l.line)},
+                             {"chain", l.chain},
+                             {"causes", causes}});
+        }
         return lines;
     };
     nlohmann::json doc = {{"shader", ast.name},
@@ -167,6 +178,13 @@ void printFactoring(const FactorCommandOptions& options, const std::string& shad
             for (const std::string& step : l.chain)
                 chain += (chain.empty() ? "" : "\n        <- ") + step;
             std::printf("        <- %s\n", chain.c_str());
+            if (l.causes.size() > 1) {
+                std::string all;
+                for (const DynamicCause& c : l.causes)
+                    all += (all.empty() ? "" : "; ") + c.why + " (line " + std::to_string(c.line) +
+                           ":" + std::to_string(c.column) + ")";
+                std::printf("        every input: %s\n", all.c_str());
+            }
         }
     };
     std::printf("\ndynamic lines (and the input that reaches them):\n");

@@ -107,7 +107,10 @@ BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& 
     bt.stage.assign(n, Stage::Free);
     bt.cause.assign(n, -1);
     bt.why.assign(n, {});
-    std::vector<char> forced(n, 0);  // made dynamic by a dynamic() override
+    bt.lightMoves.assign(n, 0);
+    std::vector<char> forced(n, 0);                // made dynamic by a dynamic() override
+    std::vector<int32_t>& forcedBy = bt.forcedBy;  // the dynamic() instruction that forced it
+    forcedBy.assign(n, -1);
 
     auto pass = [&]() {
         for (const Inst& inst : program.insts) {
@@ -162,6 +165,8 @@ BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& 
                     const size_t light = static_cast<size_t>(inst.imm);
                     const bool moves = light < binding.lights.size() &&
                                        binding.lights[light].movesRelativeToObject;
+                    for (int o = 0; o < inst.nout; ++o)
+                        bt.lightMoves[static_cast<size_t>(inst.result + o)] = moves ? 1 : 0;
                     if (moves && stage != Stage::Dynamic) {
                         stage = Stage::Dynamic;
                         cause = -1;
@@ -195,20 +200,22 @@ BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& 
     // dynamic(x) evaluates x every frame: the static work under it moves to the dynamic
     // part (down to free values), and whatever uses it follows.
     bool anyForced = false;
-    std::vector<int32_t> stack;
-    for (const Inst& inst : program.insts)
-        if (inst.op == Op::Dynamic)
-            for (int a = 0; a < inst.nargs; ++a) stack.push_back(program.argsOf(inst)[a]);
     const std::vector<int> defining = definingInstructions(program);
-    while (!stack.empty()) {
-        const size_t v = static_cast<size_t>(stack.back());
-        stack.pop_back();
-        if (forced[v] || bt.stage[v] != Stage::Static) continue;
-        const Inst& inst = program.insts[static_cast<size_t>(defining[v])];
-        if (inst.op == Op::Bake) continue;  // an explicit bake wins
-        forced[v] = 1;
-        anyForced = true;
-        for (int a = 0; a < inst.nargs; ++a) stack.push_back(program.argsOf(inst)[a]);
+    for (size_t d = 0; d < program.insts.size(); ++d) {
+        const Inst& dyn = program.insts[d];
+        if (dyn.op != Op::Dynamic) continue;
+        std::vector<int32_t> stack(program.argsOf(dyn), program.argsOf(dyn) + dyn.nargs);
+        while (!stack.empty()) {
+            const size_t v = static_cast<size_t>(stack.back());
+            stack.pop_back();
+            if (forced[v] || bt.stage[v] != Stage::Static) continue;
+            const Inst& inst = program.insts[static_cast<size_t>(defining[v])];
+            if (inst.op == Op::Bake) continue;  // an explicit bake wins
+            forced[v] = 1;
+            forcedBy[v] = static_cast<int32_t>(d);
+            anyForced = true;
+            for (int a = 0; a < inst.nargs; ++a) stack.push_back(program.argsOf(inst)[a]);
+        }
     }
     if (anyForced) pass();
     return bt;

@@ -61,6 +61,12 @@ struct BindingTimes {
         cause;  // per dynamic value: the argument that made it dynamic; -1 at a source
     std::vector<std::string>
         why;  // per dynamic source value: what varies ("I (the view direction)")
+    // Per value: a light's contribution whose light moves relative to the object -- a cause
+    // of its own even where another argument (I, in a specular) made it dynamic first.
+    std::vector<uint8_t> lightMoves;
+    // Per value: the instruction of the dynamic() that made it dynamic, or -1: a report names
+    // the annotation, not the work under it.
+    std::vector<int32_t> forcedBy;
 };
 
 // `binding` says which lights move relative to the object (animated parameters are

@@ -229,6 +229,14 @@ std::vector<char> computedPerFrame(const IrProgram& p, const std::vector<int>& d
     return reached;
 }
 
+// Where a dynamic input enters: its instruction, or for work a dynamic() forced, the
+// dynamic() the author wrote.
+const Inst& sourceOf(const IrProgram& p, const BindingTimes& bt, const std::vector<int>& defining,
+                     int32_t v) {
+    const int32_t by = bt.forcedBy[static_cast<size_t>(v)];
+    return p.insts[static_cast<size_t>(by >= 0 ? by : defining[static_cast<size_t>(v)])];
+}
+
 // The steps from value `at` back to the dynamic input that reached it, each line once.
 std::vector<std::string> causeChain(const IrProgram& p, const BindingTimes& bt,
                                     const std::vector<int>& defining, int32_t at) {
@@ -238,8 +246,9 @@ std::vector<std::string> causeChain(const IrProgram& p, const BindingTimes& bt,
         const Inst& def = p.insts[static_cast<size_t>(defining[static_cast<size_t>(at)])];
         const int32_t cause = bt.cause[static_cast<size_t>(at)];
         if (cause < 0) {
-            chain.push_back(bt.why[static_cast<size_t>(at)] + " (line " + std::to_string(def.line) +
-                            ":" + std::to_string(def.column) + ")");
+            const Inst& where = sourceOf(p, bt, defining, at);
+            chain.push_back(bt.why[static_cast<size_t>(at)] + " (line " +
+                            std::to_string(where.line) + ":" + std::to_string(where.column) + ")");
             break;
         }
         if (def.line != lastLine) {
@@ -254,6 +263,58 @@ std::vector<std::string> causeChain(const IrProgram& p, const BindingTimes& bt,
     return chain;
 }
 
+// Every dynamic input that reaches the values `from`, through dynamic values (not into a
+// bake's argument, which the static phase computes), in the order first met.
+std::vector<DynamicCause> causesOf(const IrProgram& p, const BindingTimes& bt,
+                                   const std::vector<int>& defining,
+                                   const std::vector<int32_t>& from) {
+    std::vector<DynamicCause> causes;
+    auto add = [&](DynamicCause c) {
+        for (const DynamicCause& k : causes)
+            if (k.kind == c.kind && k.name == c.name && k.index == c.index) return;
+        causes.push_back(std::move(c));
+    };
+    std::vector<char> seen(defining.size(), 0);
+    std::vector<int32_t> stack(from.rbegin(), from.rend());
+    while (!stack.empty()) {
+        const int32_t v = stack.back();
+        stack.pop_back();
+        const size_t u = static_cast<size_t>(v);
+        if (v < 0 || seen[u] || bt.stage[u] != Stage::Dynamic) continue;
+        seen[u] = 1;
+        const Inst& inst = p.insts[static_cast<size_t>(defining[u])];
+        DynamicCause c;
+        const Inst& where = sourceOf(p, bt, defining, v);
+        c.line = where.line, c.column = where.column;
+        c.why = bt.why[u];
+        const bool source = bt.cause[u] < 0;
+        if (bt.lightMoves[u]) {
+            c.kind = "light", c.index = inst.imm;
+            c.why = "light " + std::to_string(inst.imm) + " moves relative to the object";
+            add(c);
+        } else if (source && inst.op == Op::Global) {
+            const auto id = static_cast<GlobalId>(inst.imm);
+            c.kind = id == GlobalId::time ? "time" : "view";
+            c.name = globalName(id);
+            add(c);
+        } else if (source && inst.op == Op::Param) {
+            c.kind = "parameter";
+            for (const AnimatedParam& ap : p.animatedParams)
+                if (ap.slot <= inst.imm && inst.imm < ap.slot + ap.components) c.name = ap.name;
+            add(c);
+        } else if (source && inst.op == Op::LightAmbient) {
+            c.kind = "ambient_light", c.index = inst.imm;
+            add(c);
+        } else if (source) {
+            c.kind = "annotation";
+            add(c);
+        }
+        if (inst.op == Op::Bake) continue;
+        for (int a = inst.nargs - 1; a >= 0; --a) stack.push_back(p.argsOf(inst)[a]);
+    }
+    return causes;
+}
+
 // Lines whose bake() freezes a dynamic input (the view, time, an animated parameter or a
 // moving light): the static phase computes them once, at its representative values.
 std::vector<DynamicLine> explainBakedLines(const IrProgram& p, const BindingTimes& bt) {
@@ -263,7 +324,8 @@ std::vector<DynamicLine> explainBakedLines(const IrProgram& p, const BindingTime
         if (inst.op != Op::Bake || inst.nargs < 1 || lines.count(inst.line)) continue;
         const int32_t arg = p.argsOf(inst)[0];
         if (bt.stage[static_cast<size_t>(arg)] != Stage::Dynamic) continue;
-        lines[inst.line] = {inst.line, causeChain(p, bt, defining, arg)};
+        lines[inst.line] = {inst.line, causeChain(p, bt, defining, arg),
+                            causesOf(p, bt, defining, {arg})};
     }
     std::vector<DynamicLine> out;
     for (auto& [l, line] : lines) out.push_back(std::move(line));
@@ -311,6 +373,14 @@ std::vector<DynamicLine> explainDynamicLines(const IrProgram& p, const BindingTi
         line.chain = causeChain(p, bt, defining, static_cast<int32_t>(v));
         lines[inst.line] = line;
     }
+    // Every input of each line: from all the line's dynamic work the frames do.
+    std::map<int, std::vector<int32_t>> work;
+    for (const Inst& inst : p.insts) {
+        const size_t v = static_cast<size_t>(inst.result);
+        if (lines.count(inst.line) && bt.stage[v] == Stage::Dynamic && perFrame[v] && !inBake[v])
+            for (int o = 0; o < inst.nout; ++o) work[inst.line].push_back(inst.result + o);
+    }
+    for (auto& [l, line] : lines) line.causes = causesOf(p, bt, defining, work[l]);
     std::vector<DynamicLine> out;
     for (auto& [l, line] : lines) out.push_back(std::move(line));
     return out;

@@ -32,10 +32,23 @@ struct ChannelInfo {
     Op op = Op::Const;                  // the operation that computes it
 };
 
-// A dynamic source line and why it is dynamic: the chain from a dynamic input to it.
+// One input that makes a line dynamic (or that a bake() freezes).
+struct DynamicCause {
+    // "view" (I or E), "time", "parameter" (name: the parameter), "ambient_light" and
+    // "light" (index: the scene light), "annotation" (a dynamic() in the source).
+    std::string kind;
+    std::string name;
+    int index = -1;
+    std::string why;           // for a reader: "parameter 'k' is animated"
+    int line = 0, column = 0;  // where the input enters the shader
+};
+
+// A dynamic source line and why it is dynamic: the chain from a dynamic input to it, and
+// every input that reaches it.
 struct DynamicLine {
     int line = 0;
     std::vector<std::string> chain;  // from the line's first dynamic operation back to the input
+    std::vector<DynamicCause> causes;
 };
 
 struct FactoredShader {

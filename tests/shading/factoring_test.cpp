@@ -2,6 +2,7 @@
 // n-tuple, and running the dynamic part gives what the unfactored shader gives, while the
 // static part sees different values of every dynamic input than the dynamic part does
 // (so a static part that wrongly read a dynamic input would be caught).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -350,6 +351,46 @@ TEST(Factoring, ExplainsWhyEachLineIsDynamic) {
     ASSERT_EQ(f.channels.size(), 1u);
     EXPECT_EQ(f.channels[0].name, "a");
     EXPECT_EQ(f.channels[0].line, 2);
+}
+
+TEST(Factoring, EveryInputOfALineIsACause) {
+    // Line 2 depends on time and on the animated k: both are its causes, not the first found
+    // alone. Line 3's cause is the dynamic() the author wrote, at its own column, not the fbm
+    // under it. Line 4 adds the view and the moving light, whose specular I had made dynamic
+    // first.
+    auto ast = compileShaderText("m.sl",
+                                 "surface m(float k = 1) {\n"
+                                 "  float a = sin(time * 3) * k;\n"
+                                 "  float b = dynamic(fbm(P * 4, 3));\n"
+                                 "  Ci = color(a + b) + specular(N, -I, 0.3);\n}");
+    ShaderBinding b;
+    b.params["k"].kind = ParamBinding::Kind::Animated;
+    b.lights.resize(1);
+    b.lights[0].kind = LightKind::Point;
+    b.lights[0].movesRelativeToObject = true;
+    const FactoredShader f = factorShader(*ast, b);
+    ASSERT_EQ(f.dynamicLines.size(), 3u);
+    auto kinds = [](const DynamicLine& l) {
+        std::vector<std::string> k;
+        for (const DynamicCause& c : l.causes) k.push_back(c.kind + ":" + c.name);
+        std::sort(k.begin(), k.end());
+        return k;
+    };
+    EXPECT_EQ(kinds(f.dynamicLines[0]), (std::vector<std::string>{"parameter:k", "time:time"}));
+    ASSERT_EQ(f.dynamicLines[1].causes.size(), 1u);
+    EXPECT_EQ(f.dynamicLines[1].causes[0].kind, "annotation");
+    EXPECT_EQ(f.dynamicLines[1].causes[0].line, 3);
+    EXPECT_EQ(f.dynamicLines[1].causes[0].column, 13);
+    EXPECT_NE(f.dynamicLines[1].chain.back().find("(line 3:13)"), std::string::npos)
+        << f.dynamicLines[1].chain.back();
+    EXPECT_EQ(
+        kinds(f.dynamicLines[2]),
+        (std::vector<std::string>{"annotation:", "light:", "parameter:k", "time:time", "view:I"}));
+    for (const DynamicCause& c : f.dynamicLines[2].causes) {
+        if (c.kind == "light") {
+            EXPECT_EQ(c.index, 0);
+        }
+    }
 }
 
 TEST(Factoring, BakedLinesAreReportedAsBakedNotDynamic) {
