@@ -81,6 +81,38 @@ bool sameFile(const std::string& a, const std::string& b) {
     return std::filesystem::equivalent(a, b, ec);
 }
 
+// Every source line with what its work is for this binding.
+void printAnnotatedSource(const ShaderAst& ast, const FactoredShader& f) {
+    std::printf(
+        "\nthe source for this binding (R: repeated every frame, S: static -- stored, or "
+        "repeated where cheaper, B: baked, its dynamic input frozen, f: free on the "
+        "frames' geometry):\n");
+    std::istringstream in(ast.source);
+    std::string text;
+    size_t next = 0;
+    for (int line = 1; std::getline(in, text); ++line) {
+        std::string mark;
+        if (next < f.lineStages.size() && f.lineStages[next].line == line) {
+            const SourceLineStages& l = f.lineStages[next++];
+            mark = std::string(l.repeated ? "R" : "") + (l.stored ? "S" : "") +
+                   (l.baked ? "B" : "") + (l.free ? "f" : "");
+        }
+        std::printf("  %-4s %3d | %s\n", mark.c_str(), line, text.c_str());
+    }
+}
+
+nlohmann::json sourceLinesJson(const ShaderAst& ast, const FactoredShader& f) {
+    nlohmann::json lines = nlohmann::json::array();
+    for (const SourceLineStages& l : f.lineStages)
+        lines.push_back({{"line", l.line},
+                         {"source", sourceLine(ast.source, l.line)},
+                         {"repeated", l.repeated},
+                         {"static", l.stored},
+                         {"baked", l.baked},
+                         {"free", l.free}});
+    return lines;
+}
+
 // --json: the factoring as one document.
 nlohmann::json factoringJson(const std::string& shaderFile, const ShaderAst& ast,
                              const std::string& bindingText, const FactoredShader& f,
@@ -132,7 +164,8 @@ nlohmann::json factoringJson(const std::string& shaderFile, const ShaderAst& ast
                             {"static_repeated", f.recomputedStaticCost}}},
                           {"dynamic_to_static_instructions", ratio},
                           {"dynamic_lines", linesJson(f.dynamicLines)},
-                          {"baked_lines", linesJson(f.bakedLines)}};
+                          {"baked_lines", linesJson(f.bakedLines)},
+                          {"source_lines", sourceLinesJson(ast, f)}};
     return doc;
 }
 
@@ -198,6 +231,7 @@ void printFactoring(const FactorCommandOptions& options, const std::string& shad
             "light of each static run; the object's range bounds the view's):\n");
         printLines(f.bakedLines);
     }
+    printAnnotatedSource(ast, f);
     if (options.dump) {
         std::printf("\nstatic part:\n%s\ndynamic part:\n%s", f.staticPart.dump().c_str(),
                     f.dynamicPart.dump().c_str());

@@ -355,6 +355,39 @@ std::vector<char> writtenInBake(const IrProgram& p, const std::vector<int>& defi
     return inBake;
 }
 
+std::vector<SourceLineStages> stagesByLine(const IrProgram& p, const BindingTimes& bt) {
+    const std::vector<int> defining = definingInstructions(p);
+    const std::vector<char> perFrame = computedPerFrame(p, defining);
+    const std::vector<char> inBake = writtenInBake(p, defining);
+    std::map<int, SourceLineStages> lines;
+    for (const Inst& inst : p.insts) {
+        // Reading an input (a global, a parameter) is no work of the line's.
+        if (inst.line <= 0 || inst.op == Op::Const || inst.op == Op::Global ||
+            inst.op == Op::Param || inst.op == Op::LightAmbient)
+            continue;
+        const size_t v = static_cast<size_t>(inst.result);
+        SourceLineStages& l = lines[inst.line];
+        l.line = inst.line;
+        switch (bt.stage[v]) {
+            case Stage::Dynamic:
+                if (perFrame[v] && !inBake[v])
+                    l.repeated = true;
+                else
+                    l.baked = true;
+                break;
+            case Stage::Static:
+                l.stored = true;
+                break;
+            case Stage::Free:
+                l.free = true;
+                break;
+        }
+    }
+    std::vector<SourceLineStages> out;
+    for (auto& [n, l] : lines) out.push_back(l);
+    return out;
+}
+
 std::vector<DynamicLine> explainDynamicLines(const IrProgram& p, const BindingTimes& bt) {
     const std::vector<int> defining = definingInstructions(p);
     const std::vector<char> perFrame = computedPerFrame(p, defining);
@@ -430,6 +463,7 @@ FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
     f.dynamicCost = programCost(f.dynamicPart);
     f.dynamicLines = explainDynamicLines(f.analyzed, f.times);
     f.bakedLines = explainBakedLines(f.analyzed, f.times);
+    f.lineStages = stagesByLine(f.analyzed, f.times);
     return f;
 }
 

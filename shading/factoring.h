@@ -51,6 +51,15 @@ struct DynamicLine {
     std::vector<DynamicCause> causes;
 };
 
+// What a source line's work is for this binding (a line may do several kinds).
+struct SourceLineStages {
+    int line = 0;
+    bool repeated = false;  // dynamic: run every frame
+    bool stored = false;    // static: the static phase's (stored, or repeated if cheaper)
+    bool baked = false;     // static under a bake() that freezes a dynamic input
+    bool free = false;      // cheap arithmetic on geometry the frames have anyway
+};
+
 struct FactoredShader {
     IrProgram analyzed;     // the lowered, reassociated program the cut was made in
     BindingTimes times;     // of `analyzed`
@@ -69,6 +78,7 @@ struct FactoredShader {
     // Lines whose bake() freezes a dynamic input (its chain ends at the input): computed once
     // by the static phase at its representative time, view, parameters and lights.
     std::vector<DynamicLine> bakedLines;
+    std::vector<SourceLineStages> lineStages;  // per source line with work, in order
 };
 
 FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,

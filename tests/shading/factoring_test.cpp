@@ -413,6 +413,17 @@ TEST(Factoring, BakedLinesAreReportedAsBakedNotDynamic) {
     EXPECT_EQ(f.bakedLines[1].line, 3);
     ASSERT_FALSE(f.bakedLines[1].chain.empty());
     EXPECT_NE(f.bakedLines[1].chain.back().find("time changes every frame"), std::string::npos);
+    // The annotated source: line 2 baked, 3 baked, 4 repeated every frame (and static:
+    // the stored colour it adds to).
+    ASSERT_EQ(f.lineStages.size(), 3u);
+    EXPECT_EQ(f.lineStages[0].line, 2);
+    EXPECT_TRUE(f.lineStages[0].baked);
+    EXPECT_FALSE(f.lineStages[0].repeated);
+    EXPECT_TRUE(f.lineStages[1].baked);
+    EXPECT_FALSE(f.lineStages[1].repeated);
+    EXPECT_EQ(f.lineStages[2].line, 4);
+    EXPECT_TRUE(f.lineStages[2].repeated);
+    EXPECT_FALSE(f.lineStages[2].baked);
     // Work on another line that only a bake() reads runs in the static phase too.
     auto split = compileShaderText("ph.sl",
                                    "surface p(float rate = 2) {\n"
