@@ -2,11 +2,13 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "geometry/error.h"
+#include "phases/split_verification.h"
 #include "scene/scene.h"
 #include "scene/variability.h"
 #include "shading/factoring.h"
@@ -242,6 +244,53 @@ void printFactoring(const FactorCommandOptions& options, const std::string& shad
 
 namespace {
 
+// --verify: the factored shader against the whole one, output by output.
+void printVerification(const SplitVerification& v, double tolerance) {
+    std::printf(
+        "\nverified: %d points over the charts x %d frames, static part run at the "
+        "first, against the whole shader\n",
+        v.points, v.frames);
+    std::printf("  %-12s %12s %12s %12s   %s\n", "", "max abs", "max relative", "rms",
+                "worst at (frame, chart, u, v)");
+    auto row = [](const SplitDifference& d) {
+        std::printf("  %-12s %12.3g %12.3g %12.3g   %d, %d, %.4f, %.4f\n", d.name.c_str(), d.maxAbs,
+                    d.maxRelative, d.rms, d.worst.frame, d.worst.chart, d.worst.u, d.worst.v);
+    };
+    for (const SplitDifference& d : v.outputs) row(d);
+    if (!v.channels.empty()) {
+        std::printf(
+            "  stored channels, against the static part run at each frame (0 unless a "
+            "bake() froze an input):\n");
+        for (const SplitDifference& d : v.channels) row(d);
+    }
+    std::printf("  %s --tolerance %g (largest relative difference %.3g)\n",
+                v.maxRelative() <= tolerance ? "within" : "OVER", tolerance, v.maxRelative());
+}
+
+nlohmann::json verificationJson(const SplitVerification& v, double tolerance) {
+    auto rows = [](const std::vector<SplitDifference>& from) {
+        nlohmann::json out = nlohmann::json::array();
+        for (const SplitDifference& d : from)
+            out.push_back({{"name", d.name},
+                           {"max_abs", d.maxAbs},
+                           {"max_relative", d.maxRelative},
+                           {"rms", d.rms},
+                           {"worst",
+                            {{"frame", d.worst.frame},
+                             {"chart", d.worst.chart},
+                             {"u", d.worst.u},
+                             {"v", d.worst.v}}}});
+        return out;
+    };
+    return {{"points", v.points},
+            {"frames", v.frames},
+            {"outputs", rows(v.outputs)},
+            {"channels", rows(v.channels)},
+            {"max_relative", v.maxRelative()},
+            {"tolerance", tolerance},
+            {"within", v.maxRelative() <= tolerance}};
+}
+
 // One factoring, printed or added to `json`.
 void factorOne(const FactorCommandOptions& options, const std::string& shaderFile,
                const ShaderAst& ast, const ShaderBinding& binding, const std::string& bindingText,
@@ -264,6 +313,9 @@ int runFactorCommand(const FactorCommandOptions& options) {
     if (options.scene.empty()) {
         if (!options.object.empty())
             throw InputError({"--object", 0, 0, {}}, "--object needs --scene");
+        if (options.verify)
+            throw InputError({"--verify", 0, 0, {}},
+                             "--verify needs --scene (its objects' charts and frames)");
         if (options.shader.empty())
             throw InputError({"factor", 0, 0, {}},
                              "give a shader file, --scene SCENE (every object) or --scene SCENE "
@@ -276,50 +328,70 @@ int runFactorCommand(const FactorCommandOptions& options) {
         if (options.json) std::printf("%s\n", doc.dump(2).c_str());
         return 0;
     }
-    const Scene scene = loadScene(options.scene);
+    Scene scene = loadScene(options.scene);
+    std::vector<size_t> objects;
     if (!options.object.empty()) {
         const SceneObject& object = findObject(scene, options);
-        // Without a shader file, the object's own; with one that is not the object's, that
-        // file on the object's binding (a what-if), said so.
-        std::shared_ptr<const ShaderAst> ast = object.shader;
-        std::string file = object.shader->file;
+        objects.push_back(static_cast<size_t>(&object - scene.objects.data()));
+        // A shader file that is not the object's is factored (and verified) on its binding
+        // instead: a what-if, said so.
         if (!options.shader.empty()) {
-            ast = loadShaderFile(options.shader);
-            file = options.shader;
+            auto ast = loadShaderFile(options.shader);
+            objectBinding(scene, object, *ast, options.shader);
+            if (!sameFile(options.shader, object.shader->file))
+                std::fprintf(stderr,
+                             "mpshade: note: object '%s' uses %s; factoring %s on its binding "
+                             "instead\n",
+                             object.name.c_str(), object.shader->file.c_str(),
+                             options.shader.c_str());
+            scene.objects[objects[0]].shader = ast;
         }
-        const ShaderBinding binding = objectBinding(scene, object, *ast, file);
-        if (!options.shader.empty() && !sameFile(options.shader, object.shader->file))
-            std::fprintf(stderr,
-                         "mpshade: note: object '%s' uses %s; factoring %s on its binding "
-                         "instead\n",
-                         object.name.c_str(), object.shader->file.c_str(), options.shader.c_str());
-        nlohmann::json doc;
-        factorOne(options, file, *ast, binding, "object '" + object.name + "' in " + options.scene,
-                  options.json ? &doc : nullptr);
-        if (options.json) std::printf("%s\n", doc.dump(2).c_str());
-        return 0;
-    }
-    if (!options.shader.empty())
+    } else if (!options.shader.empty()) {
         throw InputError({"--scene", 0, 0, {}},
                          "--scene with a shader file needs --object NAME (without a shader "
                          "file: every object, each with its own shader)");
-    // Every object of the scene, each with its own shader and binding.
+    } else {
+        for (size_t i = 0; i < scene.objects.size(); ++i) objects.push_back(i);
+    }
+    // The shading the renderers would use, for --verify.
+    std::unique_ptr<SceneResources> resources;
+    std::unique_ptr<StaticPhase> statics;
+    if (options.verify) {
+        resources =
+            std::make_unique<SceneResources>(scene, SceneResources::RayScenes::ForOcclusion);
+        StaticPhaseOptions so;
+        so.factor.storeAboveCost = options.storeAboveCost;
+        statics = std::make_unique<StaticPhase>(scene, *resources, so);
+    }
+    bool within = true;
     nlohmann::json all = nlohmann::json::array();
-    for (size_t i = 0; i < scene.objects.size(); ++i) {
-        const SceneObject& object = scene.objects[i];
-        if (i > 0 && !options.json) std::printf("\n----\n\n");
+    for (size_t k = 0; k < objects.size(); ++k) {
+        const SceneObject& object = scene.objects[objects[k]];
+        const std::string file = options.shader.empty() ? object.shader->file : options.shader;
+        if (k > 0 && !options.json) std::printf("\n----\n\n");
         nlohmann::json doc;
-        factorOne(options, object.shader->file, *object.shader,
-                  objectBinding(scene, object, *object.shader, object.shader->file),
+        factorOne(options, file, *object.shader, objectBinding(scene, object, *object.shader, file),
                   "object '" + object.name + "' in " + options.scene,
                   options.json ? &doc : nullptr);
+        if (statics) {
+            const SplitVerification v = verifySplit(*statics, *resources, objects[k]);
+            within = within && v.maxRelative() <= options.tolerance;
+            if (options.json)
+                doc["verify"] = verificationJson(v, options.tolerance);
+            else
+                printVerification(v, options.tolerance);
+        }
         if (options.json) {
-            doc["object"] = object.name;
+            if (options.object.empty()) doc["object"] = object.name;
             all.push_back(std::move(doc));
         }
     }
-    if (options.json) std::printf("%s\n", nlohmann::json{{"objects", all}}.dump(2).c_str());
-    return 0;
+    if (options.json) {
+        const nlohmann::json out =
+            options.object.empty() ? nlohmann::json{{"objects", all}} : all[0];
+        std::printf("%s\n", out.dump(2).c_str());
+    }
+    return within ? 0 : 1;
 }
 
 }  // namespace mpshade

@@ -21,9 +21,13 @@ struct FactorCommandOptions {
     // FactorOptions::storeAboveCost: stored values whose static work costs at most this
     // (opCost units a point) are repeated by the dynamic part instead; 0: store them all.
     int storeAboveCost = FactorOptions{}.storeAboveCost;
+    // With --scene: evaluate the split against the whole shader (split_verification.h);
+    // the command exits 1 when the largest relative difference is over `tolerance`.
+    bool verify = false;
+    double tolerance = 1e-5;
 };
 
-// Returns the exit code: 0 success.
+// Returns the exit code: 0 success; 1 when --verify found a difference over --tolerance.
 // Bad input throws InputError naming its place (the CLI prints it and exits 2); a file
 // that cannot be written throws OutputError (exit 1).
 int runFactorCommand(const FactorCommandOptions& options);

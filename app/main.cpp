@@ -69,6 +69,11 @@ int main(int argc, char** argv) {
     factorCmd->add_option("--object", factor.object, "Object in the scene");
     factorCmd->add_flag("--json", factor.json, "Machine-readable output");
     factorCmd->add_flag("--dump", factor.dump, "Also print the IR of both parts");
+    factorCmd->add_flag("--verify", factor.verify,
+                        "With --scene: the split against the whole shader over the object's "
+                        "charts and the scene's frames (exit 1 over --tolerance)");
+    factorCmd->add_option("--tolerance", factor.tolerance,
+                          "--verify: the largest relative difference allowed (default 1e-5)");
     factorCmd
         ->add_option("--store-above-cost", factor.storeAboveCost,
                      "Store a static value only if its work costs more than this per point "

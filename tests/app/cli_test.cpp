@@ -435,6 +435,30 @@ TEST(Cli, FactorEveryObjectOrOneWithItsOwnShader) {
         << whatIf.output;
 }
 
+TEST(Cli, FactorVerifyExitsOneOverItsTolerance) {
+    // The vase's splits are exact: exit 0, the verification in the JSON. The what-if of a
+    // shader whose bake() freezes time, on the vase's binding, is over 1e-5: exit 1; and
+    // within a tolerance above its error, 0.
+    const CliRun exact = mpshade("factor --scene examples/vase/scene.json --verify --json");
+    ASSERT_EQ(exact.exitCode, 0) << exact.output;
+    const nlohmann::json doc = nlohmann::json::parse(exact.output);
+    for (const nlohmann::json& o : doc["objects"]) {
+        EXPECT_TRUE(o["verify"]["within"].get<bool>());
+        EXPECT_LE(o["verify"]["max_relative"].get<double>(), 1e-5);
+        EXPECT_GT(o["verify"]["points"].get<int>(), 100);
+    }
+    const std::string dir = tempDir("verify");
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "/pulse.sl") << "surface pulse(float scale = 1) { Ci = color(bake(0.5 + "
+                                        "0.5 * sin(6 * time))) * scale; }";
+    const std::string what =
+        "factor " + dir + "/pulse.sl --scene examples/vase/scene.json --object vase --verify";
+    const CliRun over = mpshade(what);
+    EXPECT_EQ(over.exitCode, 1) << over.output;
+    EXPECT_NE(over.output.find("OVER --tolerance 1e-05"), std::string::npos) << over.output;
+    EXPECT_EQ(mpshade(what + " --tolerance 1").exitCode, 0);
+}
+
 TEST(Cli, FactorBadInput) {
     const BadRun cases[] = {
         {"factor examples/shaders/marble.sl --scene examples/vase/scene.json --object urn",
@@ -451,6 +475,8 @@ TEST(Cli, FactorBadInput) {
         {"factor nowhere.sl", "mpshade: nowhere.sl: error: cannot open shader file\n"},
         {"factor examples/shaders",
          "mpshade: examples/shaders: error: is a folder, not a shader file\n"},
+        {"factor examples/shaders/marble.sl --verify",
+         "mpshade: --verify: error: --verify needs --scene (its objects' charts and frames)\n"},
         {"factor",
          "mpshade: factor: error: give a shader file, --scene SCENE (every object) or --scene "
          "SCENE --object NAME\n"},
