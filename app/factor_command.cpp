@@ -292,9 +292,9 @@ nlohmann::json verificationJson(const SplitVerification& v, double tolerance) {
 }
 
 // One factoring, printed or added to `json`.
-void factorOne(const FactorCommandOptions& options, const std::string& shaderFile,
-               const ShaderAst& ast, const ShaderBinding& binding, const std::string& bindingText,
-               nlohmann::json* json) {
+FactoredShader factorOne(const FactorCommandOptions& options, const std::string& shaderFile,
+                         const ShaderAst& ast, const ShaderBinding& binding,
+                         const std::string& bindingText, nlohmann::json* json) {
     FactorOptions factorOptions;
     factorOptions.storeAboveCost = options.storeAboveCost;
     const FactoredShader f = factorShader(ast, binding, factorOptions);
@@ -305,6 +305,68 @@ void factorOne(const FactorCommandOptions& options, const std::string& shaderFil
     else
         printFactoring(options, shaderFile, ast, bindingText, f, ratio,
                        factorOptions.storeAboveCost);
+    return f;
+}
+
+// The scene's objects grouped by splits alike -- the same shader cut the same way (stored
+// channels, instructions and costs of each part), whatever constants their parameters
+// folded in: twelve pebbles of one shader in twelve colours are one row.
+struct SplitGroup {
+    std::string key, shader;
+    std::vector<std::string> objects;
+    int channels = 0, bytesPerTexel = 0, staticCost = 0, dynamicCost = 0;
+};
+
+void addToGroups(std::vector<SplitGroup>& groups, const SceneObject& object,
+                 const FactoredShader& f) {
+    const std::string key = object.shader->file + " " + std::to_string(f.chosenWidth) + " " +
+                            std::to_string(f.staticInstructions) + " " +
+                            std::to_string(f.dynamicInstructions) + " " +
+                            std::to_string(f.staticCost) + " " + std::to_string(f.dynamicCost) +
+                            " " + std::to_string(object.shadermapHalf);
+    for (SplitGroup& g : groups)
+        if (g.key == key) {
+            g.objects.push_back(object.name);
+            return;
+        }
+    SplitGroup g;
+    g.key = key;
+    g.shader = object.shader->name;
+    g.objects = {object.name};
+    g.channels = f.chosenWidth;
+    g.bytesPerTexel = f.chosenWidth * (object.shadermapHalf ? 2 : 4);
+    g.staticCost = f.staticCost;
+    g.dynamicCost = f.dynamicCost;
+    groups.push_back(std::move(g));
+}
+
+void printGroups(const std::vector<SplitGroup>& groups, size_t objects) {
+    std::printf("\n====\n\nthe scene: %zu objects, %zu kinds of split\n", objects, groups.size());
+    std::printf("  %-32s %-16s %8s %10s %12s %13s\n", "objects", "shader", "floats", "bytes/texel",
+                "static cost", "dynamic cost");
+    long staticTotal = 0, dynamicTotal = 0;
+    for (const SplitGroup& g : groups) {
+        std::string names = g.objects.front();
+        if (g.objects.size() > 1) names += " and " + std::to_string(g.objects.size() - 1) + " more";
+        std::printf("  %-32s %-16s %8d %10d %12d %13d\n", names.c_str(), g.shader.c_str(),
+                    g.channels, g.bytesPerTexel, g.staticCost, g.dynamicCost);
+        staticTotal += static_cast<long>(g.staticCost) * static_cast<long>(g.objects.size());
+        dynamicTotal += static_cast<long>(g.dynamicCost) * static_cast<long>(g.objects.size());
+    }
+    std::printf("  summed over the objects, cost units a point: static %ld, dynamic %ld\n",
+                staticTotal, dynamicTotal);
+}
+
+nlohmann::json groupsJson(const std::vector<SplitGroup>& groups) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const SplitGroup& g : groups)
+        out.push_back({{"objects", g.objects},
+                       {"shader", g.shader},
+                       {"channels", g.channels},
+                       {"bytes_per_texel", g.bytesPerTexel},
+                       {"static_cost", g.staticCost},
+                       {"dynamic_cost", g.dynamicCost}});
+    return out;
 }
 
 }  // namespace
@@ -365,14 +427,16 @@ int runFactorCommand(const FactorCommandOptions& options) {
     }
     bool within = true;
     nlohmann::json all = nlohmann::json::array();
+    std::vector<SplitGroup> groups;
     for (size_t k = 0; k < objects.size(); ++k) {
         const SceneObject& object = scene.objects[objects[k]];
         const std::string file = options.shader.empty() ? object.shader->file : options.shader;
         if (k > 0 && !options.json) std::printf("\n----\n\n");
         nlohmann::json doc;
-        factorOne(options, file, *object.shader, objectBinding(scene, object, *object.shader, file),
-                  "object '" + object.name + "' in " + options.scene,
-                  options.json ? &doc : nullptr);
+        const FactoredShader f = factorOne(
+            options, file, *object.shader, objectBinding(scene, object, *object.shader, file),
+            "object '" + object.name + "' in " + options.scene, options.json ? &doc : nullptr);
+        addToGroups(groups, object, f);
         if (statics) {
             const SplitVerification v = verifySplit(*statics, *resources, objects[k]);
             within = within && v.maxRelative() <= options.tolerance;
@@ -388,8 +452,12 @@ int runFactorCommand(const FactorCommandOptions& options) {
     }
     if (options.json) {
         const nlohmann::json out =
-            options.object.empty() ? nlohmann::json{{"objects", all}} : all[0];
+            options.object.empty()
+                ? nlohmann::json{{"objects", all}, {"splits", groupsJson(groups)}}
+                : all[0];
         std::printf("%s\n", out.dump(2).c_str());
+    } else if (options.object.empty()) {
+        printGroups(groups, objects.size());
     }
     return within ? 0 : 1;
 }

@@ -435,6 +435,30 @@ TEST(Cli, FactorEveryObjectOrOneWithItsOwnShader) {
         << whatIf.output;
 }
 
+TEST(Cli, FactorTheWholeSceneGroupsSplitsAlike) {
+    // The courtyard's 51 objects: each in exactly one group; its eleven marble objects (ten
+    // columns and the plinth, one shader in different colours) in one.
+    const CliRun run = mpshade("factor --scene examples/courtyard/scene.json --json");
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const nlohmann::json doc = nlohmann::json::parse(run.output);
+    std::map<std::string, int> seen;
+    for (const nlohmann::json& g : doc["splits"])
+        for (const nlohmann::json& o : g["objects"]) ++seen[o.get<std::string>()];
+    EXPECT_EQ(seen.size(), doc["objects"].size());
+    for (const auto& [name, count] : seen) EXPECT_EQ(count, 1) << name;
+    int marbleGroups = 0;
+    for (const nlohmann::json& g : doc["splits"])
+        if (g["shader"] == "marble") {
+            ++marbleGroups;
+            EXPECT_EQ(g["objects"].size(), 11u);
+            EXPECT_EQ(g["bytes_per_texel"], 4 * g["channels"].get<int>());
+        }
+    EXPECT_EQ(marbleGroups, 1);
+    EXPECT_NE(mpshade("factor --scene examples/courtyard/scene.json")
+                  .output.find("the scene: 51 objects"),
+              std::string::npos);
+}
+
 TEST(Cli, FactorVerifyExitsOneOverItsTolerance) {
     // The vase's splits are exact: exit 0, the verification in the JSON. The what-if of a
     // shader whose bake() freezes time, on the vase's binding, is over 1e-5: exit 1; and
