@@ -167,7 +167,8 @@ nlohmann::json factoringJson(const std::string& shaderFile, const ShaderAst& ast
                           {"dynamic_to_static_instructions", ratio},
                           {"dynamic_lines", linesJson(f.dynamicLines)},
                           {"baked_lines", linesJson(f.bakedLines)},
-                          {"source_lines", sourceLinesJson(ast, f)}};
+                          {"source_lines", sourceLinesJson(ast, f)},
+                          {"warnings", f.warnings}};
     return doc;
 }
 
@@ -232,6 +233,11 @@ void printFactoring(const FactorCommandOptions& options, const std::string& shad
             "reaches them frozen at its representative value (the time, view, parameter or "
             "light of each static run; the object's range bounds the view's):\n");
         printLines(f.bakedLines);
+    }
+    if (!f.warnings.empty()) {
+        std::printf("\nwarnings:\n");
+        for (const std::string& w : f.warnings)
+            std::printf("  %s:%s\n", shaderFile.c_str(), w.c_str());
     }
     printAnnotatedSource(ast, f);
     if (options.dump) {

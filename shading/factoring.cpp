@@ -355,6 +355,56 @@ std::vector<char> writtenInBake(const IrProgram& p, const std::vector<int>& defi
     return inBake;
 }
 
+// Whether an expression is made of literals alone (so constant for every binding).
+bool literalOnly(const Expr& e) {
+    if (e.kind == Expr::Kind::Name) return false;
+    for (const auto& a : e.args)
+        if (!literalOnly(*a)) return false;
+    return true;
+}
+
+void lintExpr(const Expr& e, std::vector<std::string>& out) {
+    if (e.kind == Expr::Kind::Call && e.name == "dynamic" && !e.args.empty() &&
+        literalOnly(*e.args[0]))
+        out.push_back(std::to_string(e.line) + ":" + std::to_string(e.column) +
+                      ": dynamic() of a constant does nothing: a constant is never repeated");
+    for (const auto& a : e.args) lintExpr(*a, out);
+}
+
+void lintStmt(const Stmt& s, std::vector<std::string>& out) {
+    for (const Expr* e : {s.value.get(), s.target.get()})
+        if (e) lintExpr(*e, out);
+    for (const Stmt* t : {s.init.get(), s.step.get()})
+        if (t) lintStmt(*t, out);
+    for (const auto& t : s.body) lintStmt(*t, out);
+    for (const auto& t : s.elseBody) lintStmt(*t, out);
+}
+
+// Annotations that do nothing: a dynamic() of literals (the lowering folds it away), and a
+// bake() whose value is already static or free for this binding.
+std::vector<std::string> lintAnnotations(const ShaderAst& ast, const IrProgram& p,
+                                         const BindingTimes& bt) {
+    std::vector<std::string> out;
+    if (ast.body) lintStmt(*ast.body, out);
+    std::set<std::pair<int, int>> said;
+    for (const Inst& inst : p.insts) {
+        if (inst.op != Op::Bake || inst.nargs < 1) continue;
+        if (bt.stage[static_cast<size_t>(p.argsOf(inst)[0])] == Stage::Dynamic) continue;
+        if (!said.insert({inst.line, inst.column}).second) continue;
+        out.push_back(std::to_string(inst.line) + ":" + std::to_string(inst.column) +
+                      ": bake() of a value already static for this binding changes nothing "
+                      "here (no view, time, animated parameter or moving light reaches it)");
+    }
+    // In source order.
+    auto at = [](const std::string& w) {
+        const size_t colon = w.find(':');
+        return std::make_pair(std::stoi(w.substr(0, colon)), std::stoi(w.substr(colon + 1)));
+    };
+    std::stable_sort(out.begin(), out.end(),
+                     [&](const std::string& a, const std::string& b) { return at(a) < at(b); });
+    return out;
+}
+
 std::vector<SourceLineStages> stagesByLine(const IrProgram& p, const BindingTimes& bt) {
     const std::vector<int> defining = definingInstructions(p);
     const std::vector<char> perFrame = computedPerFrame(p, defining);
@@ -464,6 +514,7 @@ FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
     f.dynamicLines = explainDynamicLines(f.analyzed, f.times);
     f.bakedLines = explainBakedLines(f.analyzed, f.times);
     f.lineStages = stagesByLine(f.analyzed, f.times);
+    f.warnings = lintAnnotations(ast, f.analyzed, f.times);
     return f;
 }
 

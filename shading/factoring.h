@@ -79,6 +79,9 @@ struct FactoredShader {
     // by the static phase at its representative time, view, parameters and lights.
     std::vector<DynamicLine> bakedLines;
     std::vector<SourceLineStages> lineStages;  // per source line with work, in order
+    // Annotations that do nothing for this binding, each "line:col: what" (a bake() of a
+    // value already static, a dynamic() of a constant).
+    std::vector<std::string> warnings;
 };
 
 FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,

@@ -353,6 +353,23 @@ TEST(Factoring, ExplainsWhyEachLineIsDynamic) {
     EXPECT_EQ(f.channels[0].line, 2);
 }
 
+TEST(Factoring, AnnotationsThatDoNothingAreWarnedOf) {
+    // A bake() of noise(P) (static already) and a dynamic() of literals do nothing; the
+    // bake() of time-dependent work does something and is not warned of.
+    auto ast = compileShaderText("w.sl",
+                                 "surface w() {\n"
+                                 "  float a = bake(noise(P));\n"
+                                 "  float b = dynamic(0.5 * 2);\n"
+                                 "  float c = bake(sin(time));\n"
+                                 "  Ci = color(a + b + c) * time;\n}");
+    const FactoredShader f = factorShader(*ast, {});
+    ASSERT_EQ(f.warnings.size(), 2u);
+    EXPECT_EQ(f.warnings[0].rfind("2:13: bake() of a value already static", 0), 0u)
+        << f.warnings[0];
+    EXPECT_EQ(f.warnings[1].rfind("3:13: dynamic() of a constant does nothing", 0), 0u)
+        << f.warnings[1];
+}
+
 TEST(Factoring, EveryInputOfALineIsACause) {
     // Line 2 depends on time and on the animated k: both are its causes, not the first found
     // alone. Line 3's cause is the dynamic() the author wrote, at its own column, not the fbm
