@@ -95,10 +95,14 @@ SplitVerification verifySplit(const StaticPhase& statics, const SceneResources& 
     std::vector<Tally> outputs(6), drift(channels);
     const char* names[6] = {"Ci[0]", "Ci[1]", "Ci[2]", "Oi[0]", "Oi[1]", "Oi[2]"};
     for (int k = 0; k < 6; ++k) outputs[static_cast<size_t>(k)].d.name = names[k];
-    for (size_t c = 0; c < channels; ++c)
-        drift[c].d.name = c < obj.factored.channels.size() && !obj.factored.channels[c].name.empty()
-                              ? obj.factored.channels[c].name
-                              : "channel " + std::to_string(c);
+    for (size_t c = 0; c < channels && c < obj.factored.channels.size(); ++c) {
+        // The variable it holds, else the operation and where the source computes it.
+        const ChannelInfo& info = obj.factored.channels[c];
+        drift[c].d.name = !info.name.empty() ? info.name
+                                             : "(" + std::string(opName(info.op)) + ") " +
+                                                   std::to_string(info.line) + ":" +
+                                                   std::to_string(info.column);
+    }
     for (const int f : frames) {
         const FrameState state = frameStateAt(resources, f, width, height, 1);
         const ShadingUniforms& uniforms = state.uniforms[object];
