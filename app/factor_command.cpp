@@ -149,26 +149,28 @@ nlohmann::json factoringJson(const std::string& shaderFile, const ShaderAst& ast
         }
         return lines;
     };
-    nlohmann::json doc = {{"shader", ast.name},
-                          {"file", shaderFile},
-                          {"binding", bindingText},
-                          {"naive_width", f.naiveWidth},
-                          {"chosen_width", f.chosenWidth},
-                          {"channels", channels},
-                          {"instructions",
-                           {{"unfactored", f.originalInstructions},
-                            {"static", f.staticInstructions},
-                            {"dynamic", f.dynamicInstructions}}},
-                          {"cost",
-                           {{"unfactored", f.originalCost},
-                            {"static", f.staticCost},
-                            {"dynamic", f.dynamicCost},
-                            {"static_repeated", f.recomputedStaticCost}}},
-                          {"dynamic_to_static_instructions", ratio},
-                          {"dynamic_lines", linesJson(f.dynamicLines)},
-                          {"baked_lines", linesJson(f.bakedLines)},
-                          {"source_lines", sourceLinesJson(ast, f)},
-                          {"warnings", f.warnings}};
+    nlohmann::json doc = {
+        {"shader", ast.name},
+        {"file", shaderFile},
+        {"binding", bindingText},
+        {"naive_width", f.naiveWidth},
+        {"chosen_width", f.chosenWidth},
+        {"bytes_per_texel", {{"float", 4 * f.chosenWidth}, {"half", 2 * f.chosenWidth}}},
+        {"channels", channels},
+        {"instructions",
+         {{"unfactored", f.originalInstructions},
+          {"static", f.staticInstructions},
+          {"dynamic", f.dynamicInstructions}}},
+        {"cost",
+         {{"unfactored", f.originalCost},
+          {"static", f.staticCost},
+          {"dynamic", f.dynamicCost},
+          {"static_repeated", f.recomputedStaticCost}}},
+        {"dynamic_to_static_instructions", ratio},
+        {"dynamic_lines", linesJson(f.dynamicLines)},
+        {"baked_lines", linesJson(f.bakedLines)},
+        {"source_lines", sourceLinesJson(ast, f)},
+        {"warnings", f.warnings}};
     return doc;
 }
 
@@ -181,6 +183,12 @@ void printFactoring(const FactorCommandOptions& options, const std::string& shad
                 bindingText.c_str());
     std::printf("n-tuple: %d float%s (storing every static value a dynamic operation reads: %d)\n",
                 f.chosenWidth, f.chosenWidth == 1 ? "" : "s", f.naiveWidth);
+    if (f.chosenWidth > 0)
+        std::printf(
+            "  in a shader map: %d bytes a texel as float32, %d as binary16 "
+            "(\"shadermap_precision\": \"half\"), plus a 1-texel border around each "
+            "16x16 tile\n",
+            4 * f.chosenWidth, 2 * f.chosenWidth);
     if (f.recomputedStaticCost > 0)
         std::printf(
             "  %s: %d cost units of static work a point, cheaper to repeat than "

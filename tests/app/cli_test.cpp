@@ -374,6 +374,8 @@ TEST(Cli, FactorShowsASmallTupleAndACheapDynamicPart) {
     ASSERT_EQ(json.exitCode, 0) << json.output;
     const nlohmann::json doc = nlohmann::json::parse(json.output);
     EXPECT_EQ(doc["chosen_width"], 3);
+    EXPECT_EQ(doc["bytes_per_texel"]["float"], 12);
+    EXPECT_EQ(doc["bytes_per_texel"]["half"], 6);
     EXPECT_EQ(doc["channels"].size(), 3u);
     EXPECT_EQ(doc["channels"][0]["type"], "color");
     const int staticCost = doc["cost"]["static"], dynamicCost = doc["cost"]["dynamic"];
