@@ -305,13 +305,32 @@ nlohmann::json verificationJson(const SplitVerification& v, double tolerance) {
             {"within", v.maxRelative() <= tolerance}};
 }
 
+// The binding with the command's --store and --repeat what-ifs added.
+ShaderBinding withWhatIfs(const ShaderBinding& binding, const FactorCommandOptions& options) {
+    ShaderBinding b = binding;
+    auto add = [&](const std::vector<std::string>& from, FactoringOverride::Kind kind,
+                   const char* flag) {
+        for (const std::string& text : from) {
+            FactoringOverride o;
+            if (!parseFactoringOverride(text, kind, o))
+                throw InputError({flag, 0, 0, {}},
+                                 "expected line:column or a variable's name, found '" + text + "'");
+            b.overrides.push_back(o);
+        }
+    };
+    add(options.store, FactoringOverride::Kind::Store, "--store");
+    add(options.repeat, FactoringOverride::Kind::Repeat, "--repeat");
+    return b;
+}
+
 // One factoring, printed or added to `json`.
 FactoredShader factorOne(const FactorCommandOptions& options, const std::string& shaderFile,
                          const ShaderAst& ast, const ShaderBinding& binding,
                          const std::string& bindingText, nlohmann::json* json) {
     FactorOptions factorOptions;
     factorOptions.storeAboveCost = options.storeAboveCost;
-    const FactoredShader f = factorShader(ast, binding, factorOptions);
+    const ShaderBinding asked = withWhatIfs(binding, options);
+    const FactoredShader f = factorShader(ast, asked, factorOptions);
     const double ratio =
         f.staticInstructions > 0 ? double(f.dynamicInstructions) / f.staticInstructions : 0.0;
     if (json)
@@ -319,6 +338,23 @@ FactoredShader factorOne(const FactorCommandOptions& options, const std::string&
     else
         printFactoring(options, shaderFile, ast, bindingText, f, ratio,
                        factorOptions.storeAboveCost);
+    if (asked.overrides.size() > binding.overrides.size()) {
+        // The what-if against the split without it.
+        const FactoredShader base = factorShader(ast, binding, factorOptions);
+        if (json) {
+            (*json)["what_if"] = {{"without",
+                                   {{"chosen_width", base.chosenWidth},
+                                    {"static_cost", base.staticCost},
+                                    {"dynamic_cost", base.dynamicCost}}}};
+        } else {
+            std::printf("\nwhat-if, against the split without it:\n");
+            std::printf("  %-16s %8d -> %d\n", "n-tuple floats", base.chosenWidth, f.chosenWidth);
+            std::printf("  %-16s %8d -> %d\n", "bytes a texel", 4 * base.chosenWidth,
+                        4 * f.chosenWidth);
+            std::printf("  %-16s %8d -> %d\n", "static cost", base.staticCost, f.staticCost);
+            std::printf("  %-16s %8d -> %d\n", "dynamic cost", base.dynamicCost, f.dynamicCost);
+        }
+    }
     return f;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "shading/binding_time.h"
 
@@ -25,6 +26,9 @@ struct FactorCommandOptions {
     // the command exits 1 when the largest relative difference is over `tolerance`.
     bool verify = false;
     double tolerance = 1e-5;
+    // What-ifs: expressions (line:column, or a variable's name) to store or to repeat every
+    // frame, on top of the binding's own; the report then compares with the split without.
+    std::vector<std::string> store, repeat;
 };
 
 // Returns the exit code: 0 success; 1 when --verify found a difference over --tolerance.

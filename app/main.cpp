@@ -72,6 +72,12 @@ int main(int argc, char** argv) {
     factorCmd->add_flag("--verify", factor.verify,
                         "With --scene: the split against the whole shader over the object's "
                         "charts and the scene's frames (exit 1 over --tolerance)");
+    factorCmd->add_option("--store", factor.store,
+                          "What-if: store this expression (line:column, or a variable's name); "
+                          "compared with the split without");
+    factorCmd->add_option("--repeat", factor.repeat,
+                          "What-if: repeat this expression every frame (line:column, or a "
+                          "variable's name)");
     factorCmd->add_option("--tolerance", factor.tolerance,
                           "--verify: the largest relative difference allowed (default 1e-5)");
     factorCmd

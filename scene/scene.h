@@ -97,6 +97,9 @@ struct SceneObject {
     // The shader map's channels as binary16 (shadermaps/half_float.h: relative error 2^-11,
     // finite up to 65504): half the memory; false: float.
     bool shadermapHalf = false;
+    // "factoring": {"store": [...], "repeat": [...]}: decisions outside the source, checked
+    // against the analysis when the shader is factored (shading/binding.h).
+    std::vector<FactoringOverride> factoring;
     RangeOptions range;
 };
 

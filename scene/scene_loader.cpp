@@ -402,9 +402,28 @@ class SceneLoader {
         return p;
     }
 
+    // An object's "factoring": {"store": [...], "repeat": [...]}, each "line:column" or a
+    // variable's name (checked against the shader when it is factored).
+    static std::vector<FactoringOverride> factoringOverrides(const JsonNode& r) {
+        r.allowKeys({"store", "repeat"});
+        std::vector<FactoringOverride> out;
+        for (const auto& [key, kind] : {std::pair{"store", FactoringOverride::Kind::Store},
+                                        std::pair{"repeat", FactoringOverride::Kind::Repeat}})
+            if (auto list = r.optional(key))
+                for (size_t k = 0; k < list->size(); ++k) {
+                    const JsonNode item = list->at(k);
+                    FactoringOverride f;
+                    if (!parseFactoringOverride(item.string(), kind, f))
+                        item.fail("expected \"line:column\" or a variable's name, found '" +
+                                  item.string() + "'");
+                    out.push_back(f);
+                }
+        return out;
+    }
+
     void object(const JsonNode& o) {
         o.allowKeys({"name", "geometry", "shader", "params", "transform", "keys", "representation",
-                     "shadermap_resolution", "shadermap_precision", "range"});
+                     "shadermap_resolution", "shadermap_precision", "factoring", "range"});
         SceneObject obj;
         obj.name = o["name"].string();
         if (obj.name.empty()) o["name"].fail("an object name must not be empty");
@@ -487,6 +506,7 @@ class SceneLoader {
             else if (precision != "float")
                 r->fail("unknown precision '" + precision + "' (expected float or half)");
         }
+        if (auto r = o.optional("factoring")) obj.factoring = factoringOverrides(*r);
         if (auto r = o.optional("range")) {
             r->allowKeys({"distance_factor", "angle"});
             if (auto d = r->optional("distance_factor")) {

@@ -40,6 +40,7 @@ ShaderBinding bindingOf(const Scene& scene, const SceneObject& object) {
         }
         b.params[p.name] = pb;
     }
+    b.overrides = object.factoring;
     for (size_t i = 0; i < scene.lights.size(); ++i) {
         const Light& light = scene.lights[i];
         LightBinding lb;

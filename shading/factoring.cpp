@@ -388,7 +388,8 @@ std::vector<std::string> lintAnnotations(const ShaderAst& ast, const IrProgram& 
     if (ast.body) lintStmt(*ast.body, out);
     std::set<std::pair<int, int>> said;
     for (const Inst& inst : p.insts) {
-        if (inst.op != Op::Bake || inst.nargs < 1) continue;
+        // imm > 0: a store the binding asked for, which means to keep a static value.
+        if (inst.op != Op::Bake || inst.nargs < 1 || inst.imm > 0) continue;
         if (bt.stage[static_cast<size_t>(p.argsOf(inst)[0])] == Stage::Dynamic) continue;
         if (!said.insert({inst.line, inst.column}).second) continue;
         out.push_back(std::to_string(inst.line) + ":" + std::to_string(inst.column) +
@@ -471,11 +472,51 @@ std::vector<DynamicLine> explainDynamicLines(const IrProgram& p, const BindingTi
 
 }  // namespace
 
+// The binding's factoring overrides, checked against the analysis: a value can be stored
+// only if nothing dynamic reaches it (else it would be frozen: that is bake()'s, in the
+// source), and repeated only if it is static work (free work is never stored; a constant
+// has nothing to repeat).
+void checkOverrides(const ShaderAst& ast, const ShaderBinding& binding, const IrProgram& p,
+                    const BindingTimes& bt) {
+    const std::vector<int> defining = definingInstructions(p);
+    for (size_t k = 0; k < binding.overrides.size(); ++k) {
+        const FactoringOverride& o = binding.overrides[k];
+        const std::string what = "'" + o.spelled + "'";
+        bool found = false;
+        for (const Inst& inst : p.insts) {
+            if ((inst.op != Op::Bake && inst.op != Op::Dynamic) ||
+                inst.imm != static_cast<int>(k) + 1 || inst.nargs < 1)
+                continue;
+            found = true;
+            const int32_t arg = p.argsOf(inst)[0];
+            const Stage stage = bt.stage[static_cast<size_t>(arg)];
+            auto fail = [&](const std::string& why) {
+                throw InputError({ast.file, inst.line, inst.column, {}}, why);
+            };
+            if (o.kind == FactoringOverride::Kind::Store && stage == Stage::Dynamic) {
+                std::string causes;
+                for (const DynamicCause& c : causesOf(p, bt, defining, {arg}))
+                    causes += (causes.empty() ? "" : "; ") + c.why;
+                fail("cannot store " + what + ": " + causes +
+                     " (bake() in the source would freeze it at the static run's values)");
+            }
+            if (o.kind == FactoringOverride::Kind::Repeat && stage == Stage::Free)
+                fail("cannot repeat " + what +
+                     ": it is free work on the frames' geometry, never stored, so it is "
+                     "repeated already");
+        }
+        if (!found)
+            throw InputError({ast.file, o.line, o.column, {}},
+                             what + " is a constant for this binding: nothing to store or repeat");
+    }
+}
+
 FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
                             const FactorOptions& options) {
     FactoredShader f;
     const IrProgram lowered = lowerShader(ast, binding);
     const BindingTimes loweredTimes = analyzeBindingTimes(lowered, binding, options);
+    checkOverrides(ast, binding, lowered, loweredTimes);
     const std::vector<char> naive = boundary(lowered, loweredTimes);
     f.naiveWidth = static_cast<int>(std::count(naive.begin(), naive.end(), 1));
     f.analyzed = options.reassociate ? reassociate(lowered, loweredTimes) : lowered;

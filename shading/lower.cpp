@@ -33,7 +33,14 @@ class Lowerer {
         for (int k = 0; k < 3; ++k) ci.c[k] = zero, oi.c[k] = one;
         scopes_[0]["Ci"] = ci;
         scopes_[0]["Oi"] = oi;
+        overrideMatches_.assign(binding_.overrides.size(), 0);
         stmt(*ast_.body);
+        for (size_t k = 0; k < binding_.overrides.size(); ++k)
+            if (overrideMatches_[k] == 0)
+                fail(0, 0,
+                     "the factoring override '" + binding_.overrides[k].spelled +
+                         "' names nothing in the shader (the line:column of an operation as "
+                         "factor reports it, or a variable's name)");
         for (int k = 0; k < 3; ++k) {
             program_.ci[k] = scopes_[0]["Ci"].c[k];
             program_.oi[k] = scopes_[0]["Oi"].c[k];
@@ -42,6 +49,7 @@ class Lowerer {
     }
 
     const FoldStats& stats() const { return b_.stats(); }
+    std::vector<int> overrideMatches_;  // per binding override: expressions it wrapped
 
     // The inputs a value depends on, for an error: "time", "P", "parameter 'k' (animated
     // in this scene)", in the order first found.
@@ -203,6 +211,21 @@ class Lowerer {
     Val expr(const Expr& e) {
         Val v = exprUntagged(e);
         describe(v);
+        for (size_t k = 0; k < binding_.overrides.size(); ++k) {
+            const FactoringOverride& o = binding_.overrides[k];
+            if (o.line == e.line && o.column == e.column) v = overridden(v, k, e.line, e.column);
+        }
+        return v;
+    }
+
+    // v wrapped as a factoring override asks: Bake (store) or Dynamic (repeat), tagged with
+    // the override's number + 1 in imm so the factoring can check it is legal.
+    Val overridden(Val v, size_t k, int line, int column) {
+        ++overrideMatches_[k];
+        at(line, column);
+        const Op op =
+            binding_.overrides[k].kind == FactoringOverride::Kind::Store ? Op::Bake : Op::Dynamic;
+        for (int c = 0; c < v.n(); ++c) v.c[c] = b_.emit(op, {v.c[c]}, 1, static_cast<int>(k) + 1);
         return v;
     }
 
@@ -540,7 +563,10 @@ class Lowerer {
                 stmts(s.body);
                 break;
             case Stmt::Kind::Decl: {
-                const Val v = convert(expr(*s.value), s.declType);
+                Val v = convert(expr(*s.value), s.declType);
+                for (size_t k = 0; k < binding_.overrides.size(); ++k)
+                    if (binding_.overrides[k].line == 0 && binding_.overrides[k].name == s.name)
+                        v = overridden(v, k, s.value->line, s.value->column);
                 describe(v, s.name);
                 scopes_.back()[s.name] = v;
                 break;

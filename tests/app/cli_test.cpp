@@ -461,6 +461,27 @@ TEST(Cli, FactorTheWholeSceneGroupsSplitsAlike) {
               std::string::npos);
 }
 
+TEST(Cli, FactorWhatIfStoreComparesWithTheSplitWithout) {
+    // plastic.sl stores nothing by default (its lit colour is cheaper to repeat); --store at
+    // the product's operator keeps it: 0 -> 3 floats, the dynamic part cheaper. Storing the
+    // sum that holds the specular is refused, naming the view.
+    const CliRun run = mpshade("factor examples/shaders/plastic.sl --store 10:13 --json");
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const nlohmann::json doc = nlohmann::json::parse(run.output);
+    EXPECT_EQ(doc["chosen_width"], 3);
+    EXPECT_EQ(doc["what_if"]["without"]["chosen_width"], 0);
+    EXPECT_LT(doc["cost"]["dynamic"].get<int>(),
+              doc["what_if"]["without"]["dynamic_cost"].get<int>());
+    const CliRun text = mpshade("factor examples/shaders/plastic.sl --store 10:13");
+    EXPECT_NE(text.output.find("what-if, against the split without it:"), std::string::npos);
+    const CliRun refused = mpshade("factor examples/shaders/plastic.sl --store 10:45");
+    EXPECT_EQ(refused.exitCode, 2);
+    EXPECT_NE(refused.output.find("plastic.sl:10:45: error: cannot store '10:45': I, the "
+                                  "direction from the eye"),
+              std::string::npos)
+        << refused.output;
+}
+
 TEST(Cli, FactorVerifyExitsOneOverItsTolerance) {
     // The vase's splits are exact: exit 0, the verification in the JSON. The what-if of a
     // shader whose bake() freezes time, on the vase's binding, is over 1e-5: exit 1; and

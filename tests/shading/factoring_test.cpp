@@ -13,11 +13,13 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "geometry/error.h"
 #include "geometry/ray_scene.h"
 #include "scene/scene.h"
 #include "scene/variability.h"
 #include "shading/factoring.h"
 #include "shading/lower.h"
+#include "shading/shader_compiler.h"
 #include "shading/shader_harness.h"
 #include "test_support.h"
 
@@ -351,6 +353,54 @@ TEST(Factoring, ExplainsWhyEachLineIsDynamic) {
     ASSERT_EQ(f.channels.size(), 1u);
     EXPECT_EQ(f.channels[0].name, "a");
     EXPECT_EQ(f.channels[0].line, 2);
+}
+
+TEST(Factoring, OverridesOutsideTheSourceAreCheckedAndApplied) {
+    // plastic.sl with a fixed light: its 42 units of static diffuse are cheaper to repeat
+    // than to read back, so nothing is stored -- unless the binding asks to store the
+    // product at 10:13. Asking to store the whole sum (10:45, it holds the specular, which
+    // the view reaches) is refused naming I; repeating the constant Cs (10:10) is refused;
+    // repeating the parameter-free lit colour by name works like dynamic().
+    auto ast = loadShaderFile(test::sourcePath("examples/shaders/plastic.sl"));
+    ShaderBinding b = fixedLights();
+    EXPECT_EQ(factorShader(*ast, b).chosenWidth, 0);
+    auto with = [&](const char* text, FactoringOverride::Kind kind) {
+        ShaderBinding o = b;
+        FactoringOverride f;
+        EXPECT_TRUE(parseFactoringOverride(text, kind, f)) << text;
+        o.overrides.push_back(f);
+        return o;
+    };
+    const FactoredShader stored = factorShader(*ast, with("10:13", FactoringOverride::Kind::Store));
+    EXPECT_EQ(stored.chosenWidth, 3);
+    EXPECT_TRUE(stored.warnings.empty());  // a store asked for is no idle bake()
+    auto refused = [&](const char* text, FactoringOverride::Kind kind) {
+        try {
+            factorShader(*ast, with(text, kind));
+            return std::string("accepted");
+        } catch (const InputError& e) {
+            return e.message();
+        }
+    };
+    EXPECT_NE(refused("10:45", FactoringOverride::Kind::Store).find("cannot store '10:45': I,"),
+              std::string::npos)
+        << refused("10:45", FactoringOverride::Kind::Store);
+    EXPECT_NE(refused("10:10", FactoringOverride::Kind::Repeat).find("is a constant"),
+              std::string::npos);
+    EXPECT_NE(refused("99:1", FactoringOverride::Kind::Repeat).find("names nothing"),
+              std::string::npos);
+    // By a variable's name: marble's vein mask m repeated every frame, as dynamic(m) would.
+    auto marble = loadShaderFile(test::sourcePath("examples/shaders/marble.sl"));
+    ShaderBinding mb = fixedLights();
+    const int before = factorShader(*marble, mb).dynamicCost;
+    FactoringOverride m;
+    ASSERT_TRUE(parseFactoringOverride("m", FactoringOverride::Kind::Repeat, m));
+    mb.overrides.push_back(m);
+    EXPECT_GT(factorShader(*marble, mb).dynamicCost, before + 100);
+    FactoringOverride bad;
+    EXPECT_FALSE(parseFactoringOverride("1:x", FactoringOverride::Kind::Store, bad));
+    EXPECT_FALSE(parseFactoringOverride("a b", FactoringOverride::Kind::Store, bad));
+    EXPECT_FALSE(parseFactoringOverride("0:3", FactoringOverride::Kind::Store, bad));
 }
 
 TEST(Factoring, AnnotationsThatDoNothingAreWarnedOf) {
