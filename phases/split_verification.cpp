@@ -98,10 +98,10 @@ SplitVerification verifySplit(const StaticPhase& statics, const SceneResources& 
     for (size_t c = 0; c < channels && c < obj.factored.channels.size(); ++c) {
         // The variable it holds, else the operation and where the source computes it.
         const ChannelInfo& info = obj.factored.channels[c];
-        drift[c].d.name = !info.name.empty() ? info.name
-                                             : "(" + std::string(opName(info.op)) + ") " +
-                                                   std::to_string(info.line) + ":" +
-                                                   std::to_string(info.column);
+        drift[c].d.name = !info.name.empty()
+                              ? info.name
+                              : "(" + std::string(opName(info.op)) + ") " +
+                                    std::to_string(info.line) + ":" + std::to_string(info.column);
     }
     for (const int f : frames) {
         const FrameState state = frameStateAt(resources, f, width, height, 1);
@@ -112,8 +112,7 @@ SplitVerification verifySplit(const StaticPhase& statics, const SceneResources& 
             batch.setPoint(i, geometry[i], at[i], len > 0.0f ? d / len : glm::vec3(0, 0, 1));
         }
         // The whole shader at this frame.
-        statics.shading(object).directKernel->run(uniforms, batch.in, n, batch.out, workspace,
-                                                  counters);
+        obj.directKernel->run(uniforms, batch.in, n, batch.out, workspace, counters);
         for (int k = 0; k < 3; ++k)
             for (size_t i = 0; i < n; ++i) {
                 whole[static_cast<size_t>(k) * n + i] = batch.out.Ci[k][i];

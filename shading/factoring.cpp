@@ -315,23 +315,6 @@ std::vector<DynamicCause> causesOf(const IrProgram& p, const BindingTimes& bt,
     return causes;
 }
 
-// Lines whose bake() freezes a dynamic input (the view, time, an animated parameter or a
-// moving light): the static phase computes them once, at its representative values.
-std::vector<DynamicLine> explainBakedLines(const IrProgram& p, const BindingTimes& bt) {
-    const std::vector<int> defining = definingInstructions(p);
-    std::map<int, DynamicLine> lines;
-    for (const Inst& inst : p.insts) {
-        if (inst.op != Op::Bake || inst.nargs < 1 || lines.count(inst.line)) continue;
-        const int32_t arg = p.argsOf(inst)[0];
-        if (bt.stage[static_cast<size_t>(arg)] != Stage::Dynamic) continue;
-        lines[inst.line] = {inst.line, causeChain(p, bt, defining, arg),
-                            causesOf(p, bt, defining, {arg})};
-    }
-    std::vector<DynamicLine> out;
-    for (auto& [l, line] : lines) out.push_back(std::move(line));
-    return out;
-}
-
 // Per value: whether it is written inside a bake() on its own line. Shared with work the
 // frames do (the -I of a baked rim term and of a specular), it is still that line's baked
 // work: the per-frame use is reported where it is.
@@ -355,6 +338,41 @@ std::vector<char> writtenInBake(const IrProgram& p, const std::vector<int>& defi
     return inBake;
 }
 
+// Where each value's work runs, as the reports need it (computed once per factoring).
+struct WorkPlaces {
+    std::vector<int> defining;   // definingInstructions
+    std::vector<char> perFrame;  // computedPerFrame
+    std::vector<char> inBake;    // writtenInBake
+    // Dynamic work the frames do themselves: reached per frame and not a bake's own line.
+    bool repeated(size_t v) const { return perFrame[v] && !inBake[v]; }
+};
+
+WorkPlaces workPlacesOf(const IrProgram& p) {
+    WorkPlaces w;
+    w.defining = definingInstructions(p);
+    w.perFrame = computedPerFrame(p, w.defining);
+    w.inBake = writtenInBake(p, w.defining);
+    return w;
+}
+
+// Lines whose bake() freezes a dynamic input (the view, time, an animated parameter or a
+// moving light): the static phase computes them once, at its representative values.
+std::vector<DynamicLine> explainBakedLines(const IrProgram& p, const BindingTimes& bt,
+                                           const WorkPlaces& places) {
+    const std::vector<int>& defining = places.defining;
+    std::map<int, DynamicLine> lines;
+    for (const Inst& inst : p.insts) {
+        if (inst.op != Op::Bake || inst.nargs < 1 || lines.count(inst.line)) continue;
+        const int32_t arg = p.argsOf(inst)[0];
+        if (bt.stage[static_cast<size_t>(arg)] != Stage::Dynamic) continue;
+        lines[inst.line] = {inst.line, causeChain(p, bt, defining, arg),
+                            causesOf(p, bt, defining, {arg})};
+    }
+    std::vector<DynamicLine> out;
+    for (auto& [l, line] : lines) out.push_back(std::move(line));
+    return out;
+}
+
 // Whether an expression is made of literals alone (so constant for every binding).
 bool literalOnly(const Expr& e) {
     if (e.kind == Expr::Kind::Name) return false;
@@ -363,15 +381,21 @@ bool literalOnly(const Expr& e) {
     return true;
 }
 
-void lintExpr(const Expr& e, std::vector<std::string>& out) {
+// A warning at a source position.
+struct Warning {
+    int line = 0, column = 0;
+    std::string text;
+};
+
+void lintExpr(const Expr& e, std::vector<Warning>& out) {
     if (e.kind == Expr::Kind::Call && e.name == "dynamic" && !e.args.empty() &&
         literalOnly(*e.args[0]))
-        out.push_back(std::to_string(e.line) + ":" + std::to_string(e.column) +
-                      ": dynamic() of a constant does nothing: a constant is never repeated");
+        out.push_back({e.line, e.column,
+                       "dynamic() of a constant does nothing: a constant is never repeated"});
     for (const auto& a : e.args) lintExpr(*a, out);
 }
 
-void lintStmt(const Stmt& s, std::vector<std::string>& out) {
+void lintStmt(const Stmt& s, std::vector<Warning>& out) {
     for (const Expr* e : {s.value.get(), s.target.get()})
         if (e) lintExpr(*e, out);
     for (const Stmt* t : {s.init.get(), s.step.get()})
@@ -384,32 +408,29 @@ void lintStmt(const Stmt& s, std::vector<std::string>& out) {
 // bake() whose value is already static or free for this binding.
 std::vector<std::string> lintAnnotations(const ShaderAst& ast, const IrProgram& p,
                                          const BindingTimes& bt) {
-    std::vector<std::string> out;
-    if (ast.body) lintStmt(*ast.body, out);
+    std::vector<Warning> found;
+    if (ast.body) lintStmt(*ast.body, found);
     std::set<std::pair<int, int>> said;
     for (const Inst& inst : p.insts) {
         // imm > 0: a store the binding asked for, which means to keep a static value.
         if (inst.op != Op::Bake || inst.nargs < 1 || inst.imm > 0) continue;
         if (bt.stage[static_cast<size_t>(p.argsOf(inst)[0])] == Stage::Dynamic) continue;
         if (!said.insert({inst.line, inst.column}).second) continue;
-        out.push_back(std::to_string(inst.line) + ":" + std::to_string(inst.column) +
-                      ": bake() of a value already static for this binding changes nothing "
-                      "here (no view, time, animated parameter or moving light reaches it)");
+        found.push_back({inst.line, inst.column,
+                         "bake() of a value already static for this binding changes nothing "
+                         "here (no view, time, animated parameter or moving light reaches it)"});
     }
-    // In source order.
-    auto at = [](const std::string& w) {
-        const size_t colon = w.find(':');
-        return std::make_pair(std::stoi(w.substr(0, colon)), std::stoi(w.substr(colon + 1)));
-    };
-    std::stable_sort(out.begin(), out.end(),
-                     [&](const std::string& a, const std::string& b) { return at(a) < at(b); });
+    std::stable_sort(found.begin(), found.end(), [](const Warning& a, const Warning& b) {
+        return std::pair(a.line, a.column) < std::pair(b.line, b.column);
+    });
+    std::vector<std::string> out;
+    for (const Warning& w : found)
+        out.push_back(std::to_string(w.line) + ":" + std::to_string(w.column) + ": " + w.text);
     return out;
 }
 
-std::vector<SourceLineStages> stagesByLine(const IrProgram& p, const BindingTimes& bt) {
-    const std::vector<int> defining = definingInstructions(p);
-    const std::vector<char> perFrame = computedPerFrame(p, defining);
-    const std::vector<char> inBake = writtenInBake(p, defining);
+std::vector<SourceLineStages> stagesByLine(const IrProgram& p, const BindingTimes& bt,
+                                           const WorkPlaces& places) {
     std::map<int, SourceLineStages> lines;
     for (const Inst& inst : p.insts) {
         // Reading an input (a global, a parameter) is no work of the line's.
@@ -421,7 +442,7 @@ std::vector<SourceLineStages> stagesByLine(const IrProgram& p, const BindingTime
         l.line = inst.line;
         switch (bt.stage[v]) {
             case Stage::Dynamic:
-                if (perFrame[v] && !inBake[v])
+                if (places.repeated(v))
                     l.repeated = true;
                 else
                     l.baked = true;
@@ -439,16 +460,15 @@ std::vector<SourceLineStages> stagesByLine(const IrProgram& p, const BindingTime
     return out;
 }
 
-std::vector<DynamicLine> explainDynamicLines(const IrProgram& p, const BindingTimes& bt) {
-    const std::vector<int> defining = definingInstructions(p);
-    const std::vector<char> perFrame = computedPerFrame(p, defining);
-    const std::vector<char> inBake = writtenInBake(p, defining);
+std::vector<DynamicLine> explainDynamicLines(const IrProgram& p, const BindingTimes& bt,
+                                             const WorkPlaces& places) {
+    const std::vector<int>& defining = places.defining;
     std::map<int, DynamicLine> lines;
     for (const Inst& inst : p.insts) {
         const size_t v = static_cast<size_t>(inst.result);
         if (bt.stage[v] != Stage::Dynamic || inst.line <= 0 || lines.count(inst.line)) continue;
         // Only under a bake(): computed in the static phase.
-        if (!perFrame[v] || inBake[v]) continue;
+        if (!places.repeated(v)) continue;
         // The inputs themselves (a parameter's declaration, a global) are the chain's end,
         // not a line the author wrote dynamic work on.
         if (inst.op == Op::Global || inst.op == Op::Param || inst.op == Op::LightAmbient) continue;
@@ -461,7 +481,7 @@ std::vector<DynamicLine> explainDynamicLines(const IrProgram& p, const BindingTi
     std::map<int, std::vector<int32_t>> work;
     for (const Inst& inst : p.insts) {
         const size_t v = static_cast<size_t>(inst.result);
-        if (lines.count(inst.line) && bt.stage[v] == Stage::Dynamic && perFrame[v] && !inBake[v])
+        if (lines.count(inst.line) && bt.stage[v] == Stage::Dynamic && places.repeated(v))
             for (int o = 0; o < inst.nout; ++o) work[inst.line].push_back(inst.result + o);
     }
     for (auto& [l, line] : lines) line.causes = causesOf(p, bt, defining, work[l]);
@@ -530,7 +550,8 @@ FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
     });
     f.staticPart = staticPartOf(f.analyzed, cut);
     f.dynamicPart = dynamicPartOf(f.analyzed, cut);
-    const std::vector<int> defining = definingInstructions(f.analyzed);
+    const WorkPlaces places = workPlacesOf(f.analyzed);
+    const std::vector<int>& defining = places.defining;
     for (int32_t v : cut) {
         const Inst& inst = f.analyzed.insts[static_cast<size_t>(defining[static_cast<size_t>(v)])];
         ChannelInfo c;
@@ -552,9 +573,9 @@ FactoredShader factorShader(const ShaderAst& ast, const ShaderBinding& binding,
     f.originalCost = programCost(lowered);
     f.staticCost = programCost(f.staticPart);
     f.dynamicCost = programCost(f.dynamicPart);
-    f.dynamicLines = explainDynamicLines(f.analyzed, f.times);
-    f.bakedLines = explainBakedLines(f.analyzed, f.times);
-    f.lineStages = stagesByLine(f.analyzed, f.times);
+    f.dynamicLines = explainDynamicLines(f.analyzed, f.times, places);
+    f.bakedLines = explainBakedLines(f.analyzed, f.times, places);
+    f.lineStages = stagesByLine(f.analyzed, f.times, places);
     f.warnings = lintAnnotations(ast, f.analyzed, f.times);
     return f;
 }

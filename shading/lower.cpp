@@ -49,7 +49,6 @@ class Lowerer {
     }
 
     const FoldStats& stats() const { return b_.stats(); }
-    std::vector<int> overrideMatches_;  // per binding override: expressions it wrapped
 
     // The inputs a value depends on, for an error: "time", "P", "parameter 'k' (animated
     // in this scene)", in the order first found.
@@ -628,6 +627,7 @@ class Lowerer {
     }
 
     const ShaderAst& ast_;
+    std::vector<int> overrideMatches_;  // per binding override: expressions it wrapped
     const ShaderBinding& binding_;
     const LoweringLimits& limits_;
     IrProgram& program_;

@@ -397,6 +397,19 @@ TEST(Factoring, OverridesOutsideTheSourceAreCheckedAndApplied) {
     ASSERT_TRUE(parseFactoringOverride("m", FactoringOverride::Kind::Repeat, m));
     mb.overrides.push_back(m);
     EXPECT_GT(factorShader(*marble, mb).dynamicCost, before + 100);
+    // P * scale (10:22, under the fbm) is free work on the frames' geometry: nothing to
+    // repeat.
+    ShaderBinding freeWork = fixedLights();
+    FactoringOverride p;
+    ASSERT_TRUE(parseFactoringOverride("10:22", FactoringOverride::Kind::Repeat, p));
+    freeWork.overrides.push_back(p);
+    try {
+        factorShader(*marble, freeWork);
+        ADD_FAILURE() << "repeating free work was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(e.message().find("cannot repeat '10:22': it is free work"), std::string::npos)
+            << e.message();
+    }
     FactoringOverride bad;
     EXPECT_FALSE(parseFactoringOverride("1:x", FactoringOverride::Kind::Store, bad));
     EXPECT_FALSE(parseFactoringOverride("a b", FactoringOverride::Kind::Store, bad));
