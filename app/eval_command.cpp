@@ -197,10 +197,10 @@ int runEvalCommand(const EvalCommandOptions& options) {
         base.height = e.height;
 
         const std::vector<EvalConfig> configs = ladders(e.spp, options.quick);
-        SweepProgress progress(tty, e.name, frames * static_cast<int>(configs.size() + 2));
+        SweepProgress progress(tty, e.name, frames * static_cast<int>(configs.size() + 4));
         if (!options.quiet && !tty)
             std::fprintf(stderr, "mpshade eval: %s: %d configurations over %d frames\n",
-                         e.name.c_str(), static_cast<int>(configs.size()) + 1, frames);
+                         e.name.c_str(), static_cast<int>(configs.size()) + 3, frames);
 
         // The truth, from the cache where it has it.
         // The truth's samples are drawn with another seed than the ladders': a rung at
@@ -223,6 +223,18 @@ int runEvalCommand(const EvalCommandOptions& options) {
         cut.cutEveryFrame = true;
         e.worstCase = runEvalConfig(e.scene, cut, e.first, e.last, base, truth,
                                     [&] { progress.step(cut.label); });
+        // A store of its own, emptied first: the first run fills it, the second reads it.
+        EvalConfig stored = e.runs[e.defaultRun].config;
+        stored.knob = "store";
+        stored.storeFolder = (out / e.name / "store").string();
+        std::filesystem::remove_all(stored.storeFolder);
+        stored.label = "mp default, empty store";
+        e.coldStore = runEvalConfig(e.scene, stored, e.first, e.last, base, truth,
+                                    [&] { progress.step(stored.label); });
+        stored.label = "mp default, warm store";
+        e.warmStore = runEvalConfig(e.scene, stored, e.first, e.last, base, truth,
+                                    [&] { progress.step(stored.label); });
+        std::filesystem::remove_all(stored.storeFolder);
         progress.finish();
         summarize(e);
 
@@ -240,10 +252,10 @@ int runEvalCommand(const EvalCommandOptions& options) {
             std::fprintf(stderr,
                          "mpshade eval: %s: speedup at equal PSNR %.2fx (whole sequence, "
                          "defaults at %.2f dB), %.2fx at the reference's %.2f dB; a cut "
-                         "every frame %+.1f%%\n",
+                         "every frame %+.1f%%; a warm store %.2fx\n",
                          done.name.c_str(), done.atDefault.sequence, done.atDefault.psnr,
                          done.atReferencePsnr.sequence, done.atReferencePsnr.psnr,
-                         100.0 * done.worstCaseOverhead);
+                         100.0 * done.worstCaseOverhead, done.warmStoreSpeedup);
         }
     }
     if (!options.quiet)

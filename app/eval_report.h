@@ -34,11 +34,17 @@ struct SceneEvaluation {
     double truthSelfPsnr = 0.0;  // the truth against itself: +infinity
     std::vector<EvalRun> runs;   // the reference ladder, then multi-phase's
     EvalRun worstCase;           // multi-phase defaults with a cut every frame
-    size_t defaultRun = 0;       // index in runs of multi-phase at every default
-    size_t referenceAtSpp = 0;   // index of the reference at the scene's spp
+    // Multi-phase defaults with an empty store (filling it: what writing costs), then again
+    // reading it: a second run of an unchanged scene.
+    EvalRun coldStore, warmStore;
+    size_t defaultRun = 0;      // index in runs of multi-phase at every default
+    size_t referenceAtSpp = 0;  // index of the reference at the scene's spp
     std::vector<size_t> referenceFront, multiphaseFront;  // indices in runs
     EqualErrorSpeedup atDefault, best, atReferencePsnr;
     double worstCaseOverhead = 0.0;  // cut-every-frame sequence / reference's at equal spp - 1
+    // The warm store's whole-sequence speedup at the defaults' PSNR (its images are the
+    // defaults'), and the ratio of it to the defaults' own (atDefault.sequence).
+    double warmStoreSpeedup = 0.0, warmStoreGain = 0.0;
 };
 
 // Fills the fronts and the headline ratios from the runs.

@@ -12,6 +12,7 @@
 #include "app/eval_metrics.h"
 #include "controller/multiphase_renderer.h"
 #include "phases/image_compare.h"
+#include "shadermaps/tile_store.h"
 
 namespace mpshade {
 namespace {
@@ -27,6 +28,7 @@ MultiphaseOptions multiphaseOptions(const EvalConfig& c) {
     o.staticPhase.combinedDicing.maxEdgePixels = c.facetEdgePixels;
     o.mapMemoryBytes = static_cast<size_t>(c.cacheMb) << 20;
     o.singlePhaseFrames = c.singlePhaseFrames;
+    if (!c.storeFolder.empty()) o.staticPhase.store = std::make_shared<TileStore>(c.storeFolder);
     return o;
 }
 

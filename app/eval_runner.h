@@ -33,6 +33,9 @@ struct EvalConfig {
     int cacheMb = 96;               // the shader maps' tile budget
     bool cutEveryFrame = false;     // every frame starts with no static work to reuse
     bool singlePhaseFrames = true;  // frames whose static work would not pay go single-phase
+    // A shader-map store folder the run reads and adds to (docs/store.md); empty: none, every
+    // tile filled (the ladders' runs, so each pays its static work).
+    std::string storeFolder;
 };
 
 struct EvalFrame {

@@ -15,6 +15,7 @@ void addMultiphaseFrameJson(const Scene& scene, const FrameStats& stats, nlohman
     entry["static_runs_due"] = staticRunsDueJson(scene, stats);
     entry["tiles_requested"] = stats.tiles.missing;
     entry["tiles_filled"] = stats.staticWork.work.tilesFilled;
+    entry["tiles_from_store"] = stats.staticWork.work.tilesLoaded;
     entry["tiles_evicted"] = stats.tiles.evicted;
     entry["resident_bytes"] = stats.tiles.residentBytes;
     entry["resident_pinned_bytes"] = stats.tiles.residentPinnedBytes;
@@ -138,6 +139,8 @@ nlohmann::json objectReportsJson(const MultiphaseRenderer& renderer) {
                            {"longest_edge_pixels", r.longestEdgePixels},
                            {"facet_bytes", r.facetBytes},
                            {"resident_tiles", r.residentTiles},
+                           {"tiles_filled", r.staticCosts.tilesFilled},
+                           {"tiles_from_store", r.staticCosts.tilesLoaded},
                            {"map_bytes", r.mapBytes}});
         // The direct rule's last priced frame (static_run_triggers.h): CPU ms by the model.
         const ObjectSlot& slot = renderer.slot(i);

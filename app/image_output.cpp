@@ -76,6 +76,19 @@ void writeFrameImages(const Image& image, const std::string& dir, int frame) {
                          [&] { writePng(image, base + ".png"); });
 }
 
+bool frameImagesExist(const std::string& dir, int frame) {
+    const std::filesystem::path base =
+        std::filesystem::path(dir) / fmt::format("frame_{:04d}", frame);
+    std::error_code ec;
+    for (const char* ext : {".exr", ".png"}) {
+        std::filesystem::path p = base;
+        p += ext;
+        if (!std::filesystem::is_regular_file(p, ec) || std::filesystem::file_size(p, ec) == 0)
+            return false;
+    }
+    return true;
+}
+
 void writePng(const Image& image, const std::string& path) {
     std::vector<unsigned char> rgb(static_cast<size_t>(image.width) * image.height * 3);
     for (size_t i = 0; i < static_cast<size_t>(image.width) * image.height; ++i)

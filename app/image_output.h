@@ -15,6 +15,9 @@ void writeExr(const Image& image, const std::string& path);
 void writePng(const Image& image, const std::string& path);
 // Frame `frame` of a sequence as `render` and `play` write it: DIR/frame_NNNN.exr and .png.
 void writeFrameImages(const Image& image, const std::string& dir, int frame);
+// Whether both of frame `frame`'s files are in `dir` (written atomically: a file there is
+// whole).
+bool frameImagesExist(const std::string& dir, int frame);
 // Reads any image OpenImageIO reads as linear RGBA floats (alpha 1 if it has none; the
 // first three channels as RGB, a single channel as grey). Throws InputError naming the
 // file when it cannot.

@@ -11,6 +11,7 @@
 #include "app/play_command.h"
 #include "app/profile_command.h"
 #include "app/render_command.h"
+#include "app/store_command.h"
 #include "geometry/error.h"
 
 int main(int argc, char** argv) {
@@ -58,6 +59,13 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--truth-spp", render.truthSpp,
                           "With --compare: also measure both renderers against the reference "
                           "at this many samples per pixel");
+    renderCmd->add_flag("--skip-existing", render.skipExisting,
+                        "Render no frame whose EXR and PNG are in --out already (a retried "
+                        "farm task)");
+    renderCmd->add_flag("--shard-stats", render.shardStats,
+                        "Write stats_A_B.json (the frames asked for) instead of stats.json, so "
+                        "shards sharing --out keep their own");
+    mpshade::addRunOptions(*renderCmd, render.run);
 
     mpshade::FactorCommandOptions factor;
     CLI::App* factorCmd = app.add_subcommand(
@@ -135,6 +143,7 @@ int main(int argc, char** argv) {
     profileCmd->add_option("--seed", profile.seed, "Seed of the sample positions")
         ->capture_default_str();
     profileCmd->add_flag("--quiet", profile.quiet, "No progress or summary on stderr");
+    mpshade::addRunOptions(*profileCmd, profile.run);
 
     mpshade::PlayCommandOptions play;
     CLI::App* playCmd = app.add_subcommand(
@@ -160,6 +169,40 @@ int main(int argc, char** argv) {
                       "Fill missing tiles only in frames' slack, on no worker thread alongside "
                       "them (for comparisons)");
     playCmd->add_flag("--quiet", play.quiet, "No progress or summary on stderr");
+    mpshade::addRunOptions(*playCmd, play.run);
+
+    mpshade::BakeCommandOptions bake;
+    CLI::App* bakeCmd = app.add_subcommand(
+        "bake", "Fill the shader-map store with every tile the frames read (no images)");
+    bakeCmd->add_option("scene", bake.scene, "Scene file (.json)")->required();
+    bakeCmd->add_option("--frames", bake.frames,
+                        "Frames A:B (half-open) or N; default every frame");
+    bakeCmd->add_option("--size", bake.size, "Image size WxH (overrides the scene)");
+    bakeCmd->add_option("--spp", bake.spp, "Samples per pixel (overrides the scene)");
+    bakeCmd->add_option("--seed", bake.seed, "Seed of the sample positions")->capture_default_str();
+    bakeCmd->add_flag("--quiet", bake.quiet, "No progress or summary");
+    mpshade::addRunOptions(*bakeCmd, bake.run);
+
+    mpshade::StoreCommandOptions store;
+    CLI::App* storeCmd =
+        app.add_subcommand("store", "What a shader-map store holds; clean-up; export");
+    storeCmd->require_subcommand(1);
+    CLI::App* storeInfo = storeCmd->add_subcommand("info", "Maps, tiles and bytes in the store");
+    storeInfo->add_option("--store", store.store, "Store folder (default as render's)");
+    storeInfo->add_flag("--json", store.json, "Machine-readable output");
+    CLI::App* storeGc =
+        storeCmd->add_subcommand("gc", "Remove maps unused longest until the store fits");
+    storeGc->add_option("--store", store.store, "Store folder (default as render's)");
+    storeGc->add_option("--max-mb", store.maxMb, "Size to keep the store under, MB")->required();
+    CLI::App* storeExport = storeCmd->add_subcommand(
+        "export", "Write an object's stored map as mip-mapped OpenEXR, a file per chart");
+    storeExport->add_option("scene", store.scene, "Scene file (.json)")->required();
+    storeExport->add_option("--object", store.object, "Object in the scene")->required();
+    storeExport->add_option("--out", store.outDir, "Output folder (created if missing)")
+        ->required();
+    storeExport->add_option("--store", store.store, "Store folder (default as render's)");
+    storeExport->add_option("--max-size", store.maxSize, "Widest level written, texels")
+        ->capture_default_str();
 
     try {
         app.parse(argc, argv);
@@ -174,12 +217,23 @@ int main(int argc, char** argv) {
         return 2;
     }
     try {
-        if (renderCmd->parsed()) return mpshade::runRenderCommand(render);
+        if (renderCmd->parsed())
+            return mpshade::runWithThreads(render.run,
+                                           [&] { return mpshade::runRenderCommand(render); });
         if (factorCmd->parsed()) return mpshade::runFactorCommand(factor);
         if (compareCmd->parsed()) return mpshade::runCompareCommand(compare);
         if (evalCmd->parsed()) return mpshade::runEvalCommand(eval);
-        if (profileCmd->parsed()) return mpshade::runProfileCommand(profile);
-        if (playCmd->parsed()) return mpshade::runPlayCommand(play);
+        if (profileCmd->parsed())
+            return mpshade::runWithThreads(profile.run,
+                                           [&] { return mpshade::runProfileCommand(profile); });
+        if (bakeCmd->parsed())
+            return mpshade::runWithThreads(bake.run, [&] { return mpshade::runBakeCommand(bake); });
+        if (storeCmd->parsed()) {
+            store.action = storeInfo->parsed() ? "info" : storeGc->parsed() ? "gc" : "export";
+            return mpshade::runStoreCommand(store);
+        }
+        if (playCmd->parsed())
+            return mpshade::runWithThreads(play.run, [&] { return mpshade::runPlayCommand(play); });
     } catch (const mpshade::InputError& e) {
         // Bad input, its place named in the message (file:line:col, JSON path, option).
         std::fprintf(stderr, "mpshade: %s\n", e.what());

@@ -1,6 +1,10 @@
 #include "app/memory_limit.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <unordered_set>
 #include <variant>
 
@@ -36,9 +40,43 @@ uint64_t physicalMemoryBytes() {
     return pages > 0 && size > 0 ? static_cast<uint64_t>(pages) * static_cast<uint64_t>(size) : 0;
 }
 
+uint64_t cgroupLimitFrom(const std::string& cgroupFile, const std::string& cgroupRoot) {
+    std::ifstream in(cgroupFile);
+    std::string line;
+    uint64_t limit = 0;
+    auto consider = [&](const std::filesystem::path& file) {
+        std::ifstream f(file);
+        std::string value;
+        if (!(f >> value) || value == "max" || value.empty()) return;
+        char* end = nullptr;
+        const unsigned long long v = std::strtoull(value.c_str(), &end, 10);
+        // cgroup v1 writes "no limit" as a huge number rounded to pages.
+        if (end && *end == '\0' && v > 0 && v < (uint64_t{1} << 60))
+            limit = limit == 0 ? v : std::min<uint64_t>(limit, v);
+    };
+    while (std::getline(in, line)) {
+        // "0::/path" (v2) or "N:memory:/path" (v1, the memory controller).
+        const size_t a = line.find(':'), b = a == std::string::npos ? a : line.find(':', a + 1);
+        if (b == std::string::npos) continue;
+        const std::string controllers = line.substr(a + 1, b - a - 1);
+        std::string path = line.substr(b + 1);
+        const bool v2 = controllers.empty();
+        if (!v2 && controllers.find("memory") == std::string::npos) continue;
+        const std::filesystem::path base = std::filesystem::path(cgroupRoot) / (v2 ? "" : "memory");
+        // The limit of the group and of every group above it: the smallest holds.
+        for (std::filesystem::path p = path;; p = p.parent_path()) {
+            consider(base / p.relative_path() / (v2 ? "memory.max" : "memory.limit_in_bytes"));
+            if (p == p.parent_path() || p.empty()) break;
+        }
+    }
+    return limit;
+}
+
 uint64_t defaultMemoryLimitBytes() {
-    const uint64_t physical = physicalMemoryBytes();
-    return physical > 0 ? physical / 4 * 3 : uint64_t{8} << 30;
+    uint64_t available = physicalMemoryBytes();
+    const uint64_t group = cgroupLimitFrom("/proc/self/cgroup", "/sys/fs/cgroup");
+    if (group > 0) available = available > 0 ? std::min(available, group) : group;
+    return available > 0 ? available / 4 * 3 : uint64_t{8} << 30;
 }
 
 uint64_t peakResidentBytes() {

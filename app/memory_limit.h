@@ -10,8 +10,13 @@ namespace mpshade {
 
 // Physical memory of this machine, in bytes (0 if unknown).
 uint64_t physicalMemoryBytes();
-// The default limit: three quarters of physical memory (8 GiB if unknown).
+// The default limit: three quarters of physical memory or of the container's limit (the
+// cgroup's memory.max, v2, or memory.limit_in_bytes, v1, of this process's group and the
+// groups above it), whichever is less; 8 GiB if neither is known.
 uint64_t defaultMemoryLimitBytes();
+// The smallest memory limit of the cgroups `cgroupFile` (as /proc/self/cgroup) names, read
+// under `cgroupRoot` (as /sys/fs/cgroup), in bytes; 0 when none is set.
+uint64_t cgroupLimitFrom(const std::string& cgroupFile, const std::string& cgroupRoot);
 // Peak resident memory of this process so far, in bytes.
 uint64_t peakResidentBytes();
 

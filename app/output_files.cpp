@@ -1,5 +1,6 @@
 #include "app/output_files.h"
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -31,9 +32,17 @@ void prepareOutputFolder(const std::filesystem::path& folder) {
 
 void writeAtomically(const std::filesystem::path& path,
                      const std::function<void(const std::string& temporaryPath)>& write) {
-    // Same folder (so the rename stays on one file system), a name no frame uses.
+    // Same folder (so the rename stays on one file system), a name no frame uses, nor another
+    // process writing the same file (two renders into one folder, on one machine or on
+    // several sharing it).
+    static std::atomic<uint64_t> counter{0};
+    char host[64] = "host";
+    ::gethostname(host, sizeof host - 1);
+    host[sizeof host - 1] = '\0';
     const std::filesystem::path temporary =
-        path.parent_path() / ("." + path.filename().string() + ".partial");
+        path.parent_path() /
+        ("." + path.filename().string() + "." + host + "." + std::to_string(::getpid()) + "." +
+         std::to_string(counter++) + ".partial");
     std::error_code ec;
     try {
         write(temporary.string());

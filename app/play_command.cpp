@@ -117,6 +117,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
     po.cacheBytes = static_cast<size_t>(options.cacheMb) << 20;
     po.prefetch = !options.noPrefetch;
     po.backgroundFills = !options.noBackgroundFills;
+    po.store = openStore(options.run);
     prepareOutputFolder(options.outDir);
     const std::filesystem::path dir(options.outDir);
     const bool tty = !options.quiet && isatty(STDERR_FILENO);
@@ -159,6 +160,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
             {"deadline_met_fraction", played > 0 ? static_cast<double>(met) / played : 1.0},
             {"peak_resident_mb", peakResidentBytes() >> 20},
             {"steps", ladder},
+            {"store", storeReport(po.store)},
             {"frames", frames}};
         writeTextFile(dir / "stats.json", doc.dump(2) + "\n");
     };
@@ -189,6 +191,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
         steps = s.steps;
     });
     if (tty) std::fprintf(stderr, "\n");
+    cleanUpStore(po.store, options.run);
     writeStats(summary.prerollSeconds);
     if (interrupted()) {
         std::fprintf(stderr,

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <string>
 
+#include "app/run_options.h"
+
 namespace mpshade {
 
 struct PlayCommandOptions {
@@ -22,6 +24,7 @@ struct PlayCommandOptions {
     bool noPrefetch = false;         // no predicted or adjacent tiles filled ahead (comparisons)
     bool noBackgroundFills = false;  // no worker thread filling deferred tiles (comparisons)
     bool quiet = false;
+    RunOptions run;  // the shader-map store, threads
 };
 
 // Returns the exit code: 0, or 130 when stopped by Ctrl-C.

@@ -21,6 +21,8 @@ int runProfileCommand(const ProfileCommandOptions& options) {
     po.render = request.render;
     po.first = request.first;
     po.last = request.last;
+    const std::shared_ptr<TileStore> store = openStore(options.run);
+    po.multiphase.staticPhase.store = store;
     prepareOutputFolder(options.outDir);
 
     std::vector<std::string> names;
@@ -36,6 +38,7 @@ int runProfileCommand(const ProfileCommandOptions& options) {
     const std::filesystem::path dir(options.outDir);
     writeTextFile(dir / "profile.md", profileMarkdown(profile));
     writeTextFile(dir / "trace.json", trace.chromeTraceJson());
+    cleanUpStore(store, options.run);
     if (!options.quiet) {
         double staticSeconds = 0.0, wall = 0.0;
         for (const FrameStats& s : profile.frames) {

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <string>
 
+#include "app/run_options.h"
+
 namespace mpshade {
 
 struct ProfileCommandOptions {
@@ -15,6 +17,7 @@ struct ProfileCommandOptions {
     int spp = -1;        // -1 = the scene's; else 1..1024
     uint32_t seed = 0;
     bool quiet = false;  // no progress or summary on stderr
+    RunOptions run;      // the shader-map store, threads
 };
 
 // Returns the exit code, 0.

@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 
+#include <fmt/format.h>
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 
@@ -23,6 +24,7 @@
 #include "phases/image_compare.h"
 #include "phases/reference_renderer.h"
 #include "scene/scene.h"
+#include "shadermaps/tile_store.h"
 
 namespace mpshade {
 namespace {
@@ -161,8 +163,10 @@ int runRenderCommand(const RenderCommandOptions& options) {
     if (ask.reference) reference = std::make_unique<ReferenceRenderer>(scene);
     std::unique_ptr<MultiphaseRenderer> multi;
     ShadingRate shadingRate = scene.settings.shadingRate;
+    const std::shared_ptr<TileStore> store = multiphase ? openStore(options.run) : nullptr;
     if (multiphase) {
-        const MultiphaseOptions mo = multiphaseOptions(options);
+        MultiphaseOptions mo = multiphaseOptions(options);
+        mo.staticPhase.store = store;
         shadingRate = mo.shadingRate.value_or(shadingRate);
         multi = std::make_unique<MultiphaseRenderer>(scene, mo);
         multi->plan(first, last, render);
@@ -173,7 +177,10 @@ int runRenderCommand(const RenderCommandOptions& options) {
     nlohmann::json frames = nlohmann::json::array();
     const auto start = std::chrono::steady_clock::now();
     // stats.json, rewritten (atomically) after every frame: what a stopped render
-    // finished is always described.
+    // finished is always described. A shard's is its own (stats_A_B.json), so shards
+    // rendering into one folder never overwrite one another's.
+    const std::string statsName =
+        options.shardStats ? fmt::format("stats_{:04d}_{:04d}.json", first, last) : "stats.json";
     const auto writeStats = [&] {
         nlohmann::json doc = {
             {"scene", options.scene},
@@ -191,12 +198,20 @@ int runRenderCommand(const RenderCommandOptions& options) {
         if (multi) {
             doc["shading_rate"] = shadingRateName(shadingRate);
             doc["objects"] = objectReportsJson(*multi);
+            doc["store"] = storeReport(store);
         }
-        writeTextFile(std::filesystem::path(options.outDir) / "stats.json", doc.dump(2) + "\n");
+        writeTextFile(std::filesystem::path(options.outDir) / statsName, doc.dump(2) + "\n");
     };
     const InterruptWatch watch;
     Image image, referenceImage;  // reused frame to frame
+    // Without a terminal (a farm's log), a line a frame instead of the bar.
+    const bool lines = !options.quiet && !isatty(STDERR_FILENO);
+    int skipped = 0;
     for (int frame = first; frame < last; ++frame) {
+        if (options.skipExisting && frameImagesExist(options.outDir, frame)) {
+            ++skipped;
+            continue;
+        }
         FrameStats stats;
         renderer.renderFrame(frame, render, stats, image, [&](int done, int total) {
             bar.update(frame, last - first, done, total);
@@ -207,9 +222,19 @@ int runRenderCommand(const RenderCommandOptions& options) {
             compareFrame(frame, image, stats, render, options, *reference, referenceImage, entry);
         frames.push_back(entry);
         writeStats();
+        if (lines)
+            std::fprintf(stderr, "mpshade: frame %d done (%d of %d) in %.3f s\n", frame,
+                         frame - first + 1, last - first, stats.wallSeconds);
         if (interrupted()) break;
     }
+    if (skipped > 0 && !options.quiet)
+        std::fprintf(stderr, "mpshade: %d frame(s) already in %s were not rendered again\n",
+                     skipped, options.outDir.c_str());
     bar.finish();
+    if (store) {
+        cleanUpStore(store, options.run);
+        writeStats();  // with every tile written counted
+    }
     if (interrupted()) {
         std::fprintf(stderr,
                      "mpshade: stopped by the user after %zu frame(s); stats.json "

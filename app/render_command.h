@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <string>
 
+#include "app/run_options.h"
+
 namespace mpshade {
 
 struct RenderCommandOptions {
@@ -28,6 +30,13 @@ struct RenderCommandOptions {
     // Multiphase: the shader maps' tiles' memory budget, MB (MultiphaseOptions::
     // mapMemoryBytes); 0: its default.
     int64_t cacheMb = 0;
+    RunOptions run;  // the shader-map store, threads
+    // Frames whose EXR and PNG are both in the output folder already are not rendered again
+    // (a farm task retried); their stats are not in this run's stats.json.
+    bool skipExisting = false;
+    // stats_A_B.json (this request's frames) instead of stats.json: shards rendering into one
+    // folder each keep their own.
+    bool shardStats = false;
 };
 
 // Returns the exit code: 0, or 130 when stopped by Ctrl-C.

@@ -29,6 +29,15 @@ set_target_properties(mpshade::opensubdiv PROPERTIES
   IMPORTED_LOCATION "${OPENSUBDIV_CPU_LIBRARY}"
   INTERFACE_INCLUDE_DIRECTORIES "${OPENSUBDIV_INCLUDE_DIR}")
 
+# xxHash (libxxhash-dev) has no CMake config either: XXH3 digests address the shader-map
+# store (shadermaps/tile_store.h) and check its tiles.
+find_path(XXHASH_INCLUDE_DIR xxhash.h REQUIRED)
+find_library(XXHASH_LIBRARY xxhash REQUIRED)
+add_library(mpshade::xxhash UNKNOWN IMPORTED)
+set_target_properties(mpshade::xxhash PROPERTIES
+  IMPORTED_LOCATION "${XXHASH_LIBRARY}"
+  INTERFACE_INCLUDE_DIRECTORIES "${XXHASH_INCLUDE_DIR}")
+
 if(MPSHADE_BUILD_TESTS)
   find_package(GTest CONFIG REQUIRED)
 endif()

@@ -374,7 +374,10 @@ void MultiphaseRenderer::countFills(const TileFillResult& fills, FrameStats& sta
     stats.controllerSeconds += fills.roomSeconds;
     stats.tiles.evicted += fills.evicted;
     for (size_t i = 0; i < fills.objectTiles.size(); ++i) {
-        slots_[i].report.staticCosts.tilesFilled += fills.objectTiles[i];
+        const uint64_t loaded =
+            i < fills.timing.objectTilesLoaded.size() ? fills.timing.objectTilesLoaded[i] : 0;
+        slots_[i].report.staticCosts.tilesFilled += fills.objectTiles[i] - loaded;
+        slots_[i].report.staticCosts.tilesLoaded += loaded;
         slots_[i].frameTilesFilled += fills.objectTiles[i];
     }
     for (size_t i = 0; i < fills.timing.objectSeconds.size(); ++i) {

@@ -81,6 +81,7 @@ class Player {
         mo.backgroundFills = options.backgroundFills;
         mo.backgroundDuringFrames = options.backgroundDuringFrames;
         mo.trace = options.trace;
+        mo.staticPhase.store = options.store;
         return mo;
     }
 

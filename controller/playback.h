@@ -27,7 +27,8 @@ struct PlaybackOptions {
     // The shader maps' tiles stay under this many bytes (least recently used out first;
     // the always-resident levels are never dropped).
     size_t cacheBytes = size_t{256} << 20;
-    PhaseTrace* trace = nullptr;  // not owned; null: no spans
+    PhaseTrace* trace = nullptr;       // not owned; null: no spans
+    std::shared_ptr<TileStore> store;  // where tiles are kept between runs; null: nowhere
     // What frames give up when the dynamic phase alone takes most of the budget: shading
     // rate, then probe footprint (quality_regulator.h).
     QualityRegulatorOptions regulator;

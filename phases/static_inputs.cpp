@@ -4,32 +4,15 @@
 #include <cmath>
 
 #include "geometry/error.h"
+#include "shading/program_digest.h"
 
 namespace mpshade {
 
 StaticInputs::StaticInputs(const IrProgram& staticPart) {
-    for (const Inst& inst : staticPart.insts) {
-        switch (inst.op) {
-            case Op::Global:
-                time_ = time_ || inst.imm == static_cast<int32_t>(GlobalId::time);
-                break;
-            case Op::Param:
-                for (int k = 0; k < inst.nout; ++k) params_.push_back(inst.imm + k);
-                break;
-            case Op::LightAmbient:
-            case Op::Diffuse:
-            case Op::Specular:
-            case Op::Phong:
-                lights_.push_back(inst.imm);
-                break;
-            default:
-                break;
-        }
-    }
-    for (std::vector<int>* v : {&params_, &lights_}) {
-        std::sort(v->begin(), v->end());
-        v->erase(std::unique(v->begin(), v->end()), v->end());
-    }
+    const UniformsRead read = uniformsRead(staticPart);
+    time_ = read.time;
+    params_ = read.paramFloats;
+    lights_ = read.lights;
 }
 
 size_t StaticInputs::size() const {

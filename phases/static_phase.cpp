@@ -12,7 +12,9 @@
 
 #include "phases/fixed_point_warp.h"
 #include "scene/variability.h"
+#include "shadermaps/tile_store.h"
 #include "shading/builtins.h"
+#include "shading/program_digest.h"
 #include "shading/shading_batch.h"
 
 namespace mpshade {
@@ -163,6 +165,16 @@ double StaticPhase::combinedFacets(size_t object, const ObjectState& state,
 }
 
 namespace {
+
+// A channel's name in a stored map's description: its variable and component ("Cd[1]"),
+// or, for a temporary, its operation, source position and component ("mul@14:33[0]").
+std::string channelName(const ChannelInfo& c) {
+    if (!c.name.empty()) return c.name;
+    std::string name =
+        std::string(opName(c.op)) + "@" + std::to_string(c.line) + ":" + std::to_string(c.column);
+    if (c.component >= 0) name += "[" + std::to_string(c.component) + "]";
+    return name;
+}
 
 // The diced surface's positions, facets and chart points moved into `mesh` (the facets'
 // position indices through the welded positions).
@@ -330,7 +342,43 @@ std::shared_ptr<ShaderMap> StaticPhase::makeShaderMap(size_t index,
     mapOptions.halfPrecision = mapOptions.halfPrecision || sceneObject.shadermapHalf;
     return std::make_shared<ShaderMap>(
         *sceneObject.surface, *obj.staticKernel, uniforms, mapOptions,
-        pools_.forTileBytes(ShaderMap::tileBytesFor(mapOptions, static_cast<int>(channels))));
+        pools_.forTileBytes(ShaderMap::tileBytesFor(mapOptions, static_cast<int>(channels))),
+        storedTiles(index, uniforms, mapOptions));
+}
+
+// Everything a tile's texels depend on (tile_store.h): the static program and the uniform
+// values it reads, the surface, and the map's layout. Objects whose geometry has no digest
+// (made in code, not loaded) are not stored.
+StoredTiles StaticPhase::storedTiles(size_t index, const ShadingUniforms& uniforms,
+                                     const ShaderMapOptions& map) const {
+    const SceneObject& sceneObject = scene_.objects[index];
+    if (!options_.store || sceneObject.geometryDigest == Digest128{}) return {};
+    const IrProgram& program = objects_[index]->staticKernel->program();
+    ContentHasher hasher;
+    hasher.addString("mpshade shader map");
+    addProgram(hasher, program);
+    addUniformsRead(hasher, program, uniforms);
+    hasher.addDigest(sceneObject.geometryDigest)
+        .addI32(map.resolution)
+        .addI32(map.tileSize)
+        .addI32(map.border)
+        .addI32(map.halfPrecision)
+        .addI32(static_cast<int32_t>(map.prefilter))
+        .addI32(map.supersampleLimit)
+        .addI32(map.seamless);
+    StoredTiles stored{options_.store, hasher.finish()};
+    StoredMapInfo info;
+    info.object = sceneObject.name;
+    info.shader = sceneObject.shaderName;
+    for (const ChannelInfo& c : objects_[index]->factored.channels)
+        info.channelNames.push_back(channelName(c));
+    info.charts = chartCount(*sceneObject.surface);
+    info.resolution = map.resolution;
+    info.tileSize = map.tileSize;
+    info.border = map.border;
+    info.halfPrecision = map.halfPrecision;
+    options_.store->useMap(stored.digest, info);
+    return stored;
 }
 
 void StaticPhase::fill(std::span<const TileRequest> requests,
@@ -339,6 +387,7 @@ void StaticPhase::fill(std::span<const TileRequest> requests,
     if (timing) {
         timing->objectSeconds.resize(objects_.size(), 0.0);
         timing->objectInstructions.resize(objects_.size(), 0);
+        timing->objectTilesLoaded.resize(objects_.size(), 0);
     }
     if (requests.empty()) return;
     const auto start = Clock::now();
@@ -373,9 +422,11 @@ void StaticPhase::fill(std::span<const TileRequest> requests,
         for (const Work& w : work) timing->objectSeconds[w.object] += w.seconds;
     for (size_t w = 0; w < work.size(); ++w) {
         costs.addFill(done[w], work[w].instructionsPerRun);
-        if (timing)
+        if (timing) {
             timing->objectInstructions[work[w].object] +=
                 done[w].programRuns * work[w].instructionsPerRun;
+            timing->objectTilesLoaded[work[w].object] += done[w].tilesLoaded;
+        }
     }
     costs.seconds += std::chrono::duration<double>(Clock::now() - start).count();
 }

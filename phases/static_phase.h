@@ -26,6 +26,9 @@ struct StaticPhaseOptions {
     // The separate representation: within 1/4 pixel of the surface over the range.
     DicingOptions separateDicing = {DicingTarget::Flatness, 0.5f, 0.25f, true};
     ShaderMapOptions shaderMap;  // resolution: capped per object by the scene
+    // Where shader-map tiles are kept between runs (shadermaps/tile_store.h); null: nowhere,
+    // every tile is filled by the static shader.
+    std::shared_ptr<TileStore> store;
 };
 
 // One object's shading, as both phases need it, fixed for the whole render.
@@ -55,10 +58,12 @@ struct StaticCosts {
     double seconds = 0.0;
     uint64_t instructions = 0;  // static shader instructions, times lanes
     uint64_t tilesFilled = 0, tilesFromChildren = 0, texelsFilled = 0, programRuns = 0;
+    uint64_t tilesLoaded = 0;  // read from the store instead of filled
 
     // A map's fill, whose static program costs `instructionsPerRun` per evaluation.
     void addFill(const FillStats& f, uint64_t instructionsPerRun) {
         tilesFilled += f.tiles;
+        tilesLoaded += f.tilesLoaded;
         tilesFromChildren += f.tilesFromChildren;
         texelsFilled += f.texels;
         programRuns += f.programRuns;
@@ -69,6 +74,7 @@ struct StaticCosts {
         seconds += o.seconds;
         instructions += o.instructions;
         tilesFilled += o.tilesFilled;
+        tilesLoaded += o.tilesLoaded;
         tilesFromChildren += o.tilesFromChildren;
         texelsFilled += o.texelsFilled;
         programRuns += o.programRuns;
@@ -84,6 +90,7 @@ struct FillTiming {
     int64_t frame = -1;
     std::vector<double> objectSeconds;
     std::vector<uint64_t> objectInstructions;
+    std::vector<uint64_t> objectTilesLoaded;  // tiles read from the store
 };
 
 class StaticPhase {
@@ -119,6 +126,8 @@ class StaticPhase {
   private:
     static DicingView dicingView(const ObjectState& state, const CameraState& camera);
     std::shared_ptr<ShaderMap> makeShaderMap(size_t index, const ShadingUniforms& uniforms) const;
+    StoredTiles storedTiles(size_t index, const ShadingUniforms& uniforms,
+                            const ShaderMapOptions& map) const;
 
     const Scene& scene_;
     const SceneResources& resources_;

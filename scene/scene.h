@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "geometry/content_digest.h"
 #include "geometry/surface.h"
 #include "scene/animation.h"
 #include "shading/ast.h"
@@ -88,6 +89,9 @@ struct SceneObject {
     std::string name;
     std::string geometryType;  // scene-format name
     std::shared_ptr<const Surface> surface;
+    // What the surface is made from: its type, its numbers and the bytes of its file, so
+    // equal digests mean equal surfaces (the shader-map store keys tiles with it).
+    Digest128 geometryDigest;
     std::string shaderName;
     std::shared_ptr<const ShaderAst> shader;
     std::vector<ParamValue> params;  // only the parameters the scene binds

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "geometry/content_digest.h"
 #include "scene/json_reader.h"
 #include "scene/scene.h"
 #include "scene/variability.h"
@@ -305,10 +306,21 @@ class SceneLoader {
         return buf;
     }
 
-    std::shared_ptr<const Surface> surfaceFor(const std::string& key, auto make) {
+    // `shape` says the type and its numbers; `file`, if any, holds the rest, and its bytes
+    // (not its name) enter the digest, so an edited file gives a new one.
+    std::shared_ptr<const Surface> surfaceFor(const std::string& shape, const std::string& file,
+                                              auto make) {
+        const std::string key = shape + ":" + file;
         auto it = surfaces_.find(key);
-        if (it != surfaces_.end()) return it->second;
+        if (it != surfaces_.end()) {
+            digest_ = digests_[key];
+            return it->second;
+        }
         auto surface = std::make_shared<const Surface>(make());
+        ContentHasher hasher;
+        hasher.addString(shape);
+        if (!file.empty()) hasher.addDigest(digestFile(file));
+        digest_ = digests_[key] = hasher.finish();
         surfaces_[key] = surface;
         return surface;
     }
@@ -319,7 +331,7 @@ class SceneLoader {
         if (type == "sphere") {
             g.allowKeys({"type", "radius"});
             const float radius = static_cast<float>(lengthOf(g["radius"]));
-            return surfaceFor("sphere:" + exactKey(radius),
+            return surfaceFor("sphere:" + exactKey(radius), "",
                               [&] { return Surface(Sphere{radius}); });
         }
         if (type == "torus") {
@@ -328,7 +340,7 @@ class SceneLoader {
             const float minor = static_cast<float>(lengthOf(g["minor"]));
             if (!(minor < major))
                 g["minor"].fail("minor must be smaller than major (a self-intersecting torus)");
-            return surfaceFor("torus:" + exactKey(major) + ":" + exactKey(minor), [&] {
+            return surfaceFor("torus:" + exactKey(major) + ":" + exactKey(minor), "", [&] {
                 return Surface(Torus{major, minor});
             });
         }
@@ -338,14 +350,14 @@ class SceneLoader {
             if (!size.isArray() || size.size() != 2) size.fail("expected [width, depth]");
             const float w = static_cast<float>(lengthOf(size.at(0))),
                         d = static_cast<float>(lengthOf(size.at(1)));
-            return surfaceFor("plane:" + exactKey(w) + ":" + exactKey(d), [&] {
+            return surfaceFor("plane:" + exactKey(w) + ":" + exactKey(d), "", [&] {
                 return Surface(Plane{w, d});
             });
         }
         if (type == "bezier") {
             g.allowKeys({"type", "file"});
             const std::string file = existingFile(g["file"]);
-            return surfaceFor("bezier:" + file, [&] { return Surface(loadBezierPatches(file)); });
+            return surfaceFor("bezier", file, [&] { return Surface(loadBezierPatches(file)); });
         }
         if (type == "subdiv") {
             g.allowKeys({"type", "file", "scheme"});
@@ -358,20 +370,20 @@ class SceneLoader {
                 else if (name != "catmark")
                     s->fail("unknown scheme '" + name + "' (expected catmark or loop)");
             }
-            return surfaceFor(
-                "subdiv:" + std::to_string(static_cast<int>(scheme)) + ":" + file,
-                [&] { return Surface(SubdivSurface(loadObjCage(file), scheme, file)); });
+            return surfaceFor("subdiv:" + std::to_string(static_cast<int>(scheme)), file, [&] {
+                return Surface(SubdivSurface(loadObjCage(file), scheme, file));
+            });
         }
         if (type == "mesh") {
             g.allowKeys({"type", "file"});
             const std::string file = existingFile(g["file"]);
-            return surfaceFor("mesh:" + file,
+            return surfaceFor("mesh", file,
                               [&] { return Surface(PolygonMesh(readObjPolygons(file))); });
         }
         if (type == "points") {
             g.allowKeys({"type", "file"});
             const std::string file = existingFile(g["file"]);
-            return surfaceFor("points:" + file, [&] { return Surface(loadPointCloud(file)); });
+            return surfaceFor("points", file, [&] { return Surface(loadPointCloud(file)); });
         }
         g["type"].fail("unknown geometry type '" + type +
                        "' (expected sphere, torus, plane, bezier, subdiv, mesh or points)");
@@ -432,6 +444,7 @@ class SceneLoader {
                 o["name"].fail("another object is already named '" + obj.name + "'");
         obj.surface =
             withContext(o["geometry"], [&] { return geometry(o["geometry"], obj.geometryType); });
+        obj.geometryDigest = digest_;
         {
             const Bounds3 b = surfaceBounds(*obj.surface);
             for (int c = 0; c < 3; ++c)
@@ -534,6 +547,8 @@ class SceneLoader {
     fs::path dir_;
     Scene scene_;
     std::map<std::string, std::shared_ptr<const Surface>> surfaces_;
+    std::map<std::string, Digest128> digests_;
+    Digest128 digest_;  // the last geometry()'s
 };
 
 }  // namespace

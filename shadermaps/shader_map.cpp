@@ -12,6 +12,7 @@
 #include "geometry/error.h"
 #include "geometry/ray_scene.h"
 #include "shadermaps/half_float.h"
+#include "shadermaps/tile_store.h"
 
 namespace mpshade {
 namespace {
@@ -35,13 +36,14 @@ size_t ShaderMap::tileBytesFor(const ShaderMapOptions& options, int channels) {
 
 ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
                      const ShadingUniforms& uniforms, const ShaderMapOptions& options,
-                     std::shared_ptr<TilePool> pool)
+                     std::shared_ptr<TilePool> pool, StoredTiles stored)
     : surface_(surface),
       kernel_(staticPart),
       params_(uniforms.params.begin(), uniforms.params.end()),
       lights_(uniforms.lights.begin(), uniforms.lights.end()),
       uniforms_(uniforms),
-      options_(options) {
+      options_(options),
+      stored_(std::move(stored)) {
     uniforms_.params = params_;
     uniforms_.lights = lights_;
     MPSHADE_CHECK(options.resolution > 0 && (options.resolution & (options.resolution - 1)) == 0 &&
@@ -288,6 +290,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
                (1 << std::min(level, 20)) <= options_.supersampleLimit;
     };
     uint64_t abandonedTiles = 0;  // whole, but in a pass dropped
+    uint64_t loadedTiles = 0;     // read from the store, in passes published
     tbb::enumerable_thread_specific<FillScratch> scratch;
     for (size_t begin = 0; begin < work.size();) {
         size_t end = begin;
@@ -318,26 +321,39 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
         PendingTiles pending;
         for (size_t w = begin; w < end; ++w)
             pending.emplace(work[w].packed(), plan[w - begin].first);
-        std::atomic<uint64_t> whole{0};
+        std::atomic<uint64_t> whole{0}, loaded{0};
+        std::vector<uint8_t> fromStore(end - begin, 0);
         tbb::parallel_for(begin, end, [&](size_t w) {
             enableFlushToZero();
             FillScratch& s = scratch.local();
-            if (fillTile(work[w], plan[w - begin].first, plan[w - begin].second, pending, s.batch,
-                         s.points, s.geometry, s.workspace, s.stats, abandon))
+            const int slot = plan[w - begin].first;
+            if (stored_.store && stored_.store->read(stored_.digest, work[w].packed(),
+                                                     {tileData(slot), tileBytes()})) {
+                fromStore[w - begin] = 1;
+                loaded.fetch_add(1, std::memory_order_relaxed);
+                whole.fetch_add(1, std::memory_order_relaxed);
+                return;
+            }
+            if (fillTile(work[w], slot, plan[w - begin].second, pending, s.batch, s.points,
+                         s.geometry, s.workspace, s.stats, abandon))
                 whole.fetch_add(1, std::memory_order_relaxed);
         });
         if (whole.load() < end - begin) {
             // Abandoned: none of the pass is published, so no probe can hold its slots.
             for (size_t w = begin; w < end; ++w) pool_->free(plan[w - begin].first);
-            abandonedTiles += whole.load();
+            abandonedTiles += whole.load() - loaded.load();
             break;
         }
+        loadedTiles += loaded.load();
         // A texel is the same wherever it is evaluated (the program sees only its chart
         // point), so borders inside the chart come from the neighbouring tile when that is
-        // resident: a 16 x 16 tile with a 1-texel border evaluates 256 texels, not 324.
+        // resident: a 16 x 16 tile with a 1-texel border evaluates 256 texels, not 324. A
+        // stored tile came whole. A filled one is stored once whole.
         tbb::parallel_for(begin, end, [&](size_t w) {
+            if (fromStore[w - begin]) return;
             copyBorders(work[w], plan[w - begin].first, pending, scratch.local().stats);
         });
+        if (stored_.store) storeFilled(work, begin, end, plan, fromStore);
         for (size_t w = begin; w < end; ++w) table_.insert(work[w].packed(), plan[w - begin].first);
         residentTiles_.fetch_add(end - begin, std::memory_order_relaxed);
         begin = end;
@@ -345,8 +361,22 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
     FillStats done;
     for (const FillScratch& s : scratch) done += s.stats;
     done.tiles -= abandonedTiles;
+    done.tilesLoaded = loadedTiles;
     fillStats_ += done;
     return done;
+}
+
+void ShaderMap::storeFilled(std::span<const TileKey> work, size_t begin, size_t end,
+                            std::span<const std::pair<int, bool>> plan,
+                            std::span<const uint8_t> fromStore) {
+    std::vector<uint64_t> keys;
+    std::vector<const unsigned char*> tiles;
+    for (size_t w = begin; w < end; ++w)
+        if (!fromStore[w - begin]) {
+            keys.push_back(work[w].packed());
+            tiles.push_back(tileData(plan[w - begin].first));
+        }
+    stored_.store->write(stored_.digest, keys, tiles, tileBytes());
 }
 
 void ShaderMap::evict(uint64_t key) {

@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "geometry/chart_adjacency.h"
+#include "geometry/content_digest.h"
 #include "geometry/surface.h"
 #include "shadermaps/tile_pool.h"
 #include "shadermaps/tile_table.h"
@@ -88,7 +89,8 @@ struct TileKey {
 };
 
 struct FillStats {
-    uint64_t tiles = 0;
+    uint64_t tiles = 0;              // evaluated (or built from children)
+    uint64_t tilesLoaded = 0;        // read from the store instead (tile_store.h)
     uint64_t tilesFromChildren = 0;  // of tiles: built from the four tiles of the level below
     uint64_t texels = 0;
     uint64_t programRuns = 0;   // static program evaluations (texels x supersamples)
@@ -96,6 +98,7 @@ struct FillStats {
 
     FillStats& operator+=(const FillStats& o) {
         tiles += o.tiles;
+        tilesLoaded += o.tilesLoaded;
         tilesFromChildren += o.tilesFromChildren;
         texels += o.texels;
         programRuns += o.programRuns;
@@ -104,15 +107,25 @@ struct FillStats {
     }
 };
 
+class TileStore;
+
+// Where a map's tiles are kept between runs (tile_store.h): a tile is looked up there before
+// it is filled, and written there once filled.
+struct StoredTiles {
+    std::shared_ptr<TileStore> store;  // null: nowhere
+    Digest128 digest;                  // the map's content digest (see tile_store.h)
+};
+
 class ShaderMap {
   public:
     // `staticPart` computes the channels (its channelOutputs); `uniforms` are the static
     // phase's (representative) values, copied. The surface and kernel must outlive the map.
     // `pool` holds the tiles (shared with other maps of the same tile size); null: a pool of
-    // its own. Its tileBytes() must be this map's: see tileBytesFor().
+    // its own. Its tileBytes() must be this map's: see tileBytesFor(). `stored`: where tiles
+    // are kept between runs, the pinned levels filled at construction included.
     ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
               const ShadingUniforms& uniforms, const ShaderMapOptions& options = {},
-              std::shared_ptr<TilePool> pool = nullptr);
+              std::shared_ptr<TilePool> pool = nullptr, StoredTiles stored = {});
     ~ShaderMap();
     ShaderMap(const ShaderMap&) = delete;
     ShaderMap& operator=(const ShaderMap&) = delete;
@@ -217,6 +230,11 @@ class ShaderMap {
     // it must be evaluated (no such tile resident, or beyond the chart's edge).
     int neighbourSlot(const Neighbours& around, const TileKey& key, int i, int j) const;
     void copyBorders(const TileKey& key, int slot, const PendingTiles& pending, FillStats& stats);
+    // Queues a pass's filled tiles (work[begin, end) with their plan, those not read from
+    // the store) to be written to it, as one pack.
+    void storeFilled(std::span<const TileKey> work, size_t begin, size_t end,
+                     std::span<const std::pair<int, bool>> plan,
+                     std::span<const uint8_t> fromStore);
 
     const Surface& surface_;
     std::unique_ptr<ChartAdjacency> adjacency_;
@@ -234,6 +252,7 @@ class ShaderMap {
     std::shared_ptr<TilePool> pool_;  // tile storage
     std::atomic<size_t> residentTiles_{0};
     std::atomic<uint32_t> useStamp_{0};
+    StoredTiles stored_;
     FillStats fillStats_;
     std::mutex fillMutex_;
 };

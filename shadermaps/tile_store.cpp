@@ -1,0 +1,506 @@
+#include "shadermaps/tile_store.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/uio.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "geometry/error.h"
+
+namespace mpshade {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr char kTileMagic[8] = {'M', 'P', 'S', 'T', 'I', 'L', 'E', '1'};
+constexpr char kPackMagic[8] = {'M', 'P', 'S', 'P', 'A', 'C', 'K', '1'};
+
+struct TileHeader {
+    char magic[8];
+    uint64_t mapHigh, mapLow, key, payloadBytes, checksum;
+};
+static_assert(sizeof(TileHeader) == 48);
+
+struct IndexEntry {
+    uint64_t key, offset;
+};
+static_assert(sizeof(IndexEntry) == 16);
+
+struct PackFooter {
+    char magic[8];
+    uint64_t count, indexOffset, indexChecksum;
+};
+static_assert(sizeof(PackFooter) == 32);
+
+// Packs a reader keeps open at most; beyond, a read opens and closes its pack.
+constexpr int kOpenPacks = 256;
+std::atomic<int> openPacks{0};
+
+// A name in the same folder (so the rename stays on one file system) that no other writer,
+// in this process or another, on this machine or another, picks.
+std::string uniqueName() {
+    static std::atomic<uint64_t> counter{0};
+    char host[64] = "host";
+    ::gethostname(host, sizeof host - 1);
+    host[sizeof host - 1] = '\0';
+    char name[160];
+    std::snprintf(name, sizeof name, "%s.%ld.%llx.%llu", host, static_cast<long>(::getpid()),
+                  static_cast<unsigned long long>(Clock::now().time_since_epoch().count()),
+                  static_cast<unsigned long long>(counter.fetch_add(1)));
+    return name;
+}
+
+bool readAt(int fd, void* to, size_t bytes, uint64_t offset) {
+    auto* p = static_cast<unsigned char*>(to);
+    while (bytes > 0) {
+        const ssize_t got = ::pread(fd, p, bytes, static_cast<off_t>(offset));
+        if (got <= 0) return false;
+        p += got;
+        bytes -= static_cast<size_t>(got);
+        offset += static_cast<uint64_t>(got);
+    }
+    return true;
+}
+
+// Writes the pieces under a temporary name, then renames into place: readers see the whole
+// file or none.
+bool writeAtomically(const fs::path& path, std::span<const std::span<const unsigned char>> pieces) {
+    const fs::path temporary = path.string() + "." + uniqueName() + ".tmp";
+    std::FILE* f = std::fopen(temporary.c_str(), "wb");
+    if (!f) return false;
+    bool ok = true;
+    for (const auto& piece : pieces)
+        ok = ok && (piece.empty() || std::fwrite(piece.data(), 1, piece.size(), f) == piece.size());
+    ok = (std::fclose(f) == 0) && ok;
+    ok = ok && std::rename(temporary.c_str(), path.c_str()) == 0;
+    if (!ok) ::unlink(temporary.c_str());
+    return ok;
+}
+
+std::span<const unsigned char> bytesOf(const void* p, size_t n) {
+    return {static_cast<const unsigned char*>(p), n};
+}
+
+// A pack's index, checked against its footer; false if the pack is damaged.
+bool readIndex(int fd, uint64_t fileBytes, std::vector<IndexEntry>& entries) {
+    PackFooter footer{};
+    if (fileBytes < sizeof footer ||
+        !readAt(fd, &footer, sizeof footer, fileBytes - sizeof footer) ||
+        std::memcmp(footer.magic, kPackMagic, sizeof kPackMagic) != 0 ||
+        footer.count > (fileBytes / sizeof(TileHeader)) ||
+        footer.indexOffset + footer.count * sizeof(IndexEntry) + sizeof footer != fileBytes)
+        return false;
+    entries.resize(footer.count);
+    return readAt(fd, entries.data(), entries.size() * sizeof(IndexEntry), footer.indexOffset) &&
+           checksum64(entries.data(), entries.size() * sizeof(IndexEntry)) == footer.indexChecksum;
+}
+
+}  // namespace
+
+struct TileStore::Pack {
+    fs::path path;
+    fs::file_time_type written;
+    int fd = -1;  // kept open once read (at most kOpenPacks across packs)
+    ~Pack() {
+        if (fd >= 0) {
+            ::close(fd);
+            openPacks.fetch_sub(1);
+        }
+    }
+};
+
+// What a map's packs hold: per key, where its copies are, newest pack first.
+struct TileStore::MapIndex {
+    struct Copy {
+        Pack* pack;
+        uint64_t offset;
+    };
+    std::shared_mutex mutex;
+    std::map<std::string, std::unique_ptr<Pack>> packs;  // by file name
+    std::unordered_map<uint64_t, std::vector<Copy>> copies;
+    fs::file_time_type folderTime{};
+    Clock::time_point scanned{};
+
+    void add(Pack* pack, std::span<const IndexEntry> entries) {
+        for (const IndexEntry& e : entries) {
+            std::vector<Copy>& c = copies[e.key];
+            c.push_back({pack, e.offset});
+            std::stable_sort(c.begin(), c.end(), [](const Copy& a, const Copy& b) {
+                return a.pack->written > b.pack->written;
+            });
+        }
+    }
+};
+
+fs::path defaultStoreFolder() {
+    if (const char* s = std::getenv("MPSHADE_STORE"); s && *s) return s;
+    if (const char* c = std::getenv("XDG_CACHE_HOME"); c && *c)
+        return fs::path(c) / "mpshade" / "store";
+    if (const char* h = std::getenv("HOME"); h && *h)
+        return fs::path(h) / ".cache" / "mpshade" / "store";
+    return {};
+}
+
+TileStore::TileStore(fs::path root) : root_(std::move(root)) {
+    std::error_code ec;
+    fs::create_directories(root_ / kTilesFolder, ec);
+    if (ec || !fs::is_directory(root_ / kTilesFolder))
+        throw InputError({root_.string(), 0, 0, ""},
+                         "cannot use this folder as a shader-map store (" +
+                             (ec ? ec.message() : "not a folder") + ")");
+}
+
+TileStore::~TileStore() {
+    {
+        std::unique_lock<std::mutex> lock(queueMutex_);
+        queueChanged_.wait(lock, [&] { return queue_.empty() && !writing_; });
+        stopping_ = true;
+    }
+    queueChanged_.notify_all();
+    if (writer_.joinable()) writer_.join();
+}
+
+fs::path TileStore::mapFolder(const Digest128& map) const {
+    return root_ / kTilesFolder / map.hex();
+}
+
+void TileStore::warnOnce(const std::string& message) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (warned_) return;
+    warned_ = true;
+    std::fprintf(stderr,
+                 "mpshade: warning: shader-map store %s: %s; going on without writing to it\n",
+                 root_.c_str(), message.c_str());
+}
+
+// Adds the packs not seen yet; a pack whose index is damaged is removed.
+void TileStore::scan(const Digest128& map, MapIndex& index) {
+    std::error_code ec;
+    const fs::path folder = mapFolder(map);
+    index.folderTime = fs::last_write_time(folder, ec);
+    index.scanned = Clock::now();
+    for (const fs::directory_entry& f : fs::directory_iterator(folder, ec)) {
+        const std::string name = f.path().filename().string();
+        if (f.path().extension() != ".pack" || index.packs.count(name)) continue;
+        const int fd = ::open(f.path().c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd < 0) continue;  // removed meanwhile
+        struct stat st {};
+        std::vector<IndexEntry> entries;
+        if (::fstat(fd, &st) != 0 || !readIndex(fd, static_cast<uint64_t>(st.st_size), entries)) {
+            ::close(fd);
+            counters_.damaged.fetch_add(1, std::memory_order_relaxed);
+            ::unlink(f.path().c_str());
+            continue;
+        }
+        auto pack = std::make_unique<Pack>();
+        pack->path = f.path();
+        pack->written = f.last_write_time(ec);
+        if (openPacks.fetch_add(1) < kOpenPacks) {
+            pack->fd = fd;
+        } else {
+            openPacks.fetch_sub(1);
+            ::close(fd);
+        }
+        index.add(pack.get(), entries);
+        index.packs.emplace(name, std::move(pack));
+    }
+}
+
+std::shared_ptr<TileStore::MapIndex> TileStore::indexOf(const Digest128& map, bool rescan) {
+    std::shared_ptr<MapIndex> index;
+    bool fresh = false;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        std::shared_ptr<MapIndex>& slot = indices_[map.hex()];
+        if (!slot) {
+            slot = std::make_shared<MapIndex>();
+            fresh = true;
+        }
+        index = slot;
+    }
+    std::unique_lock<std::shared_mutex> lock(index->mutex, std::defer_lock);
+    if (fresh) {
+        lock.lock();
+        scan(map, *index);
+    } else if (rescan) {
+        // Another process's packs: looked for when a tile is missing, at most twice a
+        // second, and only if the folder changed (this process's own are added as written).
+        lock.lock();
+        std::error_code ec;
+        if (Clock::now() - index->scanned > std::chrono::milliseconds(500) &&
+            fs::last_write_time(mapFolder(map), ec) != index->folderTime)
+            scan(map, *index);
+    }
+    return index;
+}
+
+bool TileStore::read(const Digest128& map, uint64_t key, std::span<unsigned char> out) {
+    for (int attempt = 0; attempt < 2; ++attempt) {
+        const std::shared_ptr<MapIndex> index = indexOf(map, attempt > 0);
+        // The newest few copies (two processes that filled a tile at once each wrote one).
+        std::array<MapIndex::Copy, 4> copies;
+        size_t count = 0;
+        {
+            std::shared_lock<std::shared_mutex> lock(index->mutex);
+            const auto it = index->copies.find(key);
+            if (it != index->copies.end())
+                for (const MapIndex::Copy& c : it->second)
+                    if (count < copies.size()) copies[count++] = c;
+        }
+        for (size_t k = 0; k < count; ++k) {
+            const MapIndex::Copy& copy = copies[k];
+            int fd = copy.pack->fd;
+            const bool transient = fd < 0;
+            if (transient) fd = ::open(copy.pack->path.c_str(), O_RDONLY | O_CLOEXEC);
+            if (fd < 0) continue;  // removed by a clean-up: another copy, or missing
+            TileHeader header{};
+            iovec parts[2] = {{&header, sizeof header}, {out.data(), out.size()}};
+            const ssize_t got = ::preadv(fd, parts, 2, static_cast<off_t>(copy.offset));
+            if (transient) ::close(fd);
+            if (got == static_cast<ssize_t>(sizeof header + out.size()) &&
+                std::memcmp(header.magic, kTileMagic, sizeof kTileMagic) == 0 &&
+                header.mapHigh == map.high && header.mapLow == map.low && header.key == key &&
+                header.payloadBytes == out.size() &&
+                checksum64(out.data(), out.size()) == header.checksum) {
+                counters_.loaded.fetch_add(1, std::memory_order_relaxed);
+                return true;
+            }
+            // Damaged (a disk error) or of another size: never read.
+            counters_.damaged.fetch_add(1, std::memory_order_relaxed);
+        }
+        if (count > 0) break;  // every copy damaged: filled again
+    }
+    counters_.absent.fetch_add(1, std::memory_order_relaxed);
+    return false;
+}
+
+std::vector<uint64_t> TileStore::storedKeys(const Digest128& map) {
+    const std::shared_ptr<MapIndex> index = indexOf(map, false);
+    std::shared_lock<std::shared_mutex> lock(index->mutex);
+    std::vector<uint64_t> keys;
+    for (const auto& [key, copies] : index->copies) keys.push_back(key);
+    std::sort(keys.begin(), keys.end());
+    return keys;
+}
+
+void TileStore::write(const Digest128& map, std::span<const uint64_t> keys,
+                      std::span<const unsigned char* const> tiles, size_t tileBytes) {
+    if (readOnly_.load(std::memory_order_relaxed) || keys.empty()) return;
+    PendingPack pack{map, {keys.begin(), keys.end()}, {}, tileBytes};
+    pack.bytes.resize(keys.size() * tileBytes);
+    for (size_t i = 0; i < keys.size(); ++i)
+        std::memcpy(pack.bytes.data() + i * tileBytes, tiles[i], tileBytes);
+    const size_t size = pack.bytes.size();
+    std::unique_lock<std::mutex> lock(queueMutex_);
+    if (!writer_.joinable()) writer_ = std::thread([this] { writerLoop(); });
+    queueChanged_.wait(lock, [&] { return queuedBytes_ + size <= kQueueBytes || queue_.empty(); });
+    queuedBytes_ += size;
+    queue_.push_back(std::move(pack));
+    lock.unlock();
+    queueChanged_.notify_all();
+}
+
+void TileStore::flush() {
+    std::unique_lock<std::mutex> lock(queueMutex_);
+    queueChanged_.wait(lock, [&] { return queue_.empty() && !writing_; });
+}
+
+void TileStore::writerLoop() {
+    std::unique_lock<std::mutex> lock(queueMutex_);
+    for (;;) {
+        queueChanged_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+        if (queue_.empty()) return;  // stopping
+        PendingPack pack = std::move(queue_.front());
+        queue_.pop_front();
+        size_t taken = pack.bytes.size();
+        // Packs of the same map queued behind it go in the same file.
+        while (!queue_.empty() && queue_.front().map == pack.map &&
+               queue_.front().tileBytes == pack.tileBytes &&
+               pack.bytes.size() < (size_t{32} << 20)) {
+            PendingPack& next = queue_.front();
+            pack.keys.insert(pack.keys.end(), next.keys.begin(), next.keys.end());
+            pack.bytes.insert(pack.bytes.end(), next.bytes.begin(), next.bytes.end());
+            taken += next.bytes.size();
+            queue_.pop_front();
+        }
+        writing_ = true;
+        lock.unlock();
+        writeNow(pack);
+        lock.lock();
+        writing_ = false;
+        queuedBytes_ -= taken;
+        queueChanged_.notify_all();
+    }
+}
+
+void TileStore::writeNow(const PendingPack& pack) {
+    if (readOnly_.load(std::memory_order_relaxed)) return;
+    const size_t n = pack.keys.size();
+    std::vector<TileHeader> headers(n);
+    std::vector<IndexEntry> entries(n);
+    uint64_t offset = 0;
+    for (size_t i = 0; i < n; ++i) {
+        TileHeader& h = headers[i];
+        std::memcpy(h.magic, kTileMagic, sizeof kTileMagic);
+        h.mapHigh = pack.map.high;
+        h.mapLow = pack.map.low;
+        h.key = pack.keys[i];
+        h.payloadBytes = pack.tileBytes;
+        h.checksum = checksum64(pack.bytes.data() + i * pack.tileBytes, pack.tileBytes);
+        entries[i] = {pack.keys[i], offset};
+        offset += sizeof(TileHeader) + pack.tileBytes;
+    }
+    PackFooter footer{};
+    std::memcpy(footer.magic, kPackMagic, sizeof kPackMagic);
+    footer.count = n;
+    footer.indexOffset = offset;
+    footer.indexChecksum = checksum64(entries.data(), n * sizeof(IndexEntry));
+    std::vector<std::span<const unsigned char>> pieces;
+    for (size_t i = 0; i < n; ++i) {
+        pieces.push_back(bytesOf(&headers[i], sizeof(TileHeader)));
+        pieces.push_back(bytesOf(pack.bytes.data() + i * pack.tileBytes, pack.tileBytes));
+    }
+    pieces.push_back(bytesOf(entries.data(), n * sizeof(IndexEntry)));
+    pieces.push_back(bytesOf(&footer, sizeof footer));
+
+    const fs::path folder = mapFolder(pack.map);
+    const fs::path path = folder / (uniqueName() + ".pack");
+    bool ok = writeAtomically(path, pieces);
+    if (!ok) {
+        // The map's folder may have been removed by a clean-up in another process.
+        std::error_code ec;
+        fs::create_directories(folder, ec);
+        ok = !ec && writeAtomically(path, pieces);
+    }
+    if (!ok) {
+        counters_.writeFailures.fetch_add(1, std::memory_order_relaxed);
+        readOnly_.store(true);
+        warnOnce("cannot write " + path.string() + ": " + std::strerror(errno));
+        return;
+    }
+    counters_.written.fetch_add(n, std::memory_order_relaxed);
+    counters_.packsWritten.fetch_add(1, std::memory_order_relaxed);
+    // Readers in this process find the pack at once.
+    std::shared_ptr<MapIndex> index;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        const auto it = indices_.find(pack.map.hex());
+        if (it != indices_.end()) index = it->second;
+    }
+    if (!index) return;
+    std::unique_lock<std::shared_mutex> lock(index->mutex);
+    const std::string name = path.filename().string();
+    if (index->packs.count(name)) return;
+    auto p = std::make_unique<Pack>();
+    p->path = path;
+    std::error_code ec;
+    p->written = fs::last_write_time(path, ec);
+    index->add(p.get(), entries);
+    index->packs.emplace(name, std::move(p));
+}
+
+void TileStore::useMap(const Digest128& map, const StoredMapInfo& info) {
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!used_.emplace(map.hex(), true).second) return;
+    }
+    const fs::path folder = mapFolder(map);
+    std::error_code ec;
+    fs::create_directories(folder, ec);
+    if (!fs::exists(folder / "map.json", ec)) {
+        const nlohmann::json j = {{"object", info.object},         {"shader", info.shader},
+                                  {"channels", info.channelNames}, {"charts", info.charts},
+                                  {"resolution", info.resolution}, {"tile_size", info.tileSize},
+                                  {"border", info.border},         {"half", info.halfPrecision}};
+        const std::string text = j.dump(1) + "\n";
+        const std::span<const unsigned char> piece = bytesOf(text.data(), text.size());
+        writeAtomically(folder / "map.json", {&piece, 1});
+    }
+    // The map's last use, for clean-up by least recent use.
+    std::FILE* f = std::fopen((folder / "used").c_str(), "wb");
+    if (f) std::fclose(f);
+    fs::last_write_time(folder / "used", fs::file_time_type::clock::now(), ec);
+}
+
+std::vector<StoredMapSummary> TileStore::maps() const {
+    std::vector<StoredMapSummary> out;
+    std::error_code ec;
+    for (const fs::directory_entry& folder : fs::directory_iterator(root_ / kTilesFolder, ec)) {
+        StoredMapSummary m;
+        if (!folder.is_directory(ec) ||
+            !Digest128::fromHex(folder.path().filename().string(), m.digest))
+            continue;
+        for (const fs::directory_entry& f : fs::directory_iterator(folder.path(), ec)) {
+            if (f.path().extension() != ".pack") continue;
+            const uint64_t size = f.file_size(ec);
+            ++m.packs;
+            m.bytes += size;
+            const int fd = ::open(f.path().c_str(), O_RDONLY | O_CLOEXEC);
+            PackFooter footer{};
+            if (fd >= 0 && size >= sizeof footer &&
+                readAt(fd, &footer, sizeof footer, size - sizeof footer) &&
+                std::memcmp(footer.magic, kPackMagic, sizeof kPackMagic) == 0)
+                m.tiles += footer.count;
+            if (fd >= 0) ::close(fd);
+        }
+        m.lastUsed = fs::last_write_time(folder.path() / "used", ec);
+        if (ec) m.lastUsed = fs::last_write_time(folder.path(), ec);
+        std::ifstream in(folder.path() / "map.json");
+        const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+        if (j.is_object()) {
+            m.info.object = j.value("object", "");
+            m.info.shader = j.value("shader", "");
+            m.info.channelNames = j.value("channels", std::vector<std::string>{});
+            m.info.charts = j.value("charts", 0);
+            m.info.resolution = j.value("resolution", 0);
+            m.info.tileSize = j.value("tile_size", 0);
+            m.info.border = j.value("border", 0);
+            m.info.halfPrecision = j.value("half", false);
+        }
+        out.push_back(std::move(m));
+    }
+    std::sort(out.begin(), out.end(), [](const StoredMapSummary& a, const StoredMapSummary& b) {
+        return a.lastUsed < b.lastUsed;
+    });
+    return out;
+}
+
+uint64_t TileStore::bytes() const {
+    uint64_t total = 0;
+    for (const StoredMapSummary& m : maps()) total += m.bytes;
+    return total;
+}
+
+uint64_t TileStore::gc(uint64_t budgetBytes) {
+    const std::vector<StoredMapSummary> all = maps();
+    uint64_t total = 0, removed = 0;
+    for (const StoredMapSummary& m : all) total += m.bytes;
+    std::error_code ec;
+    const auto stale = fs::file_time_type::clock::now() - std::chrono::hours(1);
+    for (const StoredMapSummary& m : all) {
+        const fs::path folder = mapFolder(m.digest);
+        if (total > budgetBytes) {
+            fs::remove_all(folder, ec);
+            total -= m.bytes;
+            removed += m.bytes;
+            continue;
+        }
+        for (const fs::directory_entry& f : fs::directory_iterator(folder, ec))
+            if (f.path().extension() == ".tmp" && f.last_write_time(ec) < stale)
+                fs::remove(f.path(), ec);
+    }
+    return removed;
+}
+
+}  // namespace mpshade

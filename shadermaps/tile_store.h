@@ -1,0 +1,153 @@
+// tile_store.h -- shader-map tiles kept on disk between runs and shared between processes
+// and machines (a folder on a shared file system), addressed by content: a tile is found
+// by the digest of everything its texels depend on (its map's digest: the static program,
+// the uniform values it reads, the geometry, the map's layout; static_phase.cpp) and its
+// TileKey. Any change to any of those gives another address, so a stale tile is never
+// found; a tile's texels depend on nothing else (shader_map.h: "a tile does not depend on
+// what else was resident when it was filled"), so a stored one is what filling it again
+// would give, bit for bit.
+//
+// Layout (docs/store.md): ROOT/tiles-v1/<map digest>/ holds map.json (what the map is, for
+// `store info` and `store export`), `used` (its modification time is the map's last use)
+// and packs, *.pack: the tiles one fill wrote, each a 48-byte header (magic, map digest,
+// tile key, payload size, XXH3-64 of the payload) and the tile's storage as the map holds
+// it, then an index of (key, offset) and a footer (magic, count, index offset, index
+// checksum). A pack a tile was written to disk separately had cost 60-250 us a tile in file
+// creation (the gallery's cold run +85%); a pack costs one file a map and fill.
+//
+// Concurrency: a pack is written under a name no other writer uses (host, process,
+// counter) and renamed into place whole, so readers see whole packs or none; two writers of
+// one tile write the same bytes. A reader finds the packs of a map when it first reads it
+// and again when a tile is missing and the folder has changed since. A tile whose checks
+// fail (header, size, checksum) is counted as damaged and never read; another copy (a newer
+// pack, refilled) is tried, else it is missing and filled again. A pack whose footer is
+// damaged is removed. Clean-up (gc()) removes whole maps, least recently used first.
+//
+// Writes happen on a thread of the store's own: write() copies the tiles into a queue and
+// returns, so a fill is not slowed by the disk. The queue holds at most kQueueBytes; a
+// write beyond waits for room. flush() (and the destructor) waits until every queued pack
+// is on disk.
+//
+// Errors: a store that cannot be written (a full disk, no permission) warns once on stderr
+// and goes on read-only; rendering never fails because of the store.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <span>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "geometry/content_digest.h"
+
+namespace mpshade {
+
+// What a map's tiles are made from, for reports of what a store holds.
+struct StoredMapInfo {
+    std::string object, shader;
+    std::vector<std::string> channelNames;
+    int charts = 0, resolution = 0, tileSize = 0, border = 0;
+    bool halfPrecision = false;
+};
+
+struct TileStoreCounters {
+    std::atomic<uint64_t> loaded{0}, written{0}, packsWritten{0}, absent{0}, damaged{0},
+        writeFailures{0};
+};
+
+// One map of a store, as gc() and info() see it.
+struct StoredMapSummary {
+    Digest128 digest;
+    StoredMapInfo info;
+    uint64_t tiles = 0, bytes = 0, packs = 0;
+    std::filesystem::file_time_type lastUsed;
+};
+
+class TileStore {
+  public:
+    static constexpr const char* kTilesFolder = "tiles-v1";
+    static constexpr size_t kQueueBytes = size_t{64} << 20;
+
+    // Opens (creating it if needed) the store at `root`. Throws InputError naming the folder
+    // when it cannot be made or is not a folder.
+    explicit TileStore(std::filesystem::path root);
+    ~TileStore();  // flushes
+    TileStore(const TileStore&) = delete;
+    TileStore& operator=(const TileStore&) = delete;
+
+    const std::filesystem::path& root() const { return root_; }
+
+    // Reads tile `key` (TileKey::packed()) of map `map` into `out`, whose size must be the
+    // tile's storage. True when a whole, checked tile of that size was read. Thread-safe.
+    bool read(const Digest128& map, uint64_t key, std::span<unsigned char> out);
+    // Queues tiles of map `map` to be written as one pack by the store's thread: keys[i]'s
+    // storage is tiles[i], `tileBytes` long (copied now). Failures are counted, never thrown.
+    void write(const Digest128& map, std::span<const uint64_t> keys,
+               std::span<const unsigned char* const> tiles, size_t tileBytes);
+    // Waits until every queued pack is written (or has failed).
+    void flush();
+    // Records the map's description (once per store object and map) and marks it used now.
+    void useMap(const Digest128& map, const StoredMapInfo& info);
+    // The keys of the tiles stored for `map` (each once), as the packs' indices list them.
+    std::vector<uint64_t> storedKeys(const Digest128& map);
+
+    const TileStoreCounters& counters() const { return counters_; }
+
+    // Every map in the store, by last use, oldest first.
+    std::vector<StoredMapSummary> maps() const;
+    // Removes maps, least recently used first, until the store holds at most `budgetBytes`,
+    // and temporary files older than an hour (left by a process that was killed). Returns
+    // the bytes removed. Safe while other processes use the store: a tile removed under a
+    // reader is missing to it, and filled again.
+    uint64_t gc(uint64_t budgetBytes);
+    // The bytes the store's packs take.
+    uint64_t bytes() const;
+
+  private:
+    struct Pack;
+    struct MapIndex;
+    struct PendingPack {
+        Digest128 map;
+        std::vector<uint64_t> keys;
+        std::vector<unsigned char> bytes;  // the tiles, tileBytes each, in keys' order
+        size_t tileBytes = 0;
+    };
+    std::filesystem::path mapFolder(const Digest128& map) const;
+    void warnOnce(const std::string& message);
+    // The map's index, scanned first when `rescan` and the folder changed since.
+    std::shared_ptr<MapIndex> indexOf(const Digest128& map, bool rescan);
+    void scan(const Digest128& map, MapIndex& index);
+    void writeNow(const PendingPack& pack);
+    void writerLoop();
+
+    std::filesystem::path root_;
+    TileStoreCounters counters_;
+    std::mutex mutex_;                  // guards used_, warned_ and indices_
+    std::map<std::string, bool> used_;  // maps marked used by this object
+    std::map<std::string, std::shared_ptr<MapIndex>> indices_;
+    bool warned_ = false;
+    std::atomic<bool> readOnly_{false};
+    // The write queue, guarded by queueMutex_; the writer thread starts at the first write.
+    std::mutex queueMutex_;
+    std::condition_variable queueChanged_;
+    std::deque<PendingPack> queue_;
+    size_t queuedBytes_ = 0;
+    bool writing_ = false;  // the writer holds a pack taken from the queue
+    bool stopping_ = false;
+    std::thread writer_;
+};
+
+// The store's default folder: $MPSHADE_STORE if set, else $XDG_CACHE_HOME/mpshade/store,
+// else $HOME/.cache/mpshade/store; empty when none of those is set.
+std::filesystem::path defaultStoreFolder();
+
+}  // namespace mpshade
