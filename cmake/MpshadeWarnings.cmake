@@ -36,7 +36,23 @@ endfunction()
 function(mpshade_library name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
   add_library(${name} STATIC ${ARG_SOURCES})
-  target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
   target_link_libraries(${name} PUBLIC ${ARG_DEPS})
   mpshade_target_defaults(${name})
+  mpshade_install_library(${name})
+endfunction()
+
+# mpshade_install_library(name): the include root (the source tree when built, include/mpshade
+# when installed, so headers are named "geometry/surface.h" either way), and the library and
+# its folder's headers installed as mpshade::<folder> in the exported package
+# (cmake/mpshadeConfig.cmake.in).
+function(mpshade_install_library name)
+  get_filename_component(folder ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  target_include_directories(${name} PUBLIC
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/mpshade>)
+  set_target_properties(${name} PROPERTIES EXPORT_NAME ${folder})
+  install(TARGETS ${name} EXPORT mpshadeTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/
+          DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mpshade/${folder}
+          FILES_MATCHING PATTERN "*.h")
 endfunction()

@@ -16,7 +16,7 @@ PACKAGES=(
   cmake ninja-build g++ ccache pkg-config
   libosd-dev libglm-dev libopenimageio-dev openimageio-tools libembree-dev libtbb-dev
   libgtest-dev googletest libbenchmark-dev libcli11-dev nlohmann-json3-dev libfmt-dev libxxhash-dev
-  gnuplot-nox
+  gnuplot-nox help2man
 )
 # The fuzz targets only: Clang and its libFuzzer runtime.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
