@@ -62,6 +62,10 @@ int main(int argc, char** argv) {
     renderCmd->add_flag("--skip-existing", render.skipExisting,
                         "Render no frame whose EXR and PNG are in --out already (a retried "
                         "farm task)");
+    renderCmd->add_option("--plan-frames", render.planFrames,
+                          "Plan over frames A:B (holding --frames) and render those before "
+                          "--frames first, unwritten: each frame then the bits a render of A:B "
+                          "gives (a farm's shards)");
     renderCmd->add_flag("--shard-stats", render.shardStats,
                         "Write stats_A_B.json (the frames asked for) instead of stats.json, so "
                         "shards sharing --out keep their own");

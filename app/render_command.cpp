@@ -143,6 +143,37 @@ void compareFrame(int frame, const Image& image, const FrameStats& stats,
                      stats.wallSeconds > 0 ? refStats.wallSeconds / stats.wallSeconds : 0.0);
 }
 
+// --plan-frames A:B: the frames the renderer plans over (its representations, re-runs and
+// single-phase frames), which must hold the request's [first, last); else the request's.
+void planRange(const RenderCommandOptions& options, const Scene& scene, int first, int last,
+               int& planFirst, int& planLast) {
+    if (options.planFrames.empty()) return;
+    if (options.mode != "multiphase")
+        throw InputError({"--plan-frames", 0, 0, {}},
+                         "--plan-frames plans the multi-phase renderer (the reference's frames are "
+                         "independent)");
+    parseFrameRange(options.planFrames, scene.frameCount(), planFirst, planLast, options.scene);
+    if (planFirst > first || planLast < last)
+        throw InputError({"--plan-frames", 0, 0, {}},
+                         fmt::format("must hold the frames asked for, {}:{}; found {}:{}", first,
+                                     last, planFirst, planLast));
+}
+
+// Frames [from, to), rendered and not written: the state a render from `from` has at `to`
+// (representations built and rebuilt, tiles resident), so the frames after are the bits a
+// render from `from` gives (docs/store.md, "A farm").
+void preroll(MultiphaseRenderer& renderer, const RenderOptions& render, int from, int to,
+             bool quiet, Image& image) {
+    for (int frame = from; frame < to; ++frame) {
+        FrameStats stats;
+        renderer.renderFrame(frame, render, stats, image);
+        if (!quiet)
+            std::fprintf(stderr, "mpshade: frame %d rendered ahead of the request (%d of %d), "
+                         "not written, %.3f s\n",
+                         frame, frame - from + 1, to - from, stats.wallSeconds);
+    }
+}
+
 }  // namespace
 
 int runRenderCommand(const RenderCommandOptions& options) {
@@ -169,8 +200,10 @@ int runRenderCommand(const RenderCommandOptions& options) {
         mo.staticPhase.store = store;
         shadingRate = mo.shadingRate.value_or(shadingRate);
         multi = std::make_unique<MultiphaseRenderer>(scene, mo);
-        multi->plan(first, last, render);
     }
+    int planFirst = first, planLast = last;
+    planRange(options, scene, first, last, planFirst, planLast);
+    if (multi) multi->plan(planFirst, planLast, render);
     Renderer& renderer = multiphase ? static_cast<Renderer&>(*multi) : *reference;
     ProgressBar bar(!options.quiet && isatty(STDERR_FILENO));
     bar.setFirst(first);
@@ -204,12 +237,16 @@ int runRenderCommand(const RenderCommandOptions& options) {
     };
     const InterruptWatch watch;
     Image image, referenceImage;  // reused frame to frame
+    if (multi) preroll(*multi, render, planFirst, first, options.quiet, image);
     // Without a terminal (a farm's log), a line a frame instead of the bar.
     const bool lines = !options.quiet && !isatty(STDERR_FILENO);
     int skipped = 0;
     for (int frame = first; frame < last; ++frame) {
         if (options.skipExisting && frameImagesExist(options.outDir, frame)) {
             ++skipped;
+            // Planned from an earlier frame, the frames after it need its state: rendered
+            // again, not written.
+            if (multi && !options.planFrames.empty()) preroll(*multi, render, frame, frame + 1, true, image);
             continue;
         }
         FrameStats stats;

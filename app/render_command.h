@@ -37,6 +37,10 @@ struct RenderCommandOptions {
     // stats_A_B.json (this request's frames) instead of stats.json: shards rendering into one
     // folder each keep their own.
     bool shardStats = false;
+    // "A:B": the frames the multi-phase renderer plans over, holding --frames; the frames
+    // of it before the request are rendered first, not written, so each frame is the bits a
+    // render of A:B gives, whichever request renders it (a farm's shards). Empty: --frames.
+    std::string planFrames;
 };
 
 // Returns the exit code: 0, or 130 when stopped by Ctrl-C.
