@@ -17,6 +17,7 @@ PACKAGES=(
   libosd-dev libglm-dev libopenimageio-dev openimageio-tools libembree-dev libtbb-dev
   libgtest-dev googletest libbenchmark-dev libcli11-dev nlohmann-json3-dev libfmt-dev libxxhash-dev
   gnuplot-nox help2man
+  slurm-wlm munge
 )
 # The fuzz targets only: Clang and its libFuzzer runtime.
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
