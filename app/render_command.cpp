@@ -168,7 +168,8 @@ void preroll(MultiphaseRenderer& renderer, const RenderOptions& render, int from
         FrameStats stats;
         renderer.renderFrame(frame, render, stats, image);
         if (!quiet)
-            std::fprintf(stderr, "mpshade: frame %d rendered ahead of the request (%d of %d), "
+            std::fprintf(stderr,
+                         "mpshade: frame %d rendered ahead of the request (%d of %d), "
                          "not written, %.3f s\n",
                          frame, frame - from + 1, to - from, stats.wallSeconds);
     }
@@ -246,7 +247,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
             ++skipped;
             // Planned from an earlier frame, the frames after it need its state: rendered
             // again, not written.
-            if (multi && !options.planFrames.empty()) preroll(*multi, render, frame, frame + 1, true, image);
+            if (multi && !options.planFrames.empty())
+                preroll(*multi, render, frame, frame + 1, true, image);
             continue;
         }
         FrameStats stats;

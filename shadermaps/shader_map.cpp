@@ -323,19 +323,34 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
             pending.emplace(work[w].packed(), plan[w - begin].first);
         std::atomic<uint64_t> whole{0}, loaded{0};
         std::vector<uint8_t> fromStore(end - begin, 0);
+        // Tiles in the store are read; while this process fills the rest, no other sharing
+        // the store fills this map (it waits, then reads what this one wrote), so each tile
+        // is filled once however many processes ask for it.
+        std::unique_ptr<TileStore::FillLock> fillLock;
+        if (stored_.store) {
+            const auto readStored = [&] {
+                tbb::parallel_for(begin, end, [&](size_t w) {
+                    if (fromStore[w - begin] ||
+                        !stored_.store->read(stored_.digest, work[w].packed(),
+                                             {tileData(plan[w - begin].first), tileBytes()}))
+                        return;
+                    fromStore[w - begin] = 1;
+                    loaded.fetch_add(1, std::memory_order_relaxed);
+                    whole.fetch_add(1, std::memory_order_relaxed);
+                });
+            };
+            readStored();
+            if (loaded.load() < end - begin) {
+                fillLock = stored_.store->lockFills(stored_.digest);
+                if (stored_.store->refresh(stored_.digest)) readStored();
+            }
+        }
         tbb::parallel_for(begin, end, [&](size_t w) {
+            if (fromStore[w - begin]) return;
             enableFlushToZero();
             FillScratch& s = scratch.local();
-            const int slot = plan[w - begin].first;
-            if (stored_.store && stored_.store->read(stored_.digest, work[w].packed(),
-                                                     {tileData(slot), tileBytes()})) {
-                fromStore[w - begin] = 1;
-                loaded.fetch_add(1, std::memory_order_relaxed);
-                whole.fetch_add(1, std::memory_order_relaxed);
-                return;
-            }
-            if (fillTile(work[w], slot, plan[w - begin].second, pending, s.batch, s.points,
-                         s.geometry, s.workspace, s.stats, abandon))
+            if (fillTile(work[w], plan[w - begin].first, plan[w - begin].second, pending, s.batch,
+                         s.points, s.geometry, s.workspace, s.stats, abandon))
                 whole.fetch_add(1, std::memory_order_relaxed);
         });
         if (whole.load() < end - begin) {
@@ -353,7 +368,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
             if (fromStore[w - begin]) return;
             copyBorders(work[w], plan[w - begin].first, pending, scratch.local().stats);
         });
-        if (stored_.store) storeFilled(work, begin, end, plan, fromStore);
+        if (stored_.store) storeFilled(work, begin, end, plan, fromStore, fillLock != nullptr);
         for (size_t w = begin; w < end; ++w) table_.insert(work[w].packed(), plan[w - begin].first);
         residentTiles_.fetch_add(end - begin, std::memory_order_relaxed);
         begin = end;
@@ -368,7 +383,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
 
 void ShaderMap::storeFilled(std::span<const TileKey> work, size_t begin, size_t end,
                             std::span<const std::pair<int, bool>> plan,
-                            std::span<const uint8_t> fromStore) {
+                            std::span<const uint8_t> fromStore, bool now) {
     std::vector<uint64_t> keys;
     std::vector<const unsigned char*> tiles;
     for (size_t w = begin; w < end; ++w)
@@ -376,7 +391,7 @@ void ShaderMap::storeFilled(std::span<const TileKey> work, size_t begin, size_t 
             keys.push_back(work[w].packed());
             tiles.push_back(tileData(plan[w - begin].first));
         }
-    stored_.store->write(stored_.digest, keys, tiles, tileBytes());
+    stored_.store->write(stored_.digest, keys, tiles, tileBytes(), now);
 }
 
 void ShaderMap::evict(uint64_t key) {

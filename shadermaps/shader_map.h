@@ -230,11 +230,11 @@ class ShaderMap {
     // it must be evaluated (no such tile resident, or beyond the chart's edge).
     int neighbourSlot(const Neighbours& around, const TileKey& key, int i, int j) const;
     void copyBorders(const TileKey& key, int slot, const PendingTiles& pending, FillStats& stats);
-    // Queues a pass's filled tiles (work[begin, end) with their plan, those not read from
-    // the store) to be written to it, as one pack.
+    // Writes a pass's filled tiles (work[begin, end) with their plan, those not read from
+    // the store) to it, as one pack: `now` (holding the map's fill lock), before returning.
     void storeFilled(std::span<const TileKey> work, size_t begin, size_t end,
-                     std::span<const std::pair<int, bool>> plan,
-                     std::span<const uint8_t> fromStore);
+                     std::span<const std::pair<int, bool>> plan, std::span<const uint8_t> fromStore,
+                     bool now);
 
     const Surface& surface_;
     std::unique_ptr<ChartAdjacency> adjacency_;

@@ -1,6 +1,7 @@
 #include "shadermaps/tile_store.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/uio.h>
 #include <unistd.h>
@@ -295,12 +296,16 @@ std::vector<uint64_t> TileStore::storedKeys(const Digest128& map) {
 }
 
 void TileStore::write(const Digest128& map, std::span<const uint64_t> keys,
-                      std::span<const unsigned char* const> tiles, size_t tileBytes) {
+                      std::span<const unsigned char* const> tiles, size_t tileBytes, bool now) {
     if (readOnly_.load(std::memory_order_relaxed) || keys.empty()) return;
     PendingPack pack{map, {keys.begin(), keys.end()}, {}, tileBytes};
     pack.bytes.resize(keys.size() * tileBytes);
     for (size_t i = 0; i < keys.size(); ++i)
         std::memcpy(pack.bytes.data() + i * tileBytes, tiles[i], tileBytes);
+    if (now) {
+        writeNow(pack);
+        return;
+    }
     const size_t size = pack.bytes.size();
     std::unique_lock<std::mutex> lock(queueMutex_);
     if (!writer_.joinable()) writer_ = std::thread([this] { writerLoop(); });
@@ -309,6 +314,36 @@ void TileStore::write(const Digest128& map, std::span<const uint64_t> keys,
     queue_.push_back(std::move(pack));
     lock.unlock();
     queueChanged_.notify_all();
+}
+
+TileStore::FillLock::~FillLock() {
+    ::flock(fd_, LOCK_UN);
+    ::close(fd_);
+}
+
+std::unique_ptr<TileStore::FillLock> TileStore::lockFills(const Digest128& map) {
+    const fs::path folder = mapFolder(map);
+    std::error_code ec;
+    fs::create_directories(folder, ec);
+    const int fd = ::open((folder / "fill.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) return nullptr;
+    while (::flock(fd, LOCK_EX) != 0) {
+        if (errno != EINTR) {
+            ::close(fd);
+            return nullptr;
+        }
+    }
+    return std::make_unique<FillLock>(fd);
+}
+
+bool TileStore::refresh(const Digest128& map) {
+    const std::shared_ptr<MapIndex> index = indexOf(map, false);
+    std::unique_lock<std::shared_mutex> lock(index->mutex);
+    // Always listed (the folder's time may not move between two renames in one clock tick);
+    // only new packs are opened.
+    const size_t before = index->packs.size();
+    scan(map, *index);
+    return index->packs.size() > before;
 }
 
 void TileStore::flush() {

@@ -23,9 +23,11 @@
 // pack, refilled) is tried, else it is missing and filled again. A pack whose footer is
 // damaged is removed. Clean-up (gc()) removes whole maps, least recently used first.
 //
-// Writes happen on a thread of the store's own: write() copies the tiles into a queue and
-// returns, so a fill is not slowed by the disk. The queue holds at most kQueueBytes; a
-// write beyond waits for room. flush() (and the destructor) waits until every queued pack
+// Each tile is filled once across processes: a map's fills hold its fill lock (flock on
+// fill.lock in its folder), look again for packs written meanwhile, and write their pack
+// before letting go (ShaderMap::fill). Writes without `now` happen on a thread of the
+// store's own: write() copies the tiles into a queue (at most kQueueBytes; a write beyond
+// waits for room) and returns; flush() (and the destructor) waits until every queued pack
 // is on disk.
 //
 // Errors: a store that cannot be written (a full disk, no permission) warns once on stderr
@@ -89,10 +91,29 @@ class TileStore {
     // Reads tile `key` (TileKey::packed()) of map `map` into `out`, whose size must be the
     // tile's storage. True when a whole, checked tile of that size was read. Thread-safe.
     bool read(const Digest128& map, uint64_t key, std::span<unsigned char> out);
-    // Queues tiles of map `map` to be written as one pack by the store's thread: keys[i]'s
-    // storage is tiles[i], `tileBytes` long (copied now). Failures are counted, never thrown.
+    // Writes tiles of map `map` as one pack: keys[i]'s storage is tiles[i], `tileBytes` long.
+    // Queued for the store's thread (copied now), or with `now` written before returning.
+    // Failures are counted, never thrown.
     void write(const Digest128& map, std::span<const uint64_t> keys,
-               std::span<const unsigned char* const> tiles, size_t tileBytes);
+               std::span<const unsigned char* const> tiles, size_t tileBytes, bool now = false);
+
+    // While one is held, no other holder -- in this process or another sharing the store, on
+    // this machine or another (flock on the map's `fill.lock`) -- fills the map's tiles.
+    class FillLock {
+      public:
+        explicit FillLock(int fd) : fd_(fd) {}
+        ~FillLock();
+        FillLock(const FillLock&) = delete;
+        FillLock& operator=(const FillLock&) = delete;
+
+      private:
+        int fd_;
+    };
+    // Waits for the map's fill lock (null if its file cannot be made: fills go on unlocked).
+    std::unique_ptr<FillLock> lockFills(const Digest128& map);
+    // Finds the packs other processes added to the map since it was last looked at; whether
+    // there were any.
+    bool refresh(const Digest128& map);
     // Waits until every queued pack is written (or has failed).
     void flush();
     // Records the map's description (once per store object and map) and marks it used now.
