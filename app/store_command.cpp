@@ -101,9 +101,9 @@ int storeExport(const StoreCommandOptions& options) {
     if (options.object.empty())
         throw InputError({"--object", 0, 0, {}}, "name the object whose maps to export");
     if (options.outDir.empty()) throw InputError({"--out", 0, 0, {}}, "name the output folder");
-    if (options.maxSize < 1 || options.maxSize > 16384)
+    if (options.maxSize < 1 || options.maxSize > 8192)
         throw InputError({"--max-size", 0, 0, {}},
-                         "expected 1..16384 texels, found " + std::to_string(options.maxSize));
+                         "expected 1..8192 texels, found " + std::to_string(options.maxSize));
     const Scene scene = loadScene(options.scene);
     const SceneObject* object = nullptr;
     for (const SceneObject& o : scene.objects)

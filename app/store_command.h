@@ -31,7 +31,7 @@ struct StoreCommandOptions {
     int64_t maxMb = -1;  // gc: the budget, MB (required)
     // export: the scene and object whose maps are written, and where.
     std::string scene, object, outDir;
-    int maxSize = 4096;  // export: the finest level written is at most this wide
+    int maxSize = 1024;  // export: the finest level written is at most this wide
 };
 
 int runStoreCommand(const StoreCommandOptions& options);

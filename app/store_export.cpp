@@ -13,6 +13,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "app/output_files.h"
+#include "geometry/error.h"
 #include "shadermaps/half_float.h"
 #include "shadermaps/shader_map.h"
 
@@ -32,7 +33,14 @@ MapExport exportStoredMap(TileStore& store, const StoredMapSummary& map,
     const StoredMapInfo& info = map.info;
     const int channels = static_cast<int>(info.channelNames.size());
     MapExport result;
-    if (channels == 0 || info.resolution < 1 || info.tileSize < 1) return result;
+    const auto powerOfTwo = [](int v) { return v > 0 && (v & (v - 1)) == 0; };
+    if (channels < 1 || channels > 64 || !powerOfTwo(info.resolution) ||
+        info.resolution > (1 << 20) || !powerOfTwo(info.tileSize) || info.tileSize > 1024 ||
+        info.border < 1 || info.border > info.tileSize)
+        throw InputError(
+            {(store.root() / TileStore::kTilesFolder / map.digest.hex() / "map.json").string(), 0,
+             0, ""},
+            "this stored map's description is damaged or not mpshade's");
     int levels = 0;
     for (int r = info.resolution; r >= 1; r >>= 1) ++levels;
     int widest = 0;  // the finest level at most maxSize wide

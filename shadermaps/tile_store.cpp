@@ -491,17 +491,22 @@ std::vector<StoredMapSummary> TileStore::maps() const {
         }
         m.lastUsed = fs::last_write_time(folder.path() / "used", ec);
         if (ec) m.lastUsed = fs::last_write_time(folder.path(), ec);
+        // What the map is, if its description reads as one (a damaged one leaves it blank).
         std::ifstream in(folder.path() / "map.json");
         const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-        if (j.is_object()) {
-            m.info.object = j.value("object", "");
-            m.info.shader = j.value("shader", "");
-            m.info.channelNames = j.value("channels", std::vector<std::string>{});
-            m.info.charts = j.value("charts", 0);
-            m.info.resolution = j.value("resolution", 0);
-            m.info.tileSize = j.value("tile_size", 0);
-            m.info.border = j.value("border", 0);
-            m.info.halfPrecision = j.value("half", false);
+        try {
+            if (j.is_object()) {
+                m.info.object = j.value("object", "");
+                m.info.shader = j.value("shader", "");
+                m.info.channelNames = j.value("channels", std::vector<std::string>{});
+                m.info.charts = j.value("charts", 0);
+                m.info.resolution = j.value("resolution", 0);
+                m.info.tileSize = j.value("tile_size", 0);
+                m.info.border = j.value("border", 0);
+                m.info.halfPrecision = j.value("half", false);
+            }
+        } catch (const nlohmann::json::exception&) {
+            m.info = {};
         }
         out.push_back(std::move(m));
     }

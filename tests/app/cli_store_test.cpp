@@ -357,3 +357,33 @@ TEST(CliStore, ABakeKilledPartWayLeavesAStoreLaterRunsUse) {
 }
 
 }  // namespace
+
+namespace {
+
+// A store whose map descriptions are damaged or hostile: info lists the maps blank, export
+// refuses naming the file, neither crashes nor allocates what a description claims.
+TEST(CliStore, DamagedMapDescriptionsAreReportedNotTrusted) {
+    const std::string store = tempDir("hostile_store"), out = tempDir("hostile_out");
+    ASSERT_EQ(
+        mpshade("bake examples/vase/scene.json --frames 0:1 --size 64x36 --quiet --store " + store)
+            .exitCode,
+        0);
+    const auto describe = [&](const std::string& text) {
+        for (const auto& e : fs::directory_iterator(store + "/tiles-v1"))
+            std::ofstream(e.path() / "map.json") << text;
+    };
+    describe(R"({"object": "floor", "shader": "wood", "channels": 5, "resolution": -3})");
+    const CliRun info = mpshade("store info --store " + store);
+    EXPECT_EQ(info.exitCode, 0) << info.output;
+    EXPECT_NE(info.output.find("2 map(s)"), std::string::npos) << info.output;
+    describe(R"({"object": "floor", "shader": "wood", "channels": ["a", "b"],)"
+             R"( "resolution": 1073741824, "tile_size": 16, "border": 1})");
+    const CliRun exported = mpshade("store export examples/vase/scene.json --object floor --out " +
+                                    out + " --store " + store);
+    EXPECT_EQ(exported.exitCode, 2) << exported.output;
+    EXPECT_NE(exported.output.find("map.json"), std::string::npos) << exported.output;
+    describe("{not json");
+    EXPECT_EQ(mpshade("store info --store " + store).exitCode, 0);
+}
+
+}  // namespace
