@@ -12,6 +12,7 @@ void addMultiphaseFrameJson(const Scene& scene, const FrameStats& stats, nlohman
     entry["shade_seconds"] = stats.dynamic.shadeSeconds;
     entry["resolve_seconds"] = stats.dynamic.resolveSeconds;
     entry["static_runs"] = stats.staticWork.work.runs;
+    entry["static_runs_from_store"] = stats.staticWork.work.representationsLoaded;
     entry["static_runs_due"] = staticRunsDueJson(scene, stats);
     entry["tiles_requested"] = stats.tiles.missing;
     entry["tiles_filled"] = stats.staticWork.work.tilesFilled;

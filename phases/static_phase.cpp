@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "phases/fixed_point_warp.h"
+#include "phases/stored_representation.h"
 #include "scene/variability.h"
 #include "shadermaps/tile_store.h"
 #include "shading/builtins.h"
@@ -166,6 +167,21 @@ double StaticPhase::combinedFacets(size_t object, const ObjectState& state,
 
 namespace {
 
+// Whether a representation read from the store has every vertex row its dynamic part reads
+// and, for combined facets, the n-tuple's `channels` rows: a record is not trusted.
+bool holdsRows(const ObjectRepresentation& rep, bool combined, size_t channels) {
+    const VertexAttributes& a = rep.mesh.attributes;
+    if (combined && static_cast<size_t>(rep.mesh.channels) != channels) return false;
+    if (!combined && rep.mesh.channels != 0) return false;
+    for (int row : rep.geometryRows)
+        if (row < 0 || static_cast<size_t>(row) >= a.rows.size() ||
+            a.rows[static_cast<size_t>(row)].size() != a.count)
+            return false;
+    for (size_t c = 0; c < static_cast<size_t>(rep.mesh.channels); ++c)
+        if (a.rows[VertexAttributes::kGeometryRows + c].size() != a.count) return false;
+    return true;
+}
+
 // A channel's name in a stored map's description: its variable and component ("Cd[1]"),
 // or, for a temporary, its operation, source position and component ("mul@14:33[0]").
 std::string channelName(const ChannelInfo& c) {
@@ -277,7 +293,6 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     const bool combined = !useMap && !direct;
     const DicingView view = dicingView(state, camera);
     const DicingOptions& dicing = combined ? options_.combinedDicing : options_.separateDicing;
-    DicedSurface diced = diceSurface(surface, view, sceneObject.range, dicing);
 
     auto rep = std::make_unique<ObjectRepresentation>();
     rep->kind = combined ? Representation::Facets : kind;
@@ -292,26 +307,40 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     rep->geometryRows = direct ? obj.directRows : obj.geometryRows;
     rep->opaque = direct ? obj.directOpaque : obj.opaque;
     rep->closed = obj.closed;
-    rep->charts = diced.charts;
-    rep->patches = diced.patches;
-    rep->culledPatches = diced.culledCharts;
-    rep->frustumCulledPatches = diced.frustumCulled;
-    rep->cappedPatches = diced.cappedCharts;
-    FacetMesh& mesh = rep->mesh;
-    takeDicedMesh(diced, mesh);
     const size_t channels = obj.factored.staticPart.channelOutputs.size();
-    mesh.channels = combined ? static_cast<int>(channels) : 0;
-    // The survey between grid points can miss a little, so the facets are diced again when
-    // their edges outgrow P/2 or, if dicing overshot it, what they started at.
-    if (combined)
-        rep->maxEdgePixels =
-            std::max(dicing.maxEdgePixels, 1.05f * longestEdgePixels(mesh, state, camera));
-    costs.instructions +=
-        shadeVertices(obj, rep->geometryRows, diced, state, uniforms, combined, mesh);
-    if (direct) {
-        // Nothing static: the dynamic phase runs the whole shader.
-    } else if (combined) {
-        costs.programRuns += mesh.attributeChartPoint.size();
+    // The facets: read from the store where an earlier run built the same ones (the
+    // same geometry, view, state, options and, for combined facets, static program and
+    // inputs), else diced and shaded here (and stored).
+    const Digest128 key = options_.store && sceneObject.geometryDigest != Digest128{}
+                              ? representationKey(index, combined, direct, state, camera, uniforms)
+                              : Digest128{};
+    std::vector<unsigned char> record;
+    if (key != Digest128{} && options_.store->readRecord(key, record) &&
+        unpackRepresentation(record, *rep) && holdsRows(*rep, combined, channels)) {
+        ++costs.representationsLoaded;
+    } else {
+        DicedSurface diced = diceSurface(surface, view, sceneObject.range, dicing);
+        rep->charts = diced.charts;
+        rep->patches = diced.patches;
+        rep->culledPatches = diced.culledCharts;
+        rep->frustumCulledPatches = diced.frustumCulled;
+        rep->cappedPatches = diced.cappedCharts;
+        FacetMesh& mesh = rep->mesh;
+        takeDicedMesh(diced, mesh);
+        mesh.channels = combined ? static_cast<int>(channels) : 0;
+        // The survey between grid points can miss a little, so the facets are diced again
+        // when their edges outgrow P/2 or, if dicing overshot it, what they started at.
+        if (combined)
+            rep->maxEdgePixels =
+                std::max(dicing.maxEdgePixels, 1.05f * longestEdgePixels(mesh, state, camera));
+        costs.instructions +=
+            shadeVertices(obj, rep->geometryRows, diced, state, uniforms, combined, mesh);
+        if (combined) costs.programRuns += mesh.attributeChartPoint.size();
+        if (key != Digest128{}) options_.store->writeRecord(key, packRepresentation(*rep));
+    }
+    if (direct || combined) {
+        // Nothing more: the dynamic phase runs the whole shader, or the facets hold the
+        // n-tuple.
     } else if (channels == 0) {
         // Nothing static is stored (factoring.h, storeAboveCost): no map to make.
     } else if (previous && previous->map && !obj.staticReadsFrame) {
@@ -323,6 +352,40 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     ++costs.runs;
     costs.seconds += std::chrono::duration<double>(Clock::now() - start).count();
     return rep;
+}
+
+// Everything a representation's facets depend on: the geometry, the kind, the object's
+// state and the camera at the representative frame (so its dicing view), the dicing
+// options and range, the vertex rows kept, and for combined facets the static program
+// and the uniforms it reads.
+Digest128 StaticPhase::representationKey(size_t index, bool combined, bool direct,
+                                         const ObjectState& state, const CameraState& camera,
+                                         const ShadingUniforms& uniforms) const {
+    const ObjectShading& obj = *objects_[index];
+    const SceneObject& object = scene_.objects[index];
+    const DicingOptions& d = combined ? options_.combinedDicing : options_.separateDicing;
+    ContentHasher h;
+    h.addString("mpshade representation").addU64(kEvaluationVersion);
+    h.addDigest(object.geometryDigest).addI32(combined).addI32(direct);
+    h.addBytes(&state.objectToWorld, sizeof state.objectToWorld)
+        .addBytes(&state.worldToObject, sizeof state.worldToObject)
+        .addFloat(state.scale)
+        .addBytes(&state.eye, sizeof state.eye);
+    for (const glm::vec3& v : {camera.eye, camera.forward, camera.right, camera.up})
+        h.addBytes(&v, sizeof v);
+    h.addFloat(camera.tanHalfFovY).addFloat(camera.aspect).addFloat(camera.zNear);
+    h.addFloat(camera.zFar).addI32(camera.width).addI32(camera.height);
+    h.addI32(static_cast<int32_t>(d.target)).addFloat(d.maxEdgePixels).addFloat(d.flatnessPixels);
+    h.addI32(d.overRange).addI32(d.maxEdgeRate).addI32(d.maxSplitDepth).addI32(d.maxPatches);
+    h.addU64(d.maxFacets).addI32(d.frustumCull);
+    h.addFloat(object.range.distanceFactor).addFloat(object.range.angle);
+    const std::vector<int>& rows = direct ? obj.directRows : obj.geometryRows;
+    h.addU64(rows.size()).addBytes(rows.data(), rows.size() * sizeof(int));
+    if (combined) {
+        addProgram(h, obj.staticKernel->program());
+        addUniformsRead(h, obj.staticKernel->program(), uniforms);
+    }
+    return h.finish();
 }
 
 // A new map at the object's resolution (its own cap, else the options', rounded up to a

@@ -58,7 +58,8 @@ struct StaticCosts {
     double seconds = 0.0;
     uint64_t instructions = 0;  // static shader instructions, times lanes
     uint64_t tilesFilled = 0, tilesFromChildren = 0, texelsFilled = 0, programRuns = 0;
-    uint64_t tilesLoaded = 0;  // read from the store instead of filled
+    uint64_t tilesLoaded = 0;       // read from the store instead of filled
+    int representationsLoaded = 0;  // of runs: facets read from the store, not diced
 
     // A map's fill, whose static program costs `instructionsPerRun` per evaluation.
     void addFill(const FillStats& f, uint64_t instructionsPerRun) {
@@ -75,6 +76,7 @@ struct StaticCosts {
         instructions += o.instructions;
         tilesFilled += o.tilesFilled;
         tilesLoaded += o.tilesLoaded;
+        representationsLoaded += o.representationsLoaded;
         tilesFromChildren += o.tilesFromChildren;
         texelsFilled += o.texelsFilled;
         programRuns += o.programRuns;
@@ -128,6 +130,8 @@ class StaticPhase {
     std::shared_ptr<ShaderMap> makeShaderMap(size_t index, const ShadingUniforms& uniforms) const;
     StoredTiles storedTiles(size_t index, const ShadingUniforms& uniforms,
                             const ShaderMapOptions& map) const;
+    Digest128 representationKey(size_t index, bool combined, bool direct, const ObjectState& state,
+                                const CameraState& camera, const ShadingUniforms& uniforms) const;
 
     const Scene& scene_;
     const SceneResources& resources_;

@@ -445,6 +445,56 @@ void TileStore::writeNow(const PendingPack& pack) {
     index->packs.emplace(name, std::move(p));
 }
 
+bool TileStore::readRecord(const Digest128& key, std::vector<unsigned char>& out) {
+    const fs::path path = root_ / kRecordsFolder / (key.hex() + ".rep");
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return false;
+    struct stat st {};
+    TileHeader header{};
+    bool ok = ::fstat(fd, &st) == 0 && static_cast<uint64_t>(st.st_size) >= sizeof header &&
+              readAt(fd, &header, sizeof header, 0) &&
+              std::memcmp(header.magic, kTileMagic, sizeof kTileMagic) == 0 &&
+              header.mapHigh == key.high && header.mapLow == key.low &&
+              header.payloadBytes == static_cast<uint64_t>(st.st_size) - sizeof header;
+    if (ok) {
+        out.resize(header.payloadBytes);
+        ok = readAt(fd, out.data(), out.size(), sizeof header) &&
+             checksum64(out.data(), out.size()) == header.checksum;
+    }
+    ::close(fd);
+    if (!ok) {
+        counters_.damaged.fetch_add(1, std::memory_order_relaxed);
+        ::unlink(path.c_str());
+        return false;
+    }
+    std::error_code ec;
+    fs::last_write_time(path, fs::file_time_type::clock::now(), ec);  // used now
+    counters_.recordsRead.fetch_add(1, std::memory_order_relaxed);
+    return true;
+}
+
+void TileStore::writeRecord(const Digest128& key, std::span<const unsigned char> bytes) {
+    if (readOnly_.load(std::memory_order_relaxed)) return;
+    TileHeader header{};
+    std::memcpy(header.magic, kTileMagic, sizeof kTileMagic);
+    header.mapHigh = key.high;
+    header.mapLow = key.low;
+    header.key = 0;
+    header.payloadBytes = bytes.size();
+    header.checksum = checksum64(bytes.data(), bytes.size());
+    const std::span<const unsigned char> pieces[2] = {bytesOf(&header, sizeof header), bytes};
+    const fs::path folder = root_ / kRecordsFolder;
+    std::error_code ec;
+    fs::create_directories(folder, ec);
+    if (writeAtomically(folder / (key.hex() + ".rep"), pieces)) {
+        counters_.recordsWritten.fetch_add(1, std::memory_order_relaxed);
+        return;
+    }
+    counters_.writeFailures.fetch_add(1, std::memory_order_relaxed);
+    readOnly_.store(true);
+    warnOnce("cannot write in " + folder.string() + ": " + std::strerror(errno));
+}
+
 void TileStore::useMap(const Digest128& map, const StoredMapInfo& info) {
     {
         std::lock_guard<std::mutex> lock(mutex_);
@@ -516,30 +566,58 @@ std::vector<StoredMapSummary> TileStore::maps() const {
     return out;
 }
 
+namespace {
+
+// What clean-up weighs: a map (its folder) or a record (its file), by last use.
+struct StoreEntry {
+    fs::path path;
+    uint64_t bytes;
+    fs::file_time_type lastUsed;
+};
+
+std::vector<StoreEntry> records(const fs::path& folder) {
+    std::vector<StoreEntry> out;
+    std::error_code ec;
+    for (const fs::directory_entry& f : fs::directory_iterator(folder, ec))
+        if (f.path().extension() == ".rep")
+            out.push_back({f.path(), f.file_size(ec), f.last_write_time(ec)});
+    return out;
+}
+
+}  // namespace
+
 uint64_t TileStore::bytes() const {
     uint64_t total = 0;
     for (const StoredMapSummary& m : maps()) total += m.bytes;
+    for (const StoreEntry& r : records(root_ / kRecordsFolder)) total += r.bytes;
     return total;
 }
 
 uint64_t TileStore::gc(uint64_t budgetBytes) {
-    const std::vector<StoredMapSummary> all = maps();
+    std::vector<StoreEntry> all = records(root_ / kRecordsFolder);
+    for (const StoredMapSummary& m : maps())
+        all.push_back({mapFolder(m.digest), m.bytes, m.lastUsed});
+    std::sort(all.begin(), all.end(),
+              [](const StoreEntry& a, const StoreEntry& b) { return a.lastUsed < b.lastUsed; });
     uint64_t total = 0, removed = 0;
-    for (const StoredMapSummary& m : all) total += m.bytes;
+    for (const StoreEntry& e : all) total += e.bytes;
     std::error_code ec;
     const auto stale = fs::file_time_type::clock::now() - std::chrono::hours(1);
-    for (const StoredMapSummary& m : all) {
-        const fs::path folder = mapFolder(m.digest);
+    for (const StoreEntry& e : all) {
         if (total > budgetBytes) {
-            fs::remove_all(folder, ec);
-            total -= m.bytes;
-            removed += m.bytes;
+            fs::remove_all(e.path, ec);
+            total -= e.bytes;
+            removed += e.bytes;
             continue;
         }
-        for (const fs::directory_entry& f : fs::directory_iterator(folder, ec))
+        if (!fs::is_directory(e.path, ec)) continue;
+        for (const fs::directory_entry& f : fs::directory_iterator(e.path, ec))
             if (f.path().extension() == ".tmp" && f.last_write_time(ec) < stale)
                 fs::remove(f.path(), ec);
     }
+    for (const fs::directory_entry& f : fs::directory_iterator(root_ / kRecordsFolder, ec))
+        if (f.path().extension() == ".tmp" && f.last_write_time(ec) < stale)
+            fs::remove(f.path(), ec);
     return removed;
 }
 

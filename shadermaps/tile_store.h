@@ -63,7 +63,7 @@ struct StoredMapInfo {
 
 struct TileStoreCounters {
     std::atomic<uint64_t> loaded{0}, written{0}, packsWritten{0}, absent{0}, damaged{0},
-        writeFailures{0};
+        writeFailures{0}, recordsRead{0}, recordsWritten{0};
 };
 
 // One map of a store, as gc() and info() see it.
@@ -121,16 +121,24 @@ class TileStore {
     // The keys of the tiles stored for `map` (each once), as the packs' indices list them.
     std::vector<uint64_t> storedKeys(const Digest128& map);
 
+    // Records other than tiles (the static phase's built representations), one file each
+    // under ROOT/reps-v1/, with the same header and checksum as a tile. readRecord() marks
+    // the record used (for clean-up); false if absent or damaged (counted, removed).
+    static constexpr const char* kRecordsFolder = "reps-v1";
+    bool readRecord(const Digest128& key, std::vector<unsigned char>& out);
+    void writeRecord(const Digest128& key, std::span<const unsigned char> bytes);
+
     const TileStoreCounters& counters() const { return counters_; }
 
     // Every map in the store, by last use, oldest first.
     std::vector<StoredMapSummary> maps() const;
-    // Removes maps, least recently used first, until the store holds at most `budgetBytes`,
+    // Removes maps and records, least recently used first, until the store holds at most
+    // `budgetBytes`,
     // and temporary files older than an hour (left by a process that was killed). Returns
     // the bytes removed. Safe while other processes use the store: a tile removed under a
     // reader is missing to it, and filled again.
     uint64_t gc(uint64_t budgetBytes);
-    // The bytes the store's packs take.
+    // The bytes the store's packs and records take.
     uint64_t bytes() const;
 
   private:

@@ -73,6 +73,10 @@ TEST(CliStore, ASecondRenderReadsEveryTileAndRendersTheSameBits) {
     EXPECT_EQ(first["store"]["tiles_written"].get<uint64_t>(), filled);
     EXPECT_EQ(sum(again["frames"], "tiles_filled"), 0u);
     EXPECT_EQ(sum(again["frames"], "tiles_from_store"), filled);
+    // Each representation's facets were read, not diced again.
+    EXPECT_EQ(sum(first["frames"], "static_runs_from_store"), 0u);
+    EXPECT_EQ(sum(again["frames"], "static_runs_from_store"), sum(again["frames"], "static_runs"));
+    EXPECT_GT(sum(again["frames"], "static_runs"), 0u);
     EXPECT_EQ(again["store"]["tiles_read"].get<uint64_t>(), filled);
     for (size_t i = 0; i < first["objects"].size(); ++i)
         EXPECT_EQ(again["objects"][i]["tiles_from_store"], first["objects"][i]["tiles_filled"]);
@@ -102,6 +106,13 @@ TEST(CliStore, TheCameraKeepsEveryStoredMapAStaticParameterRefillsOnlyItsObject)
     EXPECT_EQ(maps().size(), 2u);
     const nlohmann::json m = readJson(dir + "/o2/stats.json");
     EXPECT_GT(m["objects"][0]["tiles_from_store"].get<uint64_t>(), 0u);
+    // ... and what it reads is what this view needs: the bits of a render without a store
+    // (facets diced for the first view would not be).
+    ASSERT_EQ(mpshade("render " + moved + " --frames 0:1" + kSmall + " --no-store --out " + dir +
+                      "/o2alone")
+                  .exitCode,
+              0);
+    EXPECT_EQ(pixels(dir + "/o2/frame_0000.exr"), pixels(dir + "/o2alone/frame_0000.exr"));
     // The floor's ring scale is folded into its static part: a new map for the floor only;
     // the vase reads every tile it needs.
     ASSERT_EQ(mpshade("render " + rings + opts + dir + "/o3").exitCode, 0);
