@@ -79,6 +79,17 @@ Digest128 digestFile(const std::string& path) {
     return hasher.finish();
 }
 
+const Digest128& engineDigest() {
+    static const Digest128 digest = [] {
+        try {
+            return digestFile("/proc/self/exe");
+        } catch (const InputError&) {
+            return Digest128{};
+        }
+    }();
+    return digest;
+}
+
 uint64_t checksum64(const void* data, size_t bytes) {
     return XXH3_64bits(data, bytes);
 }

@@ -50,6 +50,12 @@ class ContentHasher {
 // it cannot be read.
 Digest128 digestFile(const std::string& path);
 
+// The running program's own digest: of its executable's bytes (/proc/self/exe), read once.
+// What is stored by content is keyed with it too, so a store is never read by a build that
+// could evaluate a shader to other bits (another compiler, a changed noise function): any
+// change to the engine is a new key. Zero where the executable cannot be read.
+const Digest128& engineDigest();
+
 // A 64-bit checksum of bytes (XXH3-64), for detecting a damaged copy.
 uint64_t checksum64(const void* data, size_t bytes);
 

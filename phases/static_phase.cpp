@@ -365,7 +365,7 @@ Digest128 StaticPhase::representationKey(size_t index, bool combined, bool direc
     const SceneObject& object = scene_.objects[index];
     const DicingOptions& d = combined ? options_.combinedDicing : options_.separateDicing;
     ContentHasher h;
-    h.addString("mpshade representation").addU64(kEvaluationVersion);
+    h.addString("mpshade representation").addU64(kEvaluationVersion).addDigest(engineDigest());
     h.addDigest(object.geometryDigest).addI32(combined).addI32(direct);
     h.addBytes(&state.objectToWorld, sizeof state.objectToWorld)
         .addBytes(&state.worldToObject, sizeof state.worldToObject)
@@ -418,7 +418,7 @@ StoredTiles StaticPhase::storedTiles(size_t index, const ShadingUniforms& unifor
     if (!options_.store || sceneObject.geometryDigest == Digest128{}) return {};
     const IrProgram& program = objects_[index]->staticKernel->program();
     ContentHasher hasher;
-    hasher.addString("mpshade shader map");
+    hasher.addString("mpshade shader map").addDigest(engineDigest());
     addProgram(hasher, program);
     addUniformsRead(hasher, program, uniforms);
     hasher.addDigest(sceneObject.geometryDigest)

@@ -398,3 +398,29 @@ TEST(CliStore, DamagedMapDescriptionsAreReportedNotTrusted) {
 }
 
 }  // namespace
+
+namespace {
+
+// Another build never reads what this one stored: the same binary with one byte more
+// (still runnable) finds nothing in the store and fills every tile itself.
+TEST(CliStore, AnotherBuildReadsNothingThisOneStored) {
+    const std::string store = tempDir("build_store"), a = tempDir("build_a"),
+                      b = tempDir("build_b"), copy = tempDir("build_bin");
+    fs::create_directories(copy);
+    const std::string other = copy + "/mpshade";
+    fs::copy_file(MPSHADE_BINARY, other);
+    std::ofstream(other, std::ios::app | std::ios::binary) << '\n';
+    const std::string args =
+        " render examples/vase/scene.json --frames 0:1" + kSmall + " --store " + store + " --out ";
+    ASSERT_EQ(mpshade(args.substr(1) + a).exitCode, 0);
+    const std::string command =
+        "cd '" MPSHADE_SOURCE_DIR "' && '" + other + "'" + args + b + " 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    const nlohmann::json mine = readJson(a + "/stats.json"), theirs = readJson(b + "/stats.json");
+    EXPECT_GT(sum(theirs["frames"], "tiles_filled"), 0u);
+    EXPECT_EQ(sum(theirs["frames"], "tiles_from_store"), 0u);
+    EXPECT_EQ(sum(theirs["frames"], "static_runs_from_store"), 0u);
+    EXPECT_EQ(sum(theirs["frames"], "tiles_filled"), sum(mine["frames"], "tiles_filled"));
+}
+
+}  // namespace
