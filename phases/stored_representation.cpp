@@ -20,6 +20,7 @@ class Writer {
     void array(const std::vector<T>& v) {
         static_assert(std::is_trivially_copyable_v<T>);
         value<uint64_t>(v.size());
+        if (v.empty()) return;  // data() may be null
         const auto* p = reinterpret_cast<const unsigned char*>(v.data());
         out.insert(out.end(), p, p + v.size() * sizeof(T));
     }
@@ -42,7 +43,7 @@ class Reader {
         uint64_t n = 0;
         if (!value(n) || n > (bytes.size() - at) / sizeof(T)) return false;
         v.resize(n);
-        std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));
+        if (n > 0) std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));  // data() may be null
         at += n * sizeof(T);
         return true;
     }
