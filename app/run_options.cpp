@@ -46,10 +46,9 @@ std::shared_ptr<TileStore> openStore(const RunOptions& options) {
 nlohmann::json storeReport(const std::shared_ptr<TileStore>& store) {
     if (!store) return {{"folder", nullptr}};
     const TileStoreCounters& c = store->counters();
-    return {{"folder", store->root().string()},
-            {"tiles_read", c.loaded.load()},
-            {"tiles_written", c.written.load()},
-            {"tiles_damaged", c.damaged.load()},
+    return {{"folder", store->root().string()},        {"tiles_read", c.loaded.load()},
+            {"tiles_written", c.written.load()},       {"tiles_damaged", c.damaged.load()},
+            {"records_read", c.recordsRead.load()},    {"records_written", c.recordsWritten.load()},
             {"write_failures", c.writeFailures.load()}};
 }
 

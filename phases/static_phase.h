@@ -130,6 +130,8 @@ class StaticPhase {
     std::shared_ptr<ShaderMap> makeShaderMap(size_t index, const ShadingUniforms& uniforms) const;
     StoredTiles storedTiles(size_t index, const ShadingUniforms& uniforms,
                             const ShaderMapOptions& map) const;
+    void addDicingInputs(ContentHasher& h, size_t index, const DicingOptions& dicing,
+                         const ObjectState& state, const CameraState& camera) const;
     Digest128 representationKey(size_t index, bool combined, bool direct, const ObjectState& state,
                                 const CameraState& camera, const ShadingUniforms& uniforms) const;
 

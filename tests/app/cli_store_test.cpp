@@ -77,6 +77,10 @@ TEST(CliStore, ASecondRenderReadsEveryTileAndRendersTheSameBits) {
     EXPECT_EQ(sum(first["frames"], "static_runs_from_store"), 0u);
     EXPECT_EQ(sum(again["frames"], "static_runs_from_store"), sum(again["frames"], "static_runs"));
     EXPECT_GT(sum(again["frames"], "static_runs"), 0u);
+    // Nothing was made again: no facets, no survey of them (the records are all read).
+    EXPECT_GT(first["store"]["records_written"].get<uint64_t>(), 0u);
+    EXPECT_EQ(again["store"]["records_written"], 0);
+    EXPECT_EQ(again["store"]["records_read"], first["store"]["records_written"]);
     EXPECT_EQ(again["store"]["tiles_read"].get<uint64_t>(), filled);
     for (size_t i = 0; i < first["objects"].size(); ++i)
         EXPECT_EQ(again["objects"][i]["tiles_from_store"], first["objects"][i]["tiles_filled"]);
