@@ -270,10 +270,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         std::fprintf(stderr, "mpshade: %d frame(s) already in %s were not rendered again\n",
                      skipped, options.outDir.c_str());
     bar.finish();
-    if (store) {
-        cleanUpStore(store, options.run);
-        writeStats();  // with every tile written counted
-    }
+    cleanUpStore(store, options.run);
     if (interrupted()) {
         std::fprintf(stderr,
                      "mpshade: stopped by the user after %zu frame(s); stats.json "

@@ -54,7 +54,6 @@ nlohmann::json storeReport(const std::shared_ptr<TileStore>& store) {
 
 void cleanUpStore(const std::shared_ptr<TileStore>& store, const RunOptions& options) {
     if (!store) return;
-    store->flush();
     const TileStoreCounters& c = store->counters();
     if (c.written.load() > 0)
         store->gc(static_cast<uint64_t>(options.storeMb > 0 ? options.storeMb : 8192) << 20);

@@ -40,7 +40,7 @@ std::shared_ptr<TileStore> openStore(const RunOptions& options);
 // read, written, damaged (found, removed and filled again) and writes that failed.
 nlohmann::json storeReport(const std::shared_ptr<TileStore>& store);
 
-// After a run: waits for the store's writes; if it wrote to the store, removes maps unused longest
+// After a run: if it wrote to the store, removes maps unused longest
 // while the store is over its budget; warns of damaged tiles found.
 void cleanUpStore(const std::shared_ptr<TileStore>& store, const RunOptions& options);
 

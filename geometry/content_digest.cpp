@@ -50,11 +50,6 @@ ContentHasher& ContentHasher::addBytes(const void* data, size_t bytes) {
     return *this;
 }
 
-ContentHasher& ContentHasher::addFloats(std::span<const float> v) {
-    addU64(v.size());
-    return addBytes(v.data(), v.size_bytes());
-}
-
 ContentHasher& ContentHasher::addString(std::string_view s) {
     addU64(s.size());
     return addBytes(s.data(), s.size());

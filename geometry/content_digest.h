@@ -8,7 +8,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <span>
 #include <string>
 #include <string_view>
 
@@ -36,7 +35,6 @@ class ContentHasher {
     ContentHasher& addI32(int32_t v) { return addBytes(&v, sizeof v); }
     // Floats by their bits: -0 and 0 differ, as do NaNs of different payloads.
     ContentHasher& addFloat(float v) { return addBytes(&v, sizeof v); }
-    ContentHasher& addFloats(std::span<const float> v);
     ContentHasher& addString(std::string_view s);  // length, then bytes
     ContentHasher& addDigest(const Digest128& d) { return addU64(d.high).addU64(d.low); }
     Digest128 finish() const;

@@ -368,7 +368,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
             if (fromStore[w - begin]) return;
             copyBorders(work[w], plan[w - begin].first, pending, scratch.local().stats);
         });
-        if (stored_.store) storeFilled(work, begin, end, plan, fromStore, fillLock != nullptr);
+        if (stored_.store) storeFilled(work, begin, end, plan, fromStore);
         for (size_t w = begin; w < end; ++w) table_.insert(work[w].packed(), plan[w - begin].first);
         residentTiles_.fetch_add(end - begin, std::memory_order_relaxed);
         begin = end;
@@ -383,7 +383,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
 
 void ShaderMap::storeFilled(std::span<const TileKey> work, size_t begin, size_t end,
                             std::span<const std::pair<int, bool>> plan,
-                            std::span<const uint8_t> fromStore, bool now) {
+                            std::span<const uint8_t> fromStore) {
     std::vector<uint64_t> keys;
     std::vector<const unsigned char*> tiles;
     for (size_t w = begin; w < end; ++w)
@@ -391,7 +391,7 @@ void ShaderMap::storeFilled(std::span<const TileKey> work, size_t begin, size_t 
             keys.push_back(work[w].packed());
             tiles.push_back(tileData(plan[w - begin].first));
         }
-    stored_.store->write(stored_.digest, keys, tiles, tileBytes(), now);
+    stored_.store->write(stored_.digest, keys, tiles, tileBytes());
 }
 
 void ShaderMap::evict(uint64_t key) {

@@ -231,10 +231,10 @@ class ShaderMap {
     int neighbourSlot(const Neighbours& around, const TileKey& key, int i, int j) const;
     void copyBorders(const TileKey& key, int slot, const PendingTiles& pending, FillStats& stats);
     // Writes a pass's filled tiles (work[begin, end) with their plan, those not read from
-    // the store) to it, as one pack: `now` (holding the map's fill lock), before returning.
+    // the store) to it, as one pack (holding the map's fill lock).
     void storeFilled(std::span<const TileKey> work, size_t begin, size_t end,
-                     std::span<const std::pair<int, bool>> plan, std::span<const uint8_t> fromStore,
-                     bool now);
+                     std::span<const std::pair<int, bool>> plan,
+                     std::span<const uint8_t> fromStore);
 
     const Surface& surface_;
     std::unique_ptr<ChartAdjacency> adjacency_;

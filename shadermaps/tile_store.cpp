@@ -130,8 +130,6 @@ struct TileStore::MapIndex {
     std::shared_mutex mutex;
     std::map<std::string, std::unique_ptr<Pack>> packs;  // by file name
     std::unordered_map<uint64_t, std::vector<Copy>> copies;
-    fs::file_time_type folderTime{};
-    Clock::time_point scanned{};
 
     void add(Pack* pack, std::span<const IndexEntry> entries) {
         for (const IndexEntry& e : entries) {
@@ -162,16 +160,6 @@ TileStore::TileStore(fs::path root) : root_(std::move(root)) {
                              (ec ? ec.message() : "not a folder") + ")");
 }
 
-TileStore::~TileStore() {
-    {
-        std::unique_lock<std::mutex> lock(queueMutex_);
-        queueChanged_.wait(lock, [&] { return queue_.empty() && !writing_; });
-        stopping_ = true;
-    }
-    queueChanged_.notify_all();
-    if (writer_.joinable()) writer_.join();
-}
-
 fs::path TileStore::mapFolder(const Digest128& map) const {
     return root_ / kTilesFolder / map.hex();
 }
@@ -189,8 +177,6 @@ void TileStore::warnOnce(const std::string& message) {
 void TileStore::scan(const Digest128& map, MapIndex& index) {
     std::error_code ec;
     const fs::path folder = mapFolder(map);
-    index.folderTime = fs::last_write_time(folder, ec);
-    index.scanned = Clock::now();
     for (const fs::directory_entry& f : fs::directory_iterator(folder, ec)) {
         const std::string name = f.path().filename().string();
         if (f.path().extension() != ".pack" || index.packs.count(name)) continue;
@@ -218,102 +204,65 @@ void TileStore::scan(const Digest128& map, MapIndex& index) {
     }
 }
 
-std::shared_ptr<TileStore::MapIndex> TileStore::indexOf(const Digest128& map, bool rescan) {
+std::shared_ptr<TileStore::MapIndex> TileStore::indexOf(const Digest128& map) {
     std::shared_ptr<MapIndex> index;
-    bool fresh = false;
+    std::unique_lock<std::shared_mutex> scanning;
     {
         std::lock_guard<std::mutex> lock(mutex_);
         std::shared_ptr<MapIndex>& slot = indices_[map.hex()];
-        if (!slot) {
-            slot = std::make_shared<MapIndex>();
-            fresh = true;
-        }
+        if (slot) return slot;
+        // Published locked: another thread asking for it waits for the first scan.
+        slot = std::make_shared<MapIndex>();
+        scanning = std::unique_lock<std::shared_mutex>(slot->mutex);
         index = slot;
     }
-    std::unique_lock<std::shared_mutex> lock(index->mutex, std::defer_lock);
-    if (fresh) {
-        lock.lock();
-        scan(map, *index);
-    } else if (rescan) {
-        // Another process's packs: looked for when a tile is missing, at most twice a
-        // second, and only if the folder changed (this process's own are added as written).
-        lock.lock();
-        std::error_code ec;
-        if (Clock::now() - index->scanned > std::chrono::milliseconds(500) &&
-            fs::last_write_time(mapFolder(map), ec) != index->folderTime)
-            scan(map, *index);
-    }
+    scan(map, *index);
     return index;
 }
 
 bool TileStore::read(const Digest128& map, uint64_t key, std::span<unsigned char> out) {
-    for (int attempt = 0; attempt < 2; ++attempt) {
-        const std::shared_ptr<MapIndex> index = indexOf(map, attempt > 0);
-        // The newest few copies (two processes that filled a tile at once each wrote one).
-        std::array<MapIndex::Copy, 4> copies;
-        size_t count = 0;
-        {
-            std::shared_lock<std::shared_mutex> lock(index->mutex);
-            const auto it = index->copies.find(key);
-            if (it != index->copies.end())
-                for (const MapIndex::Copy& c : it->second)
-                    if (count < copies.size()) copies[count++] = c;
-        }
-        for (size_t k = 0; k < count; ++k) {
-            const MapIndex::Copy& copy = copies[k];
-            int fd = copy.pack->fd;
-            const bool transient = fd < 0;
-            if (transient) fd = ::open(copy.pack->path.c_str(), O_RDONLY | O_CLOEXEC);
-            if (fd < 0) continue;  // removed by a clean-up: another copy, or missing
-            TileHeader header{};
-            iovec parts[2] = {{&header, sizeof header}, {out.data(), out.size()}};
-            const ssize_t got = ::preadv(fd, parts, 2, static_cast<off_t>(copy.offset));
-            if (transient) ::close(fd);
-            if (got == static_cast<ssize_t>(sizeof header + out.size()) &&
-                std::memcmp(header.magic, kTileMagic, sizeof kTileMagic) == 0 &&
-                header.mapHigh == map.high && header.mapLow == map.low && header.key == key &&
-                header.payloadBytes == out.size() &&
-                checksum64(out.data(), out.size()) == header.checksum) {
-                counters_.loaded.fetch_add(1, std::memory_order_relaxed);
-                return true;
-            }
-            // Damaged (a disk error) or of another size: never read.
-            counters_.damaged.fetch_add(1, std::memory_order_relaxed);
-        }
-        if (count > 0) break;  // every copy damaged: filled again
+    const std::shared_ptr<MapIndex> index = indexOf(map);
+    // The newest few copies (two processes that filled a tile at once each wrote one).
+    std::array<MapIndex::Copy, 4> copies;
+    size_t count = 0;
+    {
+        std::shared_lock<std::shared_mutex> lock(index->mutex);
+        const auto it = index->copies.find(key);
+        if (it != index->copies.end())
+            for (const MapIndex::Copy& c : it->second)
+                if (count < copies.size()) copies[count++] = c;
     }
-    counters_.absent.fetch_add(1, std::memory_order_relaxed);
+    for (size_t k = 0; k < count; ++k) {
+        const MapIndex::Copy& copy = copies[k];
+        int fd = copy.pack->fd;
+        const bool transient = fd < 0;
+        if (transient) fd = ::open(copy.pack->path.c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd < 0) continue;  // removed by a clean-up: another copy, or missing
+        TileHeader header{};
+        iovec parts[2] = {{&header, sizeof header}, {out.data(), out.size()}};
+        const ssize_t got = ::preadv(fd, parts, 2, static_cast<off_t>(copy.offset));
+        if (transient) ::close(fd);
+        if (got == static_cast<ssize_t>(sizeof header + out.size()) &&
+            std::memcmp(header.magic, kTileMagic, sizeof kTileMagic) == 0 &&
+            header.mapHigh == map.high && header.mapLow == map.low && header.key == key &&
+            header.payloadBytes == out.size() &&
+            checksum64(out.data(), out.size()) == header.checksum) {
+            counters_.loaded.fetch_add(1, std::memory_order_relaxed);
+            return true;
+        }
+        // Damaged (a disk error) or of another size: never read, filled again.
+        counters_.damaged.fetch_add(1, std::memory_order_relaxed);
+    }
     return false;
 }
 
 std::vector<uint64_t> TileStore::storedKeys(const Digest128& map) {
-    const std::shared_ptr<MapIndex> index = indexOf(map, false);
+    const std::shared_ptr<MapIndex> index = indexOf(map);
     std::shared_lock<std::shared_mutex> lock(index->mutex);
     std::vector<uint64_t> keys;
     for (const auto& [key, copies] : index->copies) keys.push_back(key);
     std::sort(keys.begin(), keys.end());
     return keys;
-}
-
-void TileStore::write(const Digest128& map, std::span<const uint64_t> keys,
-                      std::span<const unsigned char* const> tiles, size_t tileBytes, bool now) {
-    if (readOnly_.load(std::memory_order_relaxed) || keys.empty()) return;
-    PendingPack pack{map, {keys.begin(), keys.end()}, {}, tileBytes};
-    pack.bytes.resize(keys.size() * tileBytes);
-    for (size_t i = 0; i < keys.size(); ++i)
-        std::memcpy(pack.bytes.data() + i * tileBytes, tiles[i], tileBytes);
-    if (now) {
-        writeNow(pack);
-        return;
-    }
-    const size_t size = pack.bytes.size();
-    std::unique_lock<std::mutex> lock(queueMutex_);
-    if (!writer_.joinable()) writer_ = std::thread([this] { writerLoop(); });
-    queueChanged_.wait(lock, [&] { return queuedBytes_ + size <= kQueueBytes || queue_.empty(); });
-    queuedBytes_ += size;
-    queue_.push_back(std::move(pack));
-    lock.unlock();
-    queueChanged_.notify_all();
 }
 
 TileStore::FillLock::~FillLock() {
@@ -337,7 +286,7 @@ std::unique_ptr<TileStore::FillLock> TileStore::lockFills(const Digest128& map) 
 }
 
 bool TileStore::refresh(const Digest128& map) {
-    const std::shared_ptr<MapIndex> index = indexOf(map, false);
+    const std::shared_ptr<MapIndex> index = indexOf(map);
     std::unique_lock<std::shared_mutex> lock(index->mutex);
     // Always listed (the folder's time may not move between two renames in one clock tick);
     // only new packs are opened.
@@ -346,55 +295,23 @@ bool TileStore::refresh(const Digest128& map) {
     return index->packs.size() > before;
 }
 
-void TileStore::flush() {
-    std::unique_lock<std::mutex> lock(queueMutex_);
-    queueChanged_.wait(lock, [&] { return queue_.empty() && !writing_; });
-}
-
-void TileStore::writerLoop() {
-    std::unique_lock<std::mutex> lock(queueMutex_);
-    for (;;) {
-        queueChanged_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
-        if (queue_.empty()) return;  // stopping
-        PendingPack pack = std::move(queue_.front());
-        queue_.pop_front();
-        size_t taken = pack.bytes.size();
-        // Packs of the same map queued behind it go in the same file.
-        while (!queue_.empty() && queue_.front().map == pack.map &&
-               queue_.front().tileBytes == pack.tileBytes &&
-               pack.bytes.size() < (size_t{32} << 20)) {
-            PendingPack& next = queue_.front();
-            pack.keys.insert(pack.keys.end(), next.keys.begin(), next.keys.end());
-            pack.bytes.insert(pack.bytes.end(), next.bytes.begin(), next.bytes.end());
-            taken += next.bytes.size();
-            queue_.pop_front();
-        }
-        writing_ = true;
-        lock.unlock();
-        writeNow(pack);
-        lock.lock();
-        writing_ = false;
-        queuedBytes_ -= taken;
-        queueChanged_.notify_all();
-    }
-}
-
-void TileStore::writeNow(const PendingPack& pack) {
-    if (readOnly_.load(std::memory_order_relaxed)) return;
-    const size_t n = pack.keys.size();
+void TileStore::write(const Digest128& map, std::span<const uint64_t> keys,
+                      std::span<const unsigned char* const> tiles, size_t tileBytes) {
+    if (readOnly_.load(std::memory_order_relaxed) || keys.empty()) return;
+    const size_t n = keys.size();
     std::vector<TileHeader> headers(n);
     std::vector<IndexEntry> entries(n);
     uint64_t offset = 0;
     for (size_t i = 0; i < n; ++i) {
         TileHeader& h = headers[i];
         std::memcpy(h.magic, kTileMagic, sizeof kTileMagic);
-        h.mapHigh = pack.map.high;
-        h.mapLow = pack.map.low;
-        h.key = pack.keys[i];
-        h.payloadBytes = pack.tileBytes;
-        h.checksum = checksum64(pack.bytes.data() + i * pack.tileBytes, pack.tileBytes);
-        entries[i] = {pack.keys[i], offset};
-        offset += sizeof(TileHeader) + pack.tileBytes;
+        h.mapHigh = map.high;
+        h.mapLow = map.low;
+        h.key = keys[i];
+        h.payloadBytes = tileBytes;
+        h.checksum = checksum64(tiles[i], tileBytes);
+        entries[i] = {keys[i], offset};
+        offset += sizeof(TileHeader) + tileBytes;
     }
     PackFooter footer{};
     std::memcpy(footer.magic, kPackMagic, sizeof kPackMagic);
@@ -404,12 +321,12 @@ void TileStore::writeNow(const PendingPack& pack) {
     std::vector<std::span<const unsigned char>> pieces;
     for (size_t i = 0; i < n; ++i) {
         pieces.push_back(bytesOf(&headers[i], sizeof(TileHeader)));
-        pieces.push_back(bytesOf(pack.bytes.data() + i * pack.tileBytes, pack.tileBytes));
+        pieces.push_back(bytesOf(tiles[i], tileBytes));
     }
     pieces.push_back(bytesOf(entries.data(), n * sizeof(IndexEntry)));
     pieces.push_back(bytesOf(&footer, sizeof footer));
 
-    const fs::path folder = mapFolder(pack.map);
+    const fs::path folder = mapFolder(map);
     const fs::path path = folder / (uniqueName() + ".pack");
     bool ok = writeAtomically(path, pieces);
     if (!ok) {
@@ -425,12 +342,11 @@ void TileStore::writeNow(const PendingPack& pack) {
         return;
     }
     counters_.written.fetch_add(n, std::memory_order_relaxed);
-    counters_.packsWritten.fetch_add(1, std::memory_order_relaxed);
     // Readers in this process find the pack at once.
     std::shared_ptr<MapIndex> index;
     {
         std::lock_guard<std::mutex> lock(mutex_);
-        const auto it = indices_.find(pack.map.hex());
+        const auto it = indices_.find(map.hex());
         if (it != indices_.end()) index = it->second;
     }
     if (!index) return;
@@ -498,7 +414,7 @@ void TileStore::writeRecord(const Digest128& key, std::span<const unsigned char>
 void TileStore::useMap(const Digest128& map, const StoredMapInfo& info) {
     {
         std::lock_guard<std::mutex> lock(mutex_);
-        if (!used_.emplace(map.hex(), true).second) return;
+        if (!used_.insert(map.hex()).second) return;
     }
     const fs::path folder = mapFolder(map);
     std::error_code ec;

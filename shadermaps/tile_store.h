@@ -16,36 +16,31 @@
 // creation (the gallery's cold run +85%); a pack costs one file a map and fill.
 //
 // Concurrency: a pack is written under a name no other writer uses (host, process,
-// counter) and renamed into place whole, so readers see whole packs or none; two writers of
-// one tile write the same bytes. A reader finds the packs of a map when it first reads it
-// and again when a tile is missing and the folder has changed since. A tile whose checks
+// counter) and renamed into place whole, so readers see whole packs or none. A tile whose checks
 // fail (header, size, checksum) is counted as damaged and never read; another copy (a newer
 // pack, refilled) is tried, else it is missing and filled again. A pack whose footer is
 // damaged is removed. Clean-up (gc()) removes whole maps, least recently used first.
 //
 // Each tile is filled once across processes: a map's fills hold its fill lock (flock on
-// fill.lock in its folder), look again for packs written meanwhile, and write their pack
-// before letting go (ShaderMap::fill). Writes without `now` happen on a thread of the
-// store's own: write() copies the tiles into a queue (at most kQueueBytes; a write beyond
-// waits for room) and returns; flush() (and the destructor) waits until every queued pack
-// is on disk.
+// fill.lock in its folder), look again for packs written meanwhile (refresh()), and write
+// their pack before letting go (ShaderMap::fill). A reader lists a map's packs when it
+// first reads the map and then only when refresh() asks; its own packs it adds as it
+// writes them.
 //
 // Errors: a store that cannot be written (a full disk, no permission) warns once on stderr
 // and goes on read-only; rendering never fails because of the store.
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <shared_mutex>
 #include <span>
 #include <string>
-#include <thread>
 #include <unordered_map>
 #include <vector>
 
@@ -62,8 +57,8 @@ struct StoredMapInfo {
 };
 
 struct TileStoreCounters {
-    std::atomic<uint64_t> loaded{0}, written{0}, packsWritten{0}, absent{0}, damaged{0},
-        writeFailures{0}, recordsRead{0}, recordsWritten{0};
+    std::atomic<uint64_t> loaded{0}, written{0}, damaged{0}, writeFailures{0}, recordsRead{0},
+        recordsWritten{0};
 };
 
 // One map of a store, as gc() and info() see it.
@@ -77,12 +72,10 @@ struct StoredMapSummary {
 class TileStore {
   public:
     static constexpr const char* kTilesFolder = "tiles-v1";
-    static constexpr size_t kQueueBytes = size_t{64} << 20;
 
     // Opens (creating it if needed) the store at `root`. Throws InputError naming the folder
     // when it cannot be made or is not a folder.
     explicit TileStore(std::filesystem::path root);
-    ~TileStore();  // flushes
     TileStore(const TileStore&) = delete;
     TileStore& operator=(const TileStore&) = delete;
 
@@ -91,11 +84,10 @@ class TileStore {
     // Reads tile `key` (TileKey::packed()) of map `map` into `out`, whose size must be the
     // tile's storage. True when a whole, checked tile of that size was read. Thread-safe.
     bool read(const Digest128& map, uint64_t key, std::span<unsigned char> out);
-    // Writes tiles of map `map` as one pack: keys[i]'s storage is tiles[i], `tileBytes` long.
-    // Queued for the store's thread (copied now), or with `now` written before returning.
-    // Failures are counted, never thrown.
+    // Writes tiles of map `map` as one pack, before returning: keys[i]'s storage is
+    // tiles[i], `tileBytes` long. Failures are counted, never thrown.
     void write(const Digest128& map, std::span<const uint64_t> keys,
-               std::span<const unsigned char* const> tiles, size_t tileBytes, bool now = false);
+               std::span<const unsigned char* const> tiles, size_t tileBytes);
 
     // While one is held, no other holder -- in this process or another sharing the store, on
     // this machine or another (flock on the map's `fill.lock`) -- fills the map's tiles.
@@ -114,8 +106,6 @@ class TileStore {
     // Finds the packs other processes added to the map since it was last looked at; whether
     // there were any.
     bool refresh(const Digest128& map);
-    // Waits until every queued pack is written (or has failed).
-    void flush();
     // Records the map's description (once per store object and map) and marks it used now.
     void useMap(const Digest128& map, const StoredMapInfo& info);
     // The keys of the tiles stored for `map` (each once), as the packs' indices list them.
@@ -144,35 +134,19 @@ class TileStore {
   private:
     struct Pack;
     struct MapIndex;
-    struct PendingPack {
-        Digest128 map;
-        std::vector<uint64_t> keys;
-        std::vector<unsigned char> bytes;  // the tiles, tileBytes each, in keys' order
-        size_t tileBytes = 0;
-    };
     std::filesystem::path mapFolder(const Digest128& map) const;
     void warnOnce(const std::string& message);
-    // The map's index, scanned first when `rescan` and the folder changed since.
-    std::shared_ptr<MapIndex> indexOf(const Digest128& map, bool rescan);
+    // The map's index, its packs listed when it is first asked for.
+    std::shared_ptr<MapIndex> indexOf(const Digest128& map);
     void scan(const Digest128& map, MapIndex& index);
-    void writeNow(const PendingPack& pack);
-    void writerLoop();
 
     std::filesystem::path root_;
     TileStoreCounters counters_;
-    std::mutex mutex_;                  // guards used_, warned_ and indices_
-    std::map<std::string, bool> used_;  // maps marked used by this object
+    std::mutex mutex_;            // guards used_, warned_ and indices_
+    std::set<std::string> used_;  // maps marked used by this object
     std::map<std::string, std::shared_ptr<MapIndex>> indices_;
     bool warned_ = false;
     std::atomic<bool> readOnly_{false};
-    // The write queue, guarded by queueMutex_; the writer thread starts at the first write.
-    std::mutex queueMutex_;
-    std::condition_variable queueChanged_;
-    std::deque<PendingPack> queue_;
-    size_t queuedBytes_ = 0;
-    bool writing_ = false;  // the writer holds a pack taken from the queue
-    bool stopping_ = false;
-    std::thread writer_;
 };
 
 // The store's default folder: $MPSHADE_STORE if set, else $XDG_CACHE_HOME/mpshade/store,

@@ -36,12 +36,11 @@ std::vector<unsigned char> bytes(size_t n, unsigned char seed) {
     return v;
 }
 
-// Writes tiles of `map` as one pack and waits until it is on disk.
+// Writes tiles of `map` as one pack.
 void writePack(TileStore& store, const Digest128& map, std::vector<uint64_t> keys,
                const std::vector<unsigned char>& tile) {
     std::vector<const unsigned char*> tiles(keys.size(), tile.data());
     store.write(map, keys, tiles, tile.size());
-    store.flush();
 }
 
 std::vector<fs::path> packs(const fs::path& root) {
@@ -59,7 +58,6 @@ TEST(TileStore, ReadsWhatWasWrittenUnderItsDigestAndKeyOnly) {
     const std::vector<const unsigned char*> both = {tile.data(), second.data()};
     const std::vector<uint64_t> keys = {42, 44};
     store.write(map, keys, both, tile.size());
-    store.flush();
     EXPECT_EQ(packs(root).size(), 1u);  // one pack for the fill
     std::vector<unsigned char> out(tile.size());
     ASSERT_TRUE(store.read(map, 42, out));
@@ -248,7 +246,6 @@ TEST(TileStore, AMapReadsStoredTilesBitForBitAndFillsTheRest) {
     const FillStats a = first.fill(keys);
     EXPECT_EQ(a.tiles, 4u);
     EXPECT_EQ(a.tilesLoaded, 0u);
-    store->flush();
 
     ShaderMap second(plane, kernel, {}, options, nullptr, stored);
     std::vector<TileKey> more = keys;
