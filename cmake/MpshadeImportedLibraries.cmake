@@ -15,25 +15,25 @@ if(_oiio_inc)
   set_target_properties(OpenImageIO::OpenImageIO PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_oiio_kept}")
 endif()
 
+# mpshade_import(TARGET HEADER LIBRARY): a library found by one of its headers and its
+# name, as the UNKNOWN IMPORTED target TARGET (kept if it exists: the config may be read
+# twice).
+function(mpshade_import target header library)
+  string(MAKE_C_IDENTIFIER "${target}" id)
+  find_path(${id}_INCLUDE_DIR ${header} REQUIRED)
+  find_library(${id}_LIBRARY ${library} REQUIRED)
+  if(NOT TARGET ${target})
+    add_library(${target} UNKNOWN IMPORTED)
+    set_target_properties(${target} PROPERTIES
+      IMPORTED_LOCATION "${${id}_LIBRARY}"
+      INTERFACE_INCLUDE_DIRECTORIES "${${id}_INCLUDE_DIR}")
+  endif()
+endfunction()
+
 # OpenSubdiv's Debian CMake config names static libraries the package does not ship, so it
 # is found by hand. libosdCPU holds Far, Sdc, Vtr and Bfr.
-find_path(OPENSUBDIV_INCLUDE_DIR opensubdiv/version.h REQUIRED)
-find_library(OPENSUBDIV_CPU_LIBRARY osdCPU REQUIRED)
-if(NOT TARGET mpshade::opensubdiv)
-  add_library(mpshade::opensubdiv UNKNOWN IMPORTED)
-  set_target_properties(mpshade::opensubdiv PROPERTIES
-    IMPORTED_LOCATION "${OPENSUBDIV_CPU_LIBRARY}"
-    INTERFACE_INCLUDE_DIRECTORIES "${OPENSUBDIV_INCLUDE_DIR}")
-endif()
+mpshade_import(mpshade::opensubdiv opensubdiv/version.h osdCPU)
 
 # xxHash (libxxhash-dev) has no CMake config either: XXH3 digests address the shader-map
 # store (shadermaps/tile_store.h) and check its tiles.
-find_path(XXHASH_INCLUDE_DIR xxhash.h REQUIRED)
-find_library(XXHASH_LIBRARY xxhash REQUIRED)
-if(NOT TARGET mpshade::xxhash)
-  add_library(mpshade::xxhash UNKNOWN IMPORTED)
-  set_target_properties(mpshade::xxhash PROPERTIES
-    IMPORTED_LOCATION "${XXHASH_LIBRARY}"
-    INTERFACE_INCLUDE_DIRECTORIES "${XXHASH_INCLUDE_DIR}")
-endif()
-
+mpshade_import(mpshade::xxhash xxhash.h xxhash)

@@ -165,7 +165,7 @@ double StaticPhase::combinedFacets(size_t object, const ObjectState& state,
     // The survey dices too (the courtyard's 50 objects: 50 ms of a warm run's first frame),
     // so its estimate is kept in the store like the facets.
     Digest128 key;
-    if (options_.store && sceneObject.geometryDigest != Digest128{}) {
+    if (stores(object)) {
         ContentHasher h;
         h.addString("mpshade facet survey");
         addDicingInputs(h, object, survey, state, camera);
@@ -332,7 +332,7 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     // The facets: read from the store where an earlier run built the same ones (the
     // same geometry, view, state, options and, for combined facets, static program and
     // inputs), else diced and shaded here (and stored).
-    const Digest128 key = options_.store && sceneObject.geometryDigest != Digest128{}
+    const Digest128 key = stores(index)
                               ? representationKey(index, combined, direct, state, camera, uniforms)
                               : Digest128{};
     std::vector<unsigned char> record;
@@ -375,10 +375,12 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     return rep;
 }
 
-// Everything a representation's facets depend on: the geometry, the kind, the object's
-// state and the camera at the representative frame (so its dicing view), the dicing
-// options and range, the vertex rows kept, and for combined facets the static program
-// and the uniforms it reads.
+// Whether object `index`'s static work is kept in the store: there is one, and the
+// geometry has a digest (objects made in code, not loaded, have none).
+bool StaticPhase::stores(size_t index) const {
+    return options_.store && scene_.objects[index].geometryDigest != Digest128{};
+}
+
 // What dicing object `index` for this frame depends on: the engine, the geometry, the
 // object's state and the camera at the frame (so its dicing view), the options and range.
 void StaticPhase::addDicingInputs(ContentHasher& h, size_t index, const DicingOptions& d,
@@ -441,12 +443,11 @@ std::shared_ptr<ShaderMap> StaticPhase::makeShaderMap(size_t index,
 }
 
 // Everything a tile's texels depend on (tile_store.h): the static program and the uniform
-// values it reads, the surface, and the map's layout. Objects whose geometry has no digest
-// (made in code, not loaded) are not stored.
+// values it reads, the surface, and the map's layout.
 StoredTiles StaticPhase::storedTiles(size_t index, const ShadingUniforms& uniforms,
                                      const ShaderMapOptions& map) const {
     const SceneObject& sceneObject = scene_.objects[index];
-    if (!options_.store || sceneObject.geometryDigest == Digest128{}) return {};
+    if (!stores(index)) return {};
     const IrProgram& program = objects_[index]->staticKernel->program();
     ContentHasher hasher;
     hasher.addString("mpshade shader map").addDigest(engineDigest());

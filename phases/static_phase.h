@@ -130,6 +130,7 @@ class StaticPhase {
     std::shared_ptr<ShaderMap> makeShaderMap(size_t index, const ShadingUniforms& uniforms) const;
     StoredTiles storedTiles(size_t index, const ShadingUniforms& uniforms,
                             const ShaderMapOptions& map) const;
+    bool stores(size_t index) const;
     void addDicingInputs(ContentHasher& h, size_t index, const DicingOptions& dicing,
                          const ObjectState& state, const CameraState& camera) const;
     Digest128 representationKey(size_t index, bool combined, bool direct, const ObjectState& state,
