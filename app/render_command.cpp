@@ -152,7 +152,11 @@ void planRange(const RenderCommandOptions& options, const Scene& scene, int firs
         throw InputError({"--plan-frames", 0, 0, {}},
                          "--plan-frames plans the multi-phase renderer (the reference's frames are "
                          "independent)");
-    parseFrameRange(options.planFrames, scene.frameCount(), planFirst, planLast, options.scene);
+    try {
+        parseFrameRange(options.planFrames, scene.frameCount(), planFirst, planLast, options.scene);
+    } catch (const InputError& e) {
+        throw InputError({"--plan-frames", 0, 0, {}}, e.message());  // not --frames
+    }
     if (planFirst > first || planLast < last)
         throw InputError({"--plan-frames", 0, 0, {}},
                          fmt::format("must hold the frames asked for, {}:{}; found {}:{}", first,
@@ -267,7 +271,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         if (interrupted()) break;
     }
     if (skipped > 0 && !options.quiet)
-        std::fprintf(stderr, "mpshade: %d frame(s) already in %s were not rendered again\n",
+        std::fprintf(stderr, "mpshade: %d frame(s) already in %s were not written again\n",
                      skipped, options.outDir.c_str());
     bar.finish();
     cleanUpStore(store, options.run);

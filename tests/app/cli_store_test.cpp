@@ -338,6 +338,9 @@ TEST(CliStore, ShardsPlannedOverTheRangeRenderTheBitsOfOneRender) {
     const CliRun outside = mpshade(args + " --frames 4:6 --plan-frames 0:5 --out " + alone);
     EXPECT_EQ(outside.exitCode, 2);
     EXPECT_NE(outside.output.find("--plan-frames"), std::string::npos) << outside.output;
+    const CliRun malformed = mpshade(args + " --frames 4:6 --plan-frames 0:x --out " + alone);
+    EXPECT_EQ(malformed.exitCode, 2);
+    EXPECT_NE(malformed.output.find("--plan-frames: error"), std::string::npos) << malformed.output;
 }
 
 }  // namespace
