@@ -93,8 +93,12 @@ void warpFloat(benchmark::State& state) {
 }
 
 // Steady-state frames at the example's own size and spp: the static phase has run (frame
-// 0), then frame 1 is rendered again and again (its tiles filled by the first iteration).
-// The multi-phase figure is beside the reference's, in the same binary and run.
+// 0), then frames 1 and 2 are rendered in turn (their tiles filled before timing). The
+// two alternate because a frame equal to the last one is a still view, replayed without
+// warp, rasterization or probes (view_reuse.h): rendering one frame over and over times
+// that replay, not a frame of a moving camera. A scene whose camera does hold still
+// (lamplight) is replayed as render would replay it. The multi-phase figure is beside
+// the reference's, in the same binary and run, on the same frames.
 struct FrameFixture {
     Scene scene;
     std::unique_ptr<MultiphaseRenderer> multi;
@@ -108,8 +112,10 @@ void frameReference(benchmark::State& state, const char* path) {
     f.reference = std::make_unique<ReferenceRenderer>(f.scene);
     FrameStats stats;
     Image image;  // reused frame to frame, as render and play do
+    int frame = 1;
     for (auto _ : state) {
-        f.reference->renderFrame(1, f.options, stats, image);
+        f.reference->renderFrame(frame, f.options, stats, image);
+        frame = 3 - frame;
         benchmark::DoNotOptimize(image.rgba.data());
     }
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * stats.samples));
@@ -119,8 +125,8 @@ void frameReference(benchmark::State& state, const char* path) {
 // alone: valgrind --tool=callgrind --toggle-collect='*steadyFrame*'.
 // The image is reused frame to frame, as render and play reuse it.
 __attribute__((noinline)) void steadyFrame(MultiphaseRenderer& multi, const RenderOptions& options,
-                                           FrameStats& stats, Image& image) {
-    multi.renderFrame(1, options, stats, image);
+                                           FrameStats& stats, Image& image, int frame) {
+    multi.renderFrame(frame, options, stats, image);
 }
 
 void frameMultiphase(benchmark::State& state, const char* path, int representation, int rate) {
@@ -132,9 +138,12 @@ void frameMultiphase(benchmark::State& state, const char* path, int representati
     FrameStats stats;
     f.multi->renderFrame(0, f.options, stats);  // the static phase
     f.multi->renderFrame(1, f.options, stats);  // frame 1's tiles
+    f.multi->renderFrame(2, f.options, stats);  // frame 2's
     Image image;
+    int frame = 1;
     for (auto _ : state) {
-        steadyFrame(*f.multi, f.options, stats, image);
+        steadyFrame(*f.multi, f.options, stats, image, frame);
+        frame = 3 - frame;
         benchmark::DoNotOptimize(image.rgba.data());
     }
     state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * stats.samples));
@@ -145,6 +154,7 @@ void frameMultiphase(benchmark::State& state, const char* path, int representati
     state.counters["shade_ms"] = 1e3 * stats.dynamic.shadeSeconds;
     state.counters["resolve_ms"] = 1e3 * stats.dynamic.resolveSeconds;
     state.counters["shading_points"] = static_cast<double>(stats.shadedPoints);
+    state.counters["view_reused"] = stats.dynamic.viewReused ? 1.0 : 0.0;
     state.counters["probes_per_point"] =
         stats.shadedPoints ? static_cast<double>(stats.dynamic.probes) / stats.shadedPoints : 0.0;
     // Each stage in nanoseconds per sample per core (stage_limits.h), the last frame's.
@@ -250,6 +260,10 @@ BENCHMARK_CAPTURE(predictAhead, courtyard, "examples/courtyard/scene.json")
 MPSHADE_FRAME_BENCH(vase, "examples/vase/scene.json");
 MPSHADE_FRAME_BENCH(teapot, "examples/teapot/scene.json");
 MPSHADE_FRAME_BENCH(courtyard, "examples/courtyard/scene.json");
+MPSHADE_FRAME_BENCH(gallery, "examples/gallery/scene.json");
+// A still camera, only a light moving: each frame after the first replays the last one's
+// view (view_reuse.h), the case where the static part is largest.
+MPSHADE_FRAME_BENCH(lamplight, "examples/vase/lamplight.json");
 // The hard case of a 400 x 400 floor seen from 0.25 units above it, dollying along it.
 MPSHADE_FRAME_BENCH(grazing_floor, "tests/data/scenes/grazing_floor.json");
 
