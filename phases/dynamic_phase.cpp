@@ -80,6 +80,7 @@ struct DynamicPhase::Band {
         std::vector<uint8_t> batchMissed;
         SurfaceShadingScratch surface;
         SurfaceShadingCounters counters;
+        std::vector<const float*> keptChannels;  // replay: the kept n-tuple channels of a batch
         std::vector<ObjectFrameCost> costs;  // per object
 
         // Every point of a fresh band, each object's as runs of the band's own arrays; the
@@ -146,9 +147,10 @@ void DynamicPhase::Band::Scratch::replay(std::span<const ObjectView> views, Band
         surface.missing.clear();
         for (size_t b = begin; b < end; b += kBatch) {
             const size_t m = std::min(kBatch, end - b);
-            surface.batch.resize(m, layout.channels[o]);
-            kept.restore(surface.batch, layout.rows[o], layout.channels[o], m, cursor);
-            runDynamicShader(views[o], m, &pts.color[3 * b], &pts.opacity[3 * b], surface, c);
+            surface.batch.resize(m, layout.channels[o]);  // outputs; unkept rows unread
+            ShadingInputs in = surface.batch.in;
+            kept.restore(in, keptChannels, layout.rows[o], layout.channels[o], m, cursor);
+            runDynamicShader(views[o], in, m, &pts.color[3 * b], &pts.opacity[3 * b], surface, c);
         }
         std::vector<TileRequest> none;
         addObjectCosts(o, c, began, none);
@@ -239,13 +241,27 @@ void compositeBand(const BandPoints& pts, const BandRange& r, const VisibilityBu
         float firstRgba[4];
         bool same = true;
         for (size_t smp = first; smp < first + spp; ++smp) {
-            SampleComposite c;
-            for (int l = 0; l < vis.count[smp]; ++l) {
-                const uint32_t p = pts.fragmentPoint[smp * layers + l - r.firstSlot];
-                c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
-            }
             float rgba[4];
-            c.finish(background, rgba);
+            if (vis.count[smp] == 1) {
+                // One surface (most samples): SampleComposite's arithmetic written out for one
+                // layer, the same bits without its loops over layers and channels.
+                const uint32_t p = pts.fragmentPoint[smp * layers - r.firstSlot];
+                const float* ci = &pts.color[3 * p];
+                const float* oi = &pts.opacity[3 * p];
+                float t[3];
+                for (int k = 0; k < 3; ++k) {
+                    t[k] = 1.0f - oi[k];
+                    rgba[k] = (0.0f + oi[k] * ci[k]) + t[k] * background[k];
+                }
+                rgba[3] = 1.0f - (t[0] + t[1] + t[2]) / 3.0f;
+            } else {
+                SampleComposite c;
+                for (int l = 0; l < vis.count[smp]; ++l) {
+                    const uint32_t p = pts.fragmentPoint[smp * layers + l - r.firstSlot];
+                    c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
+                }
+                c.finish(background, rgba);
+            }
             std::memcpy(&rgbaOut[4 * smp], rgba, sizeof rgba);
             if (smp == first)
                 std::memcpy(firstRgba, rgba, sizeof rgba);

@@ -189,19 +189,31 @@ size_t probeChannels(const ShaderMap& map, const ProbeOptions& probe, bool stopA
 
 }  // namespace
 
-void runDynamicShader(const ObjectView& view, size_t n, float* color, float* opacity,
-                      SurfaceShadingScratch& scratch, SurfaceShadingCounters& counters) {
+void runDynamicShader(const ObjectView& view, const ShadingInputs& in, size_t n, float* color,
+                      float* opacity, SurfaceShadingScratch& scratch,
+                      SurfaceShadingCounters& counters) {
     ShadingBatch& batch = scratch.batch;
     ShadingCounters shading;
-    view.rep->dynamicKernel->run(*view.uniforms, batch.in, n, batch.out, scratch.workspace,
-                                 shading);
+    view.rep->dynamicKernel->run(*view.uniforms, in, n, batch.out, scratch.workspace, shading);
     counters.instructions += shading.instructions;
+    // sanitizeShade (compositing.h) without a branch, so the loop vectorizes: x - x is 0
+    // for a finite x and NaN otherwise, and a sum with a NaN is not 0.
+    const float *c0 = batch.out.Ci[0], *c1 = batch.out.Ci[1], *c2 = batch.out.Ci[2];
+    const float *o0 = batch.out.Oi[0], *o1 = batch.out.Oi[1], *o2 = batch.out.Oi[2];
+    uint64_t nonFinite = 0;
     for (size_t i = 0; i < n; ++i) {
-        float ci[3], oi[3];
-        for (int k = 0; k < 3; ++k) ci[k] = batch.out.Ci[k][i], oi[k] = batch.out.Oi[k][i];
-        if (!sanitizeShade(ci, oi)) ++counters.nonFinite;
-        for (int k = 0; k < 3; ++k) color[3 * i + k] = ci[k], opacity[3 * i + k] = oi[k];
+        const float check = (c0[i] - c0[i]) + (c1[i] - c1[i]) + (c2[i] - c2[i]) +
+                            (o0[i] - o0[i]) + (o1[i] - o1[i]) + (o2[i] - o2[i]);
+        const bool finite = check == 0.0f;
+        nonFinite += finite ? 0 : 1;
+        color[3 * i] = finite ? c0[i] : 0.0f;
+        color[3 * i + 1] = finite ? c1[i] : 0.0f;
+        color[3 * i + 2] = finite ? c2[i] : 0.0f;
+        opacity[3 * i] = finite ? std::clamp(o0[i], 0.0f, 1.0f) : 1.0f;
+        opacity[3 * i + 1] = finite ? std::clamp(o1[i], 0.0f, 1.0f) : 1.0f;
+        opacity[3 * i + 2] = finite ? std::clamp(o2[i], 0.0f, 1.0f) : 1.0f;
     }
+    counters.nonFinite += nonFinite;
 }
 
 std::vector<int> shadingInputRows(const ObjectRepresentation& rep) {
@@ -269,7 +281,7 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
         missedCount =
             probeChannels(*rep.map, probe, stopAtMissing, n, channels, missed, scratch, counters);
 
-    runDynamicShader(view, n, color, opacity, scratch, counters);
+    runDynamicShader(view, batch.in, n, color, opacity, scratch, counters);
     if (missedCount > 0) {
         missedCount = 0;
         for (size_t i = 0; i < n; ++i) missedCount += missed[i];

@@ -68,12 +68,14 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
                           uint8_t* missed, SurfaceShadingScratch& scratch,
                           SurfaceShadingCounters& counters);
 
-// Step 6 of shadeSurfacePoints alone: the dynamic shader on the n points whose inputs are in
-// scratch.batch (shadingInputRows and shadingChannels of it, as shadeSurfacePoints leaves
-// them, or as a caller that kept them puts them back), its results made finite into color
-// and opacity (3 floats per point each).
-void runDynamicShader(const ObjectView& view, size_t n, float* color, float* opacity,
-                      SurfaceShadingScratch& scratch, SurfaceShadingCounters& counters);
+// Step 6 of shadeSurfacePoints alone: the dynamic shader on n points whose inputs `in`
+// points at (shadingInputRows and shadingChannels of scratch.batch as shadeSurfacePoints
+// leaves them, or the values a caller kept), its results -- written to scratch.batch's
+// outputs, which must have room for n -- made finite into color and opacity (3 floats per
+// point each).
+void runDynamicShader(const ObjectView& view, const ShadingInputs& in, size_t n, float* color,
+                      float* opacity, SurfaceShadingScratch& scratch,
+                      SurfaceShadingCounters& counters);
 // The ShadingBatch input rows shadeSurfacePoints fills for rep's points that rep's dynamic
 // shader may read (P, I and its geometry rows), ascending; the n-tuple's channels (batch
 // channels 0 .. shadingChannels - 1) come besides.

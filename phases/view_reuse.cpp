@@ -17,6 +17,20 @@ bool sameProbe(const ProbeOptions& a, const ProbeOptions& b) {
            a.levelBlend == b.levelBlend && a.tapsPerRatio == b.tapsPerRatio && a.cap == b.cap;
 }
 
+// The pointer of ShadingInputs that batch row r (ShadingBatch::Row) feeds.
+const float*& inputRow(ShadingInputs& in, int r) {
+    if (r < ShadingBatch::N) return in.P[r - ShadingBatch::P];
+    if (r < ShadingBatch::Ng) return in.N[r - ShadingBatch::N];
+    if (r < ShadingBatch::dPdu) return in.Ng[r - ShadingBatch::Ng];
+    if (r < ShadingBatch::dPdv) return in.dPdu[r - ShadingBatch::dPdu];
+    if (r < ShadingBatch::I) return in.dPdv[r - ShadingBatch::dPdv];
+    if (r < ShadingBatch::U) return in.I[r - ShadingBatch::I];
+    if (r == ShadingBatch::U) return in.u;
+    if (r == ShadingBatch::V) return in.v;
+    if (r == ShadingBatch::S) return in.s;
+    return in.t;
+}
+
 }  // namespace
 
 bool ViewKey::operator==(const ViewKey& o) const {
@@ -40,18 +54,21 @@ void BandInputs::append(ShadingBatch& batch, std::span<const int> rows, size_t c
     }
 }
 
-void BandInputs::restore(ShadingBatch& batch, std::span<const int> rows, size_t channels, size_t n,
+void BandInputs::restore(ShadingInputs& in, std::vector<const float*>& channels,
+                         std::span<const int> rows, size_t channelCount, size_t n,
                          size_t& cursor) const {
-    const float* in = values_.data() + cursor;
+    const float* at = values_.data() + cursor;
     for (int r : rows) {
-        std::memcpy(batch.row(r), in, n * sizeof(float));
-        in += n;
+        inputRow(in, r) = at;
+        at += n;
     }
-    for (size_t c = 0; c < channels; ++c) {
-        std::memcpy(batch.channel(c), in, n * sizeof(float));
-        in += n;
+    channels.resize(channelCount);
+    for (size_t c = 0; c < channelCount; ++c) {
+        channels[c] = at;
+        at += n;
     }
-    cursor += (rows.size() + channels) * n;
+    in.channels = channels.data();
+    cursor += (rows.size() + channelCount) * n;
 }
 
 }  // namespace mpshade

@@ -68,10 +68,11 @@ class BandInputs {
         values_ = {};
         valid_ = false;
     }
-    // Puts the next batch of n points back into `batch` (sized for n and `channels`), from
-    // `cursor` on, which it advances.
-    void restore(ShadingBatch& batch, std::span<const int> rows, size_t channels, size_t n,
-                 size_t& cursor) const;
+    // Points `in` at the next batch of n points' kept values, from `cursor` on, which it
+    // advances: each kept row's pointer, and the n-tuple's through `channels` (resized to
+    // `channelCount`). Nothing is copied; the pointers hold until the next start().
+    void restore(ShadingInputs& in, std::vector<const float*>& channels, std::span<const int> rows,
+                 size_t channelCount, size_t n, size_t& cursor) const;
 
   private:
     std::vector<float> values_;

@@ -122,6 +122,71 @@ TEST(DynamicPhase, CompositesFrontToBackOverTheBackgroundAtEveryRate) {
     }
 }
 
+// A plane filling the view from above, shaded by `source`, over the background
+// (0.2, 0.4, 0.6).
+std::string writePlaneScene(const std::string& name, const std::string& source) {
+    const std::string dir = ::testing::TempDir() + "mpshade_dynamic_" + name + "/";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "plane.sl") << source;
+    std::ofstream(dir + "scene.json") << R"({ "settings": { "width": 16, "height": 12,
+      "samples_per_pixel": 4, "fps": 1, "duration": 1, "background": [0.2, 0.4, 0.6] },
+      "camera": { "fov_y": 40, "near": 0.05, "far": 100,
+                  "keys": [ { "t": 0, "eye": [0, 4, 0.01], "target": [0, 0, 0] } ] },
+      "shaders": { "plane": "plane.sl" },
+      "objects": [ { "name": "plane", "geometry": { "type": "plane", "size": [20, 20] },
+                     "shader": "plane" } ] })";
+    return dir + "scene.json";
+}
+
+TEST(DynamicPhase, OpacityOutsideZeroToOneIsClampedAndANonFiniteResultIsOpaqueBlack) {
+    // Oi (2, -1, 0.5) is taken as (1, 0, 0.5): white over the background gives
+    // (1, 0.4, 0.5 + 0.5 * 0.6) and alpha 1 - (0 + 1 + 0.5) / 3. Unclamped, green would be
+    // 0.4 * 2 - 1 and alpha 1 - (-1 + 2 + 0.5) / 3.
+    // Where x > 0.045 the second shader's green is inf - inf: the whole result (every
+    // channel, and opacity) becomes opaque black; elsewhere it shades as written.
+    struct Case {
+        const char* name;
+        const char* source;
+    };
+    const Case cases[] = {
+        {"clamped", "surface plane() { Ci = color(1, 1, 1); Oi = color(2, -1, 0.5); }"},
+        {"nonfinite", "surface plane() { float big = exp(P[0] * 2000.0); "
+                      "Ci = color(0.25, 0.5 + (big - big), 0.75); Oi = 0.5; }"},
+    };
+    for (const Case& c : cases) {
+        Frame f(writePlaneScene(c.name, c.source), Representation::Facets);
+        for (ShadingRate rate : {ShadingRate::Sample, ShadingRate::Pixel}) {
+            DynamicPhase phase(f.scene);
+            phase.begin(f.state, f.drawn, f.layout, f.options(rate));
+            EXPECT_TRUE(phase.shade().empty());
+            ASSERT_TRUE(phase.complete());
+            Image image;
+            phase.resolve(image);
+            size_t black = 0, shaded = 0;
+            for (size_t p = 0; p < image.rgba.size() / 4; ++p) {
+                const float* px = &image.rgba[4 * p];
+                for (int k = 0; k < 4; ++k) ASSERT_TRUE(std::isfinite(px[k])) << c.name;
+                if (std::string(c.name) == "clamped") {
+                    const float want[4] = {1.0f, 0.4f, 0.8f, 0.5f};
+                    for (int k = 0; k < 4; ++k) ASSERT_NEAR(px[k], want[k], 1e-5f) << "pixel " << p;
+                } else if (px[0] == 0.0f && px[1] == 0.0f && px[2] == 0.0f) {
+                    EXPECT_FLOAT_EQ(px[3], 1.0f);
+                    ++black;
+                } else if (std::fabs(px[0] - (0.125f + 0.1f)) < 1e-5f &&
+                           std::fabs(px[1] - (0.25f + 0.2f)) < 1e-5f &&
+                           std::fabs(px[2] - (0.375f + 0.3f)) < 1e-5f) {
+                    ++shaded;
+                }
+            }
+            if (std::string(c.name) == "nonfinite") {
+                // Both regions are large; pixels on their border mix the two.
+                EXPECT_GT(black, image.rgba.size() / 4 / 8) << static_cast<int>(rate);
+                EXPECT_GT(shaded, image.rgba.size() / 4 / 8) << static_cast<int>(rate);
+            }
+        }
+    }
+}
+
 TEST(DynamicPhase, OneShadingPointPerSamplePixelOrBlockAndSurface) {
     // Both planes cover every sample: per sample, a point per fragment (two per sample);
     // per pixel, two per pixel; per 2x2 block, two per block.
