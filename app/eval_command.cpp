@@ -76,6 +76,8 @@ std::vector<EvalConfig> ladders(int spp, bool quick) {
     });
     add("max_anisotropy", "aniso=1", [](EvalConfig& c) { c.maxAnisotropy = 1.0f; });
     add("max_anisotropy", "aniso=8", [](EvalConfig& c) { c.maxAnisotropy = 8.0f; });
+    add("level_anisotropy", "level aniso=off", [](EvalConfig& c) { c.levelAnisotropy = 0.0f; });
+    add("level_anisotropy", "level aniso=8", [](EvalConfig& c) { c.levelAnisotropy = 8.0f; });
     add("facet_edge", "facet edge=1", [](EvalConfig& c) { c.facetEdgePixels = 1.0f; });
     add("range", "range x0.5", [](EvalConfig& c) { c.rangeScale = 0.5f; });
     add("range", "range x2", [](EvalConfig& c) { c.rangeScale = 2.0f; });

@@ -66,6 +66,7 @@ nlohmann::json runJson(const EvalRun& r, const SceneEvaluation& e) {
         settings["footprint_scale"] = c.footprintScale;
         settings["probe_filter"] = filterName(c.filter);
         settings["max_anisotropy"] = c.maxAnisotropy;
+        settings["level_anisotropy"] = c.levelAnisotropy;
         settings["facet_edge_pixels"] = c.facetEdgePixels;
         settings["range_scale"] = c.rangeScale;
         settings["cache_mb"] = c.cacheMb;

@@ -25,6 +25,7 @@ MultiphaseOptions multiphaseOptions(const EvalConfig& c) {
     o.dynamic.footprintScale = c.footprintScale;
     o.dynamic.probe.filter = c.filter;
     o.dynamic.probe.maxAnisotropy = c.maxAnisotropy;
+    o.dynamic.probe.levelAnisotropy = c.levelAnisotropy;
     o.staticPhase.combinedDicing.maxEdgePixels = c.facetEdgePixels;
     o.mapMemoryBytes = static_cast<size_t>(c.cacheMb) << 20;
     o.singlePhaseFrames = c.singlePhaseFrames;

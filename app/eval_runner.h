@@ -28,6 +28,7 @@ struct EvalConfig {
     float footprintScale = DynamicOptions{}.footprintScale;
     ProbeFilter filter = DynamicOptions{}.probe.filter;
     float maxAnisotropy = DynamicOptions{}.probe.maxAnisotropy;
+    float levelAnisotropy = DynamicOptions{}.probe.levelAnisotropy;
     float facetEdgePixels = 0.5f;   // combined representation: the facet size target
     float rangeScale = 1.0f;        // scales every object's range (distance factor - 1, angle)
     int cacheMb = 96;               // the shader maps' tile budget

@@ -81,7 +81,7 @@ struct DynamicPhase::Band {
         SurfaceShadingScratch surface;
         SurfaceShadingCounters counters;
         std::vector<const float*> keptChannels;  // replay: the kept n-tuple channels of a batch
-        std::vector<ObjectFrameCost> costs;  // per object
+        std::vector<ObjectFrameCost> costs;      // per object
 
         // Every point of a fresh band, each object's as runs of the band's own arrays; the
         // points whose probes found tiles missing go to stillPending.

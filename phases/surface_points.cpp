@@ -202,8 +202,8 @@ void runDynamicShader(const ObjectView& view, const ShadingInputs& in, size_t n,
     const float *o0 = batch.out.Oi[0], *o1 = batch.out.Oi[1], *o2 = batch.out.Oi[2];
     uint64_t nonFinite = 0;
     for (size_t i = 0; i < n; ++i) {
-        const float check = (c0[i] - c0[i]) + (c1[i] - c1[i]) + (c2[i] - c2[i]) +
-                            (o0[i] - o0[i]) + (o1[i] - o1[i]) + (o2[i] - o2[i]);
+        const float check = (c0[i] - c0[i]) + (c1[i] - c1[i]) + (c2[i] - c2[i]) + (o0[i] - o0[i]) +
+                            (o1[i] - o1[i]) + (o2[i] - o2[i]);
         const bool finite = check == 0.0f;
         nonFinite += finite ? 0 : 1;
         color[3 * i] = finite ? c0[i] : 0.0f;

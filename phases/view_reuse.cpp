@@ -14,7 +14,8 @@ bool sameCamera(const CameraState& a, const CameraState& b) {
 
 bool sameProbe(const ProbeOptions& a, const ProbeOptions& b) {
     return a.filter == b.filter && a.maxAnisotropy == b.maxAnisotropy &&
-           a.levelBlend == b.levelBlend && a.tapsPerRatio == b.tapsPerRatio && a.cap == b.cap;
+           a.levelBlend == b.levelBlend && a.tapsPerRatio == b.tapsPerRatio && a.cap == b.cap &&
+           a.levelAnisotropy == b.levelAnisotropy;
 }
 
 // The pointer of ShadingInputs that batch row r (ShadingBatch::Row) feeds.

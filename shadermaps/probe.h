@@ -58,6 +58,13 @@ struct ProbeOptions {
     // minor axis apart; fewer spread the same line more thinly.
     float tapsPerRatio = 2.0f;
     AnisotropyCap cap = AnisotropyCap::WidenMinor;
+    // ShrinkMajor: the finest level a footprint reads is that of major / levelAnisotropy.
+    // A footprint more eccentric than this (a floor near the horizon) first has its minor
+    // axis widened to major / levelAnisotropy, then its major axis shortened as ShrinkMajor
+    // does; footprints within it are not changed. Without it an oblique footprint reads --
+    // and its map fills -- texels as fine as its minor axis over a major axis dozens of
+    // times longer. 0: no such bound.
+    float levelAnisotropy = 0.0f;
 };
 
 struct ProbeQuery {

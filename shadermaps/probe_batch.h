@@ -19,8 +19,8 @@ struct Footprint {
     float major, minor;
 };
 
-Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy,
-                      AnisotropyCap cap) {
+Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy, AnisotropyCap cap,
+                      float levelAnisotropy) {
     float d[4] = {q.dudx, q.dvdx, q.dudy, q.dvdy};
     bool finite = true;
     for (float& x : d) {
@@ -46,6 +46,12 @@ Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy
     }
     f.major = la;
     f.minor = lb;
+    if (cap == AnisotropyCap::ShrinkMajor && levelAnisotropy > 0.0f && f.minor > 0.0f &&
+        f.minor * levelAnisotropy < f.major) {
+        const float widen = f.major / (levelAnisotropy * f.minor);
+        f.bx *= widen, f.by *= widen;
+        f.minor = f.major / levelAnisotropy;
+    }
     if (cap == AnisotropyCap::ShrinkMajor && f.minor > 0.0f && f.minor * maxAnisotropy < f.major) {
         const float shrink = f.minor * maxAnisotropy / f.major;
         f.ax *= shrink, f.ay *= shrink;
@@ -103,7 +109,7 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
                                                      options.filter == ProbeFilter::Trilinear
                                                          ? 1e30f
                                                          : options.maxAnisotropy,
-                                                     options.cap);
+                                                     options.cap, options.levelAnisotropy);
         if (options.filter == ProbeFilter::Trilinear) {
             p.trilinear(q.chart, std::log2(std::max(f.major, 1e-30f)), q.u, q.v, o);
             return;

@@ -150,8 +150,9 @@ TEST(DynamicPhase, OpacityOutsideZeroToOneIsClampedAndANonFiniteResultIsOpaqueBl
     };
     const Case cases[] = {
         {"clamped", "surface plane() { Ci = color(1, 1, 1); Oi = color(2, -1, 0.5); }"},
-        {"nonfinite", "surface plane() { float big = exp(P[0] * 2000.0); "
-                      "Ci = color(0.25, 0.5 + (big - big), 0.75); Oi = 0.5; }"},
+        {"nonfinite",
+         "surface plane() { float big = exp(P[0] * 2000.0); "
+         "Ci = color(0.25, 0.5 + (big - big), 0.75); Oi = 0.5; }"},
     };
     for (const Case& c : cases) {
         Frame f(writePlaneScene(c.name, c.source), Representation::Facets);

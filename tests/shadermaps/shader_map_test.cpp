@@ -342,6 +342,41 @@ TEST(ShaderMap, AnisotropyCapWidensTheMinorAxisOrShortensTheMajor) {
     }
 }
 
+TEST(ShaderMap, AnObliqueFootprintReadsNoFinerThanItsLevelAnisotropyAllows) {
+    // ShrinkMajor at 2:1 with the finest level bounded at 8:1: a footprint 1 texel across
+    // and 64 along reads level log2(64 / 8) = 3 (without the bound, level 0 of the minor
+    // axis); exactly 8:1 is within the bound (level 0 alone); 8.5:1 just past it widens the
+    // minor axis to 8.5 / 8 texels, log2 of which lies between levels 0 and 1. Rotating
+    // the footprint (major along u) changes nothing.
+    MapFixture f(kNoiseShader);
+    ShaderMapOptions sparse;
+    sparse.resolution = 256;
+    sparse.alwaysResidentLevels = 1;
+    ShaderMap empty(f.surface, *f.kernel, f.uniforms, sparse);
+    auto levels = [&](float major, bool alongU, float bound) {
+        ProbeOptions probe{ProbeFilter::Feline,        2.0f, 1.0f, 1.0f,
+                           AnisotropyCap::ShrinkMajor, bound};
+        TileKey missing[64];
+        ProbeResidency residency{missing, 64};
+        residency.stopAtMissing = true;
+        const float a = 1.0f / 256.0f, b = major / 256.0f;
+        const ProbeQuery q = alongU ? ProbeQuery{0, 0.4f, 0.6f, b, 0.0f, 0.0f, a}
+                                    : ProbeQuery{0, 0.4f, 0.6f, a, 0.0f, 0.0f, b};
+        float out[3];
+        probeShaderMap(empty, probe, {&q, 1}, out, &residency);
+        std::set<int> read;
+        for (size_t i = 0; i < residency.count; ++i) read.insert(missing[i].level);
+        return read;
+    };
+    for (const bool alongU : {false, true}) {
+        EXPECT_EQ(levels(64.0f, alongU, 8.0f), std::set<int>({3})) << alongU;
+        EXPECT_EQ(levels(64.0f, alongU, 0.0f), std::set<int>({0})) << alongU;
+        EXPECT_EQ(levels(64.0f, alongU, 16.0f), std::set<int>({2})) << alongU;
+        EXPECT_EQ(levels(8.0f, alongU, 8.0f), std::set<int>({0})) << alongU;
+        EXPECT_EQ(levels(8.5f, alongU, 8.0f), std::set<int>({0, 1})) << alongU;
+    }
+}
+
 TEST(ShaderMap, AlwaysResidentLevelsFilledUpFrontOrWhenFirstAsked) {
     // A plane is one chart; at 256 texels a side its six coarsest levels (32 x 32 .. 1 x 1)
     // are 4 + 5 tiles of 16 x 16.
