@@ -10,6 +10,12 @@ void addMultiphaseFrameJson(const Scene& scene, const FrameStats& stats, nlohman
     entry["warp_seconds"] = stats.dynamic.warpSeconds;
     entry["raster_seconds"] = stats.dynamic.rasterSeconds;
     entry["shade_seconds"] = stats.dynamic.shadeSeconds;
+    const DynamicFrameStats::ShadeParts& parts = stats.dynamic.shadeParts;
+    entry["shade_cpu_seconds"] = {{"points", parts.points},
+                                  {"interpolate", parts.interpolate},
+                                  {"probe", parts.probe},
+                                  {"kernel", parts.kernel},
+                                  {"composite", parts.composite}};
     entry["resolve_seconds"] = stats.dynamic.resolveSeconds;
     entry["static_runs"] = stats.staticWork.work.runs;
     entry["static_runs_from_store"] = stats.staticWork.work.representationsLoaded;

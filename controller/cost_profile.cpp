@@ -101,6 +101,45 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
     return p;
 }
 
+namespace {
+
+// The dynamic stages against the machine (stage_limits.h), with shade's parts.
+std::string stagesMarkdown(const CostProfile& p) {
+    std::string md;
+    if (p.stages.empty()) return md;
+    md += "## The dynamic phase against the machine\n\n";
+    md += format(
+        "Per sample per core: a stage's wall time times the %d cores sharing it, over the "
+        "frame's samples (the median of the steady frames). The bound is the time the "
+        "bytes the stage must stream take at the memory bandwidth measured now "
+        "(%.1f GB/s, every core copying): a stage near it is memory-bound, one far above "
+        "it computes (or waits on memory it does not stream). Shade's parts are CPU time "
+        "summed over the threads, per sample; shade: other is what shade took beyond them "
+        "(gathering points that waited for tiles, the last band, scheduling).\n\n",
+        p.machine.cores, p.machine.bytesPerSecond / 1e9);
+    md +=
+        "| stage | ns per sample | bytes per sample | bound, ns | times the bound | "
+        "dynamic instructions per sample |\n| --- | --- | --- | --- | --- | --- |\n";
+    for (const StageCost& c : p.stages) {
+        if (c.part) {
+            md += format("| shade: %s | %.1f | | | | %s |\n", c.name.c_str(), c.nsPerSample,
+                         c.instructionsPerSample > 0.0
+                             ? format("%.0f", c.instructionsPerSample).c_str()
+                             : "");
+            continue;
+        }
+        md += format(
+            "| %s | %.1f | %.0f | %.2f | %.1f | %s |\n", c.name.c_str(), c.nsPerSample,
+            c.bytesPerSample, c.boundNsPerSample,
+            c.boundNsPerSample > 0.0 ? c.nsPerSample / c.boundNsPerSample : 0.0,
+            c.instructionsPerSample > 0.0 ? format("%.0f", c.instructionsPerSample).c_str() : "");
+    }
+    md += "\n";
+    return md;
+}
+
+}  // namespace
+
 std::string profileMarkdown(const CostProfile& p) {
     std::string md;
     md += "# mpshade profile: " + p.scene + "\n\n";
@@ -148,27 +187,7 @@ std::string profileMarkdown(const CostProfile& p) {
             "for itself); their time is in the total only.\n\n",
             singlePhase);
 
-    if (!p.stages.empty()) {
-        md += "## The dynamic phase against the machine\n\n";
-        md += format(
-            "Per sample per core: a stage's wall time times the %d cores sharing it, over the "
-            "frame's samples (the median of the steady frames). The bound is the time the "
-            "bytes the stage must stream take at the memory bandwidth measured now "
-            "(%.1f GB/s, every core copying): a stage near it is memory-bound, one far above "
-            "it computes (or waits on memory it does not stream).\n\n",
-            p.machine.cores, p.machine.bytesPerSecond / 1e9);
-        md +=
-            "| stage | ns per sample | bytes per sample | bound, ns | times the bound | "
-            "dynamic instructions per sample |\n| --- | --- | --- | --- | --- | --- |\n";
-        for (const StageCost& c : p.stages)
-            md += format("| %s | %.1f | %.0f | %.2f | %.1f | %s |\n", c.name.c_str(), c.nsPerSample,
-                         c.bytesPerSample, c.boundNsPerSample,
-                         c.boundNsPerSample > 0.0 ? c.nsPerSample / c.boundNsPerSample : 0.0,
-                         c.instructionsPerSample > 0.0
-                             ? format("%.0f", c.instructionsPerSample).c_str()
-                             : "");
-        md += "\n";
-    }
+    md += stagesMarkdown(p);
     md += "## Per object\n\n";
     md +=
         "| object | representation | static runs | static ms | shading ms per frame drawn | "

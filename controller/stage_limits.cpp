@@ -99,6 +99,37 @@ std::vector<StageCost> dynamicStageCosts(const std::vector<FrameStats>& frames, 
          },
          nullptr},
     };
+    // Shade's parts: thread-summed CPU seconds, so not multiplied by the cores.
+    using Parts = DynamicFrameStats::ShadeParts;
+    const std::pair<const char*, double Parts::*> partFields[] = {
+        {"points", &Parts::points},
+        {"interpolate", &Parts::interpolate},
+        {"probe", &Parts::probe},
+        {"kernel", &Parts::kernel},
+        {"composite", &Parts::composite}};
+    auto shadeParts = [&](double shadeNs) {
+        std::vector<StageCost> parts;
+        double sum = 0.0;
+        for (const auto& [name, field] : partFields) {
+            std::vector<double> ns;
+            for (const FrameStats* f : steady)
+                ns.push_back(1e9 * f->dynamic.shadeParts.*field / static_cast<double>(f->samples));
+            StageCost c{name, true};
+            c.nsPerSample = median(ns);
+            if (field == &Parts::kernel) {
+                std::vector<double> instructions;
+                for (const FrameStats* f : steady)
+                    instructions.push_back(per(static_cast<double>(f->dynamic.instructions), *f));
+                c.instructionsPerSample = median(instructions);
+            }
+            sum += c.nsPerSample;
+            parts.push_back(c);
+        }
+        StageCost other{"other", true};
+        other.nsPerSample = std::max(0.0, shadeNs - sum);
+        parts.push_back(other);
+        return parts;
+    };
     std::vector<StageCost> out;
     StageCost total{"dynamic phase"};
     for (const Stage& stage : stages) {
@@ -121,6 +152,8 @@ std::vector<StageCost> dynamicStageCosts(const std::vector<FrameStats>& frames, 
         total.boundNsPerSample += c.boundNsPerSample;
         total.instructionsPerSample += c.instructionsPerSample;
         out.push_back(c);
+        if (c.name == "shade")
+            for (const StageCost& part : shadeParts(c.nsPerSample)) out.push_back(part);
     }
     out.push_back(total);
     return out;

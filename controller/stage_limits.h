@@ -15,10 +15,13 @@
 namespace mpshade {
 
 struct StageCost {
-    std::string name;                    // "warp", "rasterize", "shade", "resolve", "dynamic phase"
-    double nsPerSample = 0.0;            // per core, the median over the steady frames
-    double bytesPerSample = 0.0;         // streamed through memory (read and written)
-    double boundNsPerSample = 0.0;       // bytesPerSample at the measured bandwidth, per core
+    // "warp", "rasterize", "shade", its parts ("points", "interpolate", "probe", "kernel",
+    // "composite" and "other": shade's time beyond them), "resolve", "dynamic phase"
+    std::string name;
+    bool part = false;              // a part of shade's time, not counted again in "dynamic phase"
+    double nsPerSample = 0.0;       // per core, the median over the steady frames
+    double bytesPerSample = 0.0;    // streamed through memory (read and written)
+    double boundNsPerSample = 0.0;  // bytesPerSample at the measured bandwidth, per core
     double instructionsPerSample = 0.0;  // dynamic shader instructions (shade only), else 0
 };
 
@@ -35,6 +38,9 @@ MachineLimits measureMachineLimits();
 // (multi-phase, no static run), or every multi-phase frame but the first when none is
 // steady. Empty when no frame was multi-phase. The bytes counted are the least a stage
 // must move: one visibility layer a sample, the filter's weights for a reach of one pixel.
+// Shade's parts are CPU time summed over the threads, per sample: what each part would
+// cost a core; "other" is shade's figure less theirs (gathering pending points, waiting
+// for the last band, scheduling). They carry no bytes; the kernel its instructions.
 std::vector<StageCost> dynamicStageCosts(const std::vector<FrameStats>& frames, int spp,
                                          const MachineLimits& machine);
 

@@ -82,6 +82,7 @@ struct DynamicPhase::Band {
         SurfaceShadingCounters counters;
         std::vector<const float*> keptChannels;  // replay: the kept n-tuple channels of a batch
         std::vector<ObjectFrameCost> costs;      // per object
+        DynamicFrameStats::ShadeParts parts;     // this thread's, since the frame's last sum
 
         // Every point of a fresh band, each object's as runs of the band's own arrays; the
         // points whose probes found tiles missing go to stillPending.
@@ -212,6 +213,9 @@ void DynamicPhase::Band::Scratch::addObjectCosts(size_t o, const SurfaceShadingC
     cost.probeFallbacks += c.fallbacks;
     counters.instructions += c.instructions;
     counters.nonFinite += c.nonFinite;
+    parts.interpolate += c.interpolateSeconds;
+    parts.probe += c.probeSeconds;
+    parts.kernel += c.kernelSeconds;
 }
 
 namespace {
@@ -484,6 +488,8 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
             stats_.instructions += s.counters.instructions;
             stats_.nonFinite += s.counters.nonFinite;
             s.counters = SurfaceShadingCounters{};
+            stats_.shadeParts += s.parts;
+            s.parts = {};
         }
         stats_.shadingPoints = stats_.probes = stats_.probeFallbacks = stats_.pointsReplayed = 0;
         for (const ObjectFrameCost& c : costs_) {
@@ -511,15 +517,18 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     if (reusing_ && kept.valid() && scratch_->states[band].built) {
         BandPoints& pts = scratch_->states[band];
         s.replay(views_, pts, inputLayout_, kept);
-        finishBand(band, range, pts, s.costs);
+        finishBand(band, range, pts, s.costs, s.parts);
         return;
     }
     // A band keeps points of its own while it waits for tiles, or while the view holds
     // still; otherwise it uses its thread's buffers and keeps nothing.
     BandPoints& pts = scratch_->states[band].built ? scratch_->states[band] : s.work;
-    if (!pts.built)
+    if (!pts.built) {
+        const auto began = Clock::now();
         buildBandPoints(*layout_, visibility_, range, objects,
                         {options_.shadingRate, options_.wholePixelShortcut}, pts, s.points);
+        s.parts.points += secondsSince(began);
+    }
 
     s.batchMissed.resize(kBatch);
     s.stillPending.clear();
@@ -544,7 +553,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
         kept.finish();
         if (&pts == &s.work) std::swap(s.work, scratch_->states[band]);
         s.work.built = false;
-        finishBand(band, range, scratch_->states[band], s.costs);
+        finishBand(band, range, scratch_->states[band], s.costs, s.parts);
         return;
     }
     // Over the budget, or the view moving: the storage goes. A band that found tiles
@@ -553,15 +562,18 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
         kept.release();
     else
         kept.invalidate();
-    finishBand(band, range, pts, s.costs);
+    finishBand(band, range, pts, s.costs, s.parts);
     pts.built = false;
     if (&pts != &s.work) std::swap(s.work, pts);  // its buffers go back to the thread
 }
 
 void DynamicPhase::finishBand(size_t band, const BandRange& range, const BandPoints& pts,
-                              std::vector<ObjectFrameCost>& costs) {
+                              std::vector<ObjectFrameCost>& costs,
+                              DynamicFrameStats::ShadeParts& parts) {
+    const auto began = Clock::now();
     compositeBand(pts, range, visibility_, layout_->spp(), scene_.settings.background,
                   samples_.rgba.data(), uniform_.data());
+    parts.composite += secondsSince(began);
     for (size_t o = 0; o < objects_.size(); ++o)
         costs[o].shadingPoints += pts.objectStart[o + 1] - pts.objectStart[o];
     bandDone_[band] = 1;

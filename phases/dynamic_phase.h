@@ -104,6 +104,18 @@ struct ObjectFrameCost {
 // zeroed, and the bilinear probes, of them answered from a coarser level.
 struct DynamicFrameStats {
     double warpSeconds = 0.0, rasterSeconds = 0.0, shadeSeconds = 0.0, resolveSeconds = 0.0;
+    // Where shading's time went, CPU seconds summed over the threads (so over the cores, not
+    // wall time): making the bands' points from the visibility; their positions, view
+    // directions, interpolated attributes and chart footprints; probing the shader maps;
+    // the dynamic shader (with its results made finite); compositing the samples.
+    struct ShadeParts {
+        double points = 0.0, interpolate = 0.0, probe = 0.0, kernel = 0.0, composite = 0.0;
+        ShadeParts& operator+=(const ShadeParts& o) {
+            points += o.points, interpolate += o.interpolate, probe += o.probe;
+            kernel += o.kernel, composite += o.composite;
+            return *this;
+        }
+    } shadeParts;
     int shadePasses = 0;
     uint64_t facets = 0, verticesWarped = 0, facetBytes = 0;
     RasterStats raster;
@@ -121,6 +133,7 @@ struct DynamicFrameStats {
         rasterSeconds += o.rasterSeconds;
         shadeSeconds += o.shadeSeconds;
         resolveSeconds += o.resolveSeconds;
+        shadeParts += o.shadeParts;
         shadePasses += o.shadePasses;
         facets += o.facets;
         verticesWarped += o.verticesWarped;
@@ -173,9 +186,10 @@ class DynamicPhase {
     void rasterizeObjects();
     void prepareBands();
     void shadeBand(size_t band, bool acceptFallbacks, std::vector<TileRequest>& missing);
-    // Composites a band whose points are all shaded and counts them in `costs` (per object).
+    // Composites a band whose points are all shaded, counts them in `costs` (per object) and
+    // adds the composite's time to `parts`.
     void finishBand(size_t band, const BandRange& range, const BandPoints& pts,
-                    std::vector<ObjectFrameCost>& costs);
+                    std::vector<ObjectFrameCost>& costs, DynamicFrameStats::ShadeParts& parts);
 
     const Scene& scene_;
     const FrameState* frame_ = nullptr;

@@ -1,12 +1,14 @@
 #include "phases/surface_points.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include <glm/geometric.hpp>
 
 #include "geometry/float4.h"
 #include "phases/compositing.h"
+#include "phases/phase_trace.h"
 
 namespace mpshade {
 namespace {
@@ -192,6 +194,7 @@ size_t probeChannels(const ShaderMap& map, const ProbeOptions& probe, bool stopA
 void runDynamicShader(const ObjectView& view, const ShadingInputs& in, size_t n, float* color,
                       float* opacity, SurfaceShadingScratch& scratch,
                       SurfaceShadingCounters& counters) {
+    const auto began = std::chrono::steady_clock::now();
     ShadingBatch& batch = scratch.batch;
     ShadingCounters shading;
     view.rep->dynamicKernel->run(*view.uniforms, in, n, batch.out, scratch.workspace, shading);
@@ -214,6 +217,7 @@ void runDynamicShader(const ObjectView& view, const ShadingInputs& in, size_t n,
         opacity[3 * i + 2] = finite ? std::clamp(o2[i], 0.0f, 1.0f) : 1.0f;
     }
     counters.nonFinite += nonFinite;
+    counters.kernelSeconds += secondsSince(began);
 }
 
 std::vector<int> shadingInputRows(const ObjectRepresentation& rep) {
@@ -235,6 +239,7 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
                           const SurfacePoints& points, float* color, float* opacity,
                           uint8_t* missed, SurfaceShadingScratch& scratch,
                           SurfaceShadingCounters& counters) {
+    const auto began = std::chrono::steady_clock::now();
     const ObjectRepresentation& rep = *view.rep;
     const FacetMesh& mesh = rep.mesh;
     const VertexAttributes& attr = mesh.attributes;
@@ -276,10 +281,14 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
                            attr.rows[VertexAttributes::kGeometryRows + c].data(), batch.channel(c));
     }
     if (stopAtMissing && missed) std::fill(missed, missed + n, uint8_t{0});
+    const auto interpolated = std::chrono::steady_clock::now();
+    counters.interpolateSeconds += std::chrono::duration<double>(interpolated - began).count();
     size_t missedCount = 0;
-    if (useMap && channels > 0)
+    if (useMap && channels > 0) {
         missedCount =
             probeChannels(*rep.map, probe, stopAtMissing, n, channels, missed, scratch, counters);
+        counters.probeSeconds += secondsSince(interpolated);
+    }
 
     runDynamicShader(view, batch.in, n, color, opacity, scratch, counters);
     if (missedCount > 0) {

@@ -56,6 +56,9 @@ struct SurfaceShadingCounters {
     uint64_t probes = 0;     // bilinear probes of shader maps
     uint64_t fallbacks = 0;  // of them, answered from a coarser level
     uint64_t missingProbes = 0;
+    // CPU seconds: steps 1-4 (positions to chart footprints), step 5 (probes), step 6 (the
+    // dynamic shader and its results made finite).
+    double interpolateSeconds = 0.0, probeSeconds = 0.0, kernelSeconds = 0.0;
 };
 
 // Shades points.n points of `view`'s object into color and opacity (3 floats per point

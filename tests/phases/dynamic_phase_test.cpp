@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "phases/dynamic_phase.h"
 #include "phases/static_phase.h"
@@ -271,6 +272,17 @@ TEST(DynamicPhase, BandsMissingTilesWaitForThemAndMatchAFrameWithTheTilesResiden
     EXPECT_TRUE(again.shade().empty());  // every tile resident now
     EXPECT_EQ(again.stats().shadingPoints, phase.stats().shadingPoints);
     EXPECT_EQ(again.samples().rgba, phase.samples().rgba);
+    // Every part of shading was timed, and the parts (CPU time over the threads) fit in the
+    // pass's wall time on every thread the machine has.
+    const DynamicFrameStats::ShadeParts& parts = again.stats().shadeParts;
+    EXPECT_GT(parts.points, 0.0);
+    EXPECT_GT(parts.interpolate, 0.0);
+    EXPECT_GT(parts.probe, 0.0);
+    EXPECT_GT(parts.kernel, 0.0);
+    EXPECT_GT(parts.composite, 0.0);
+    const double threads = std::max(1, tbb::this_task_arena::max_concurrency());
+    EXPECT_LE(parts.points + parts.interpolate + parts.probe + parts.kernel + parts.composite,
+              again.stats().shadeSeconds * threads);
 }
 
 TEST(DynamicPhase, AcceptingFallbacksFinishesInOnePassFromCoarserLevels) {
