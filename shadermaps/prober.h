@@ -114,6 +114,7 @@ struct Prober {
     // between two adjacent levels.
     mutable uint64_t cachedKey[2] = {~uint64_t{0}, ~uint64_t{0}};
     mutable int cachedSlot[2] = {-1, -1};
+    mutable const Storage* cachedTile[2] = {nullptr, nullptr};  // cachedSlot's storage
     mutable uint64_t fastProbes = 0;  // bilinear probes on the fast path, for residency
     mutable bool missed = false;      // the current query found a tile missing
     // The fast path's constants: per level its width and its tiles per side; the tile's
@@ -146,44 +147,48 @@ struct Prober {
         fast = map.options().halfPrecision == Texels::kHalf && !(residency && residency->touched);
     }
 
-    // The fast path's tile lookup: the float storage of tile (tx, ty) of `level`, or null
-    // if it is not resident.
+    // The fast path's tile lookup: the storage of tile (tx, ty) of `level`, or null if it is
+    // not resident. Neighbouring lookups mostly find the last tile of their level's parity.
     const Storage* tileAt(int chart, int level, int tx, int ty) const {
         const uint64_t key = (uint64_t(static_cast<uint32_t>(chart)) << 37) |
                              (uint64_t(level) << 32) | (uint64_t(tx) << 16) | uint64_t(ty);
         const int parity = level & 1;
-        if (key != cachedKey[parity]) {
-            cachedKey[parity] = key;
-            cachedSlot[parity] =
-                map.slotOf({static_cast<uint32_t>(chart), static_cast<uint16_t>(level),
-                            static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)});
-            if (cachedSlot[parity] >= 0) {
-                map.markUsed(cachedSlot[parity]);
-                // The whole tile, now: a probe's taps walk a line through it and the next
-                // rows of points come back to it, while the first load of a tap otherwise
-                // waits on memory (a third of the probe's time). 17% off the vase's steady
-                // frame, 5-8% off the teapot's and 11% off the courtyard's.
-                // Once per tile in a while: rows of points enter the same tiles again.
-                const int slot = cachedSlot[parity];
-                int& seen = prefetched[static_cast<unsigned>(slot) % kPrefetchMemory];
-                if (seen != slot) {
-                    seen = slot;
-                    const char* d = reinterpret_cast<const char*>(map.tileStorage(slot));
-                    for (size_t b = 0; d && b < tileBytes; b += 64) __builtin_prefetch(d + b, 0, 3);
-                }
-            }
+        if (key != cachedKey[parity]) lookUpTile(key, chart, level, tx, ty);
+        return cachedTile[parity];
+    }
+
+    __attribute__((noinline)) void lookUpTile(uint64_t key, int chart, int level, int tx,
+                                              int ty) const {
+        const int parity = level & 1;
+        cachedKey[parity] = key;
+        cachedSlot[parity] = map.slotOf({static_cast<uint32_t>(chart), static_cast<uint16_t>(level),
+                                         static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)});
+        cachedTile[parity] = nullptr;
+        const int slot = cachedSlot[parity];
+        if (slot < 0) return;
+        map.markUsed(slot);
+        cachedTile[parity] = reinterpret_cast<const Storage*>(map.tileStorage(slot));
+        // The whole tile, now: a probe's taps walk a line through it and the next rows of
+        // points come back to it, while the first load of a tap otherwise waits on memory
+        // (a third of the probe's time). 17% off the vase's steady frame, 5-8% off the
+        // teapot's and 11% off the courtyard's. Once per tile in a while: rows of points
+        // enter the same tiles again.
+        int& seen = prefetched[static_cast<unsigned>(slot) % kPrefetchMemory];
+        if (seen != slot) {
+            seen = slot;
+            const char* d = reinterpret_cast<const char*>(cachedTile[parity]);
+            for (size_t b = 0; d && b < tileBytes; b += 64) __builtin_prefetch(d + b, 0, 3);
         }
-        return cachedSlot[parity] >= 0
-                   ? reinterpret_cast<const Storage*>(map.tileStorage(cachedSlot[parity]))
-                   : nullptr;
     }
 
     // Adds w * the bilinear interpolation of tile data `t` (origin texel (ox, oy) of the
     // level, borders included in `t`) at texel coordinates (x, y), already clamped.
+    template <bool kInterior = false>
     void accumulate(const Storage* __restrict t, int ox, int oy, float x, float y, float w,
                     float* __restrict sum) const {
         const int channels = kFixed ? kChannels : runtimeChannels;
-        const float fx0 = floorOf(x), fy0 = floorOf(y);
+        const float fx0 = kInterior ? static_cast<float>(static_cast<int32_t>(x)) : floorOf(x);
+        const float fy0 = kInterior ? static_cast<float>(static_cast<int32_t>(y)) : floorOf(y);
         const int li = static_cast<int>(fx0) - ox + border,
                   lj = static_cast<int>(fy0) - oy + border;
         const float fx = x - fx0, fy = y - fy0;
@@ -200,10 +205,13 @@ struct Prober {
     // accumulate() for up to 8 channels in 4-float vectors: each texel's channels are loaded
     // whole, lanes past the last channel carrying the next texel's values (or the pool's
     // slack after the last tile), which are never stored.
+    // kInterior: x and y are known to be >= 0, where the floor is the truncation.
     static constexpr int kVectors = kFixed && kChannels <= 8 ? (kChannels + 3) / 4 : 0;
+    template <bool kInterior = false>
     void accumulateVectors(const Storage* __restrict t, int ox, int oy, float x, float y, float w,
                            Float4* acc) const {
-        const float fx0 = floorOf(x), fy0 = floorOf(y);
+        const float fx0 = kInterior ? static_cast<float>(static_cast<int32_t>(x)) : floorOf(x);
+        const float fy0 = kInterior ? static_cast<float>(static_cast<int32_t>(y)) : floorOf(y);
         const int li = static_cast<int>(fx0) - ox + border,
                   lj = static_cast<int>(fy0) - oy + border;
         const float fx = x - fx0, fy = y - fy0;
@@ -334,18 +342,74 @@ struct Prober {
 
     // Feline's taps at one level: adds scale * weight[i] * bilinear(u0 + i du, v0 + i dv) to
     // sum for i < n. The taps walk a straight line, so texel coordinates advance by a
-    // constant step and the bilinear weights go straight into the sum.
+    // constant step and the bilinear weights go straight into the sum. The common case is
+    // inlined at the call, the rest (lines near a level's edge or across tiles, missing
+    // tiles, half storage, recency to report) is out of line: kept apart, the common case
+    // compiles to a third of the instructions (callgrind, the vase's steady frame).
     void lineAccumulate(int chart, int level, float u0, float v0, float du, float dv, int n,
                         const float* weight, float scale, float* sum) const {
+        if (fast && lineInTile(chart, level, u0, v0, du, dv, n, weight, scale, sum)) return;
+        lineAccumulateAnywhere(chart, level, u0, v0, du, dv, n, weight, scale, sum);
+    }
+
+    // lineAccumulate's common case: the line inside the level, away from its last texel,
+    // so no tap is clamped and each floor is a truncation, and inside one resident tile
+    // with its border -- the same taps and weights as lineAccumulateAnywhere, with none of
+    // the clamping. Returns false, having added nothing, otherwise.
+    bool lineInTile(int chart, int level, float u0, float v0, float du, float dv, int n,
+                    const float* weight, float scale, float* sum) const {
+        const int channels = kFixed ? kChannels : runtimeChannels;
+        const float fres = levelRes[level];
+        const float x0 = u0 * fres - 0.5f, y0 = v0 * fres - 0.5f;
+        const float dx = du * fres, dy = dv * fres;
+        const float xe = x0 + static_cast<float>(n - 1) * dx,
+                    ye = y0 + static_cast<float>(n - 1) * dy;
+        const float xmin = std::min(x0, xe), xmax = std::max(x0, xe);
+        const float ymin = std::min(y0, ye), ymax = std::max(y0, ye);
+        if (xmin >= 0.0f && ymin >= 0.0f && xmax < fres - 1.0f && ymax < fres - 1.0f) {
+            const int ix0 = static_cast<int>(xmin), iy0 = static_cast<int>(ymin);
+            const int tx = ix0 >> tileShift, ty = iy0 >> tileShift;
+            const int ox = tx << tileShift, oy = ty << tileShift;
+            const int reach = (1 << tileShift) + border;  // past the tile's texels
+            if (static_cast<int>(xmax) + 1 < ox + reach &&
+                static_cast<int>(ymax) + 1 < oy + reach) {
+                if (const Storage* t = tileAt(chart, level, tx, ty)) {
+                    float x = x0, y = y0;
+                    if constexpr (kVectors > 0) {
+                        Float4 acc[kVectors] = {};
+                        for (int i = 0; i < n; ++i, x += dx, y += dy)
+                            accumulateVectors<true>(t, ox, oy, x, y, weight[i] * scale, acc);
+                        float lanes[4 * (kVectors > 0 ? kVectors : 1)];
+                        for (int k = 0; k < kVectors; ++k) storeFloat4(lanes + 4 * k, acc[k]);
+                        for (int c = 0; c < channels; ++c) sum[c] += lanes[c];
+                    } else {
+                        float acc[kArr];
+                        for (int c = 0; c < channels; ++c) acc[c] = sum[c];
+                        for (int i = 0; i < n; ++i, x += dx, y += dy)
+                            accumulate<true>(t, ox, oy, x, y, weight[i] * scale, acc);
+                        for (int c = 0; c < channels; ++c) sum[c] = acc[c];
+                    }
+                    fastProbes += static_cast<uint64_t>(n);
+                    return true;
+                }
+            }
+        }
+        return false;
+    }
+
+    __attribute__((noinline)) void lineAccumulateAnywhere(int chart, int level, float u0, float v0,
+                                                          float du, float dv, int n,
+                                                          const float* weight, float scale,
+                                                          float* sum) const {
         const int channels = kFixed ? kChannels : runtimeChannels;
         const float fres = levelRes[level];
         const float x0 = u0 * fres - 0.5f, y0 = v0 * fres - 0.5f;
         const float dx = du * fres, dy = dv * fres;
         if (fast) {
-            // Every tap's texels in one tile (the common case: taps span a few texels):
-            // one lookup for the line.
             const float xe = x0 + static_cast<float>(n - 1) * dx,
                         ye = y0 + static_cast<float>(n - 1) * dy;
+            // Every tap's texels in one tile (the common case: taps span a few texels):
+            // one lookup for the line.
             const float lo = -0.5f, hi = fres - 0.5f;
             const int ix0 = static_cast<int>(floorOf(std::clamp(std::min(x0, xe), lo, hi)));
             const int ix1 = static_cast<int>(floorOf(std::clamp(std::max(x0, xe), lo, hi)));
