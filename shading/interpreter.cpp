@@ -104,15 +104,23 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
     float* regs = workspace.data();
     auto R = [&](int32_t r) { return regs + static_cast<size_t>(r) * kLanes; };
     for (const auto& [r, value] : constants_) std::fill_n(R(r), kLanes, value);
+    // Where each register's lanes are read from: its own storage, or -- for a global or an
+    // n-tuple channel -- the input array itself, which is then read in place instead of
+    // copied in. A register written by an instruction reads from its storage again.
+    thread_local std::vector<const float*> sources;
+    sources.resize(static_cast<size_t>(registerCount_));
+    const float** S = sources.data();
+    for (int32_t r = 0; r < registerCount_; ++r) S[r] = R(r);
 
     for (size_t start = 0; start < n; start += kLanes) {
         if (stop && stop->load(std::memory_order_relaxed)) return false;
         const int m = static_cast<int>(std::min<size_t>(kLanes, n - start));
         for (const ExecInst& e : code_) {
             float* o = R(e.out[0]);
-            const float* a = e.nin > 0 ? R(e.in[0]) : nullptr;
-            const float* b = e.nin > 1 ? R(e.in[1]) : nullptr;
-            const float* c = e.nin > 2 ? R(e.in[2]) : nullptr;
+            const float* a = e.nin > 0 ? S[e.in[0]] : nullptr;
+            const float* b = e.nin > 1 ? S[e.in[1]] : nullptr;
+            const float* c = e.nin > 2 ? S[e.in[2]] : nullptr;
+            for (int k = 0; k < e.nout; ++k) S[e.out[k]] = R(e.out[k]);
             switch (e.op) {
                 case Op::Global: {
                     const auto id = static_cast<GlobalId>(e.imm);
@@ -162,11 +170,10 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                     if (src) {
                         for (int k = 0; k < 3; ++k) {
                             MPSHADE_CHECK(src[k] != nullptr);
-                            std::memcpy(R(e.out[k]), src[k] + start,
-                                        sizeof(float) * static_cast<size_t>(m));
+                            S[e.out[k]] = src[k] + start;
                         }
                     } else if (scalarSrc) {
-                        std::memcpy(o, scalarSrc + start, sizeof(float) * static_cast<size_t>(m));
+                        S[e.out[0]] = scalarSrc + start;
                     }
                     break;
                 }
@@ -177,8 +184,7 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                     break;
                 case Op::Channel:
                     MPSHADE_CHECK(in.channels != nullptr);
-                    std::memcpy(o, in.channels[e.imm] + start,
-                                sizeof(float) * static_cast<size_t>(m));
+                    S[e.out[0]] = in.channels[e.imm] + start;
                     break;
                 case Op::LightAmbient:
                     for (int k = 0; k < 3; ++k)
@@ -264,14 +270,14 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
                 case Op::Phong: {
                     const LightSample& light = uniforms.lights[static_cast<size_t>(e.imm)];
                     const float* arg[10];
-                    for (int k = 0; k < e.nin; ++k) arg[k] = R(e.in[k]);
+                    for (int k = 0; k < e.nin; ++k) arg[k] = S[e.in[k]];
                     float* rgb[3] = {R(e.out[0]), R(e.out[1]), R(e.out[2])};
                     shadeLight(e.op, light, arg, rgb, m);
                     break;
                 }
                 case Op::Occlusion: {
                     const float* arg[6];
-                    for (int k = 0; k < 6; ++k) arg[k] = R(e.in[k]);
+                    for (int k = 0; k < 6; ++k) arg[k] = S[e.in[k]];
                     counters.occlusionRays +=
                         occlusionLanes(uniforms.occluder, uniforms.occlusionBias, e.imm, arg, o, m);
                     break;
@@ -283,11 +289,11 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
         }
         const size_t bytes = sizeof(float) * static_cast<size_t>(m);
         for (int k = 0; k < 3; ++k) {
-            if (ci_[k] >= 0) std::memcpy(out.Ci[k] + start, R(ci_[k]), bytes);
-            if (oi_[k] >= 0) std::memcpy(out.Oi[k] + start, R(oi_[k]), bytes);
+            if (ci_[k] >= 0) std::memcpy(out.Ci[k] + start, S[ci_[k]], bytes);
+            if (oi_[k] >= 0) std::memcpy(out.Oi[k] + start, S[oi_[k]], bytes);
         }
         for (size_t k = 0; k < channelRegs_.size(); ++k)
-            std::memcpy(out.channels[k] + start, R(channelRegs_[k]), bytes);
+            std::memcpy(out.channels[k] + start, S[channelRegs_[k]], bytes);
         counters.instructions += code_.size() * static_cast<uint64_t>(m);
     }
     counters.points += n;
