@@ -353,9 +353,10 @@ struct Prober {
     }
 
     // lineAccumulate's common case: the line inside the level, away from its last texel,
-    // so no tap is clamped and each floor is a truncation, and inside one resident tile
-    // with its border -- the same taps and weights as lineAccumulateAnywhere, with none of
-    // the clamping. Returns false, having added nothing, otherwise.
+    // so no tap is clamped and each floor is a truncation; each tap reads the tile its
+    // texel lies in (a tile's border holds the next texel), the line's taps mostly one,
+    // sometimes two. Returns false, having added nothing, if a tile is not resident or
+    // the line is not inside.
     bool lineInTile(int chart, int level, float u0, float v0, float du, float dv, int n,
                     const float* weight, float scale, float* sum) const {
         const int channels = kFixed ? kChannels : runtimeChannels;
@@ -364,37 +365,41 @@ struct Prober {
         const float dx = du * fres, dy = dv * fres;
         const float xe = x0 + static_cast<float>(n - 1) * dx,
                     ye = y0 + static_cast<float>(n - 1) * dy;
-        const float xmin = std::min(x0, xe), xmax = std::max(x0, xe);
-        const float ymin = std::min(y0, ye), ymax = std::max(y0, ye);
-        if (xmin >= 0.0f && ymin >= 0.0f && xmax < fres - 1.0f && ymax < fres - 1.0f) {
-            const int ix0 = static_cast<int>(xmin), iy0 = static_cast<int>(ymin);
-            const int tx = ix0 >> tileShift, ty = iy0 >> tileShift;
-            const int ox = tx << tileShift, oy = ty << tileShift;
-            const int reach = (1 << tileShift) + border;  // past the tile's texels
-            if (static_cast<int>(xmax) + 1 < ox + reach &&
-                static_cast<int>(ymax) + 1 < oy + reach) {
-                if (const Storage* t = tileAt(chart, level, tx, ty)) {
-                    float x = x0, y = y0;
-                    if constexpr (kVectors > 0) {
-                        Float4 acc[kVectors] = {};
-                        for (int i = 0; i < n; ++i, x += dx, y += dy)
-                            accumulateVectors<true>(t, ox, oy, x, y, weight[i] * scale, acc);
-                        float lanes[4 * (kVectors > 0 ? kVectors : 1)];
-                        for (int k = 0; k < kVectors; ++k) storeFloat4(lanes + 4 * k, acc[k]);
-                        for (int c = 0; c < channels; ++c) sum[c] += lanes[c];
-                    } else {
-                        float acc[kArr];
-                        for (int c = 0; c < channels; ++c) acc[c] = sum[c];
-                        for (int i = 0; i < n; ++i, x += dx, y += dy)
-                            accumulate<true>(t, ox, oy, x, y, weight[i] * scale, acc);
-                        for (int c = 0; c < channels; ++c) sum[c] = acc[c];
-                    }
-                    fastProbes += static_cast<uint64_t>(n);
-                    return true;
-                }
+        if (!(std::min(x0, xe) >= 0.0f && std::min(y0, ye) >= 0.0f &&
+              std::max(x0, xe) < fres - 1.0f && std::max(y0, ye) < fres - 1.0f))
+            return false;
+        int tx = -1, ty = -1, ox = 0, oy = 0;
+        const Storage* t = nullptr;
+        float x = x0, y = y0;
+        auto tileOfTap = [&](float tapX, float tapY) {
+            const int ix = static_cast<int>(tapX), iy = static_cast<int>(tapY);
+            if ((ix >> tileShift) != tx || (iy >> tileShift) != ty) {
+                tx = ix >> tileShift, ty = iy >> tileShift;
+                ox = tx << tileShift, oy = ty << tileShift;
+                t = tileAt(chart, level, tx, ty);
             }
+            return t != nullptr;
+        };
+        if constexpr (kVectors > 0) {
+            Float4 acc[kVectors] = {};
+            for (int i = 0; i < n; ++i, x += dx, y += dy) {
+                if (!tileOfTap(x, y)) return false;
+                accumulateVectors<true>(t, ox, oy, x, y, weight[i] * scale, acc);
+            }
+            float lanes[4 * (kVectors > 0 ? kVectors : 1)];
+            for (int k = 0; k < kVectors; ++k) storeFloat4(lanes + 4 * k, acc[k]);
+            for (int c = 0; c < channels; ++c) sum[c] += lanes[c];
+        } else {
+            float acc[kArr];
+            for (int c = 0; c < channels; ++c) acc[c] = sum[c];
+            for (int i = 0; i < n; ++i, x += dx, y += dy) {
+                if (!tileOfTap(x, y)) return false;
+                accumulate<true>(t, ox, oy, x, y, weight[i] * scale, acc);
+            }
+            for (int c = 0; c < channels; ++c) sum[c] = acc[c];
         }
-        return false;
+        fastProbes += static_cast<uint64_t>(n);
+        return true;
     }
 
     __attribute__((noinline)) void lineAccumulateAnywhere(int chart, int level, float u0, float v0,
