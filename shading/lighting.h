@@ -22,6 +22,11 @@ namespace mpshade {
 void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb,
                 int m);
 
+// shadeLight in baseline code (four lanes at a time and one) whatever the processor, for
+// tests of the AVX2 path against it.
+void shadeLightBaseline(Op op, const LightSample& light, const float* const* args,
+                        float* const* rgb, int m);
+
 // args: P(3) N(3). Writes the open fraction per lane; returns the rays traced.
 uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,
                         const float* const* args, float* out, int m);

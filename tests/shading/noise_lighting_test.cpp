@@ -11,6 +11,7 @@
 
 #include "geometry/ray_scene.h"
 #include "shading/lighting.h"
+#include "shading/lighting_avx2.h"
 #include "shading/noise.h"
 #include "shading/shader_harness.h"
 
@@ -296,6 +297,45 @@ TEST(Lighting, EveryLaneOfARunMatchesTheOneLaneFormula) {
                         << (light.kind == LightKind::Point ? " point" : " distant");
                 }
             }
+        }
+}
+
+TEST(Lighting, EightLanesInAvx2AreTheBaselineBitForBit) {
+    // 37 lanes: four runs of eight, one of four and one single lane, with the edge inputs
+    // of the test above spread over the runs and the tails, and a normal of huge length.
+    if (!shadeLightAvx2Available()) GTEST_SKIP() << "no AVX2 on this processor";
+    std::mt19937 rng(29);
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    constexpr int m = 37;
+    LightSample point, distant;
+    point.kind = LightKind::Point;
+    point.position = glm::vec3(0.3f, 2.0f, -0.5f);
+    point.color = glm::vec3(3.0f, 2.0f, 1.0f);
+    distant.kind = LightKind::Distant;
+    distant.toLight = glm::normalize(glm::vec3(0.2f, 1.0f, 0.4f));
+    distant.color = glm::vec3(0.5f, 1.0f, 1.5f);
+    std::vector<float> in(10 * m);
+    for (float& x : in) x = uni(rng);
+    for (int l = 0; l < m; ++l) in[9 * m + l] = 0.5f + 0.5f * uni(rng);
+    for (int k = 0; k < 3; ++k) in[k * m + 3] = point.position[k];  // at the light
+    for (int k = 0; k < 3; ++k) in[(3 + k) * m + 17] = 0.0f;        // zero normal
+    for (int k = 0; k < 3; ++k) in[(3 + k) * m + 34] *= 1e18f;      // huge, in the tail
+    in[9 * m + 9] = std::nanf("");
+    in[9 * m + 33] = 0.0f;
+    in[9 * m + 36] = 3.0f;
+    const float* args[10];
+    for (int k = 0; k < 10; ++k) args[k] = &in[static_cast<size_t>(k) * m];
+    for (const LightSample& light : {point, distant})
+        for (Op op : {Op::Diffuse, Op::Specular}) {
+            std::vector<float> wide(3 * m, -1.0f), base(3 * m, -2.0f);
+            float* w[3] = {&wide[0], &wide[m], &wide[2 * m]};
+            float* b[3] = {&base[0], &base[m], &base[2 * m]};
+            shadeLightAvx2(op, light, args, w, m);
+            shadeLightBaseline(op, light, args, b, m);
+            for (int i = 0; i < 3 * m; ++i)
+                ASSERT_EQ(std::memcmp(&wide[i], &base[i], sizeof(float)), 0)
+                    << "lane " << i % m << " channel " << i / m << " op " << static_cast<int>(op)
+                    << " " << wide[i] << " against " << base[i];
         }
 }
 
