@@ -128,11 +128,26 @@ bool collapsed(const SurfaceSample& p) {
 // another meridian), so it is not judged: the chords along the chart's lines through the
 // same points are. Below float noise (the coordinates' rounding) it is zero, so a flat
 // chart stays two triangles.
+// Whether the surface is flat between a and b: their and m's geometric normals agree.
+bool flatBetween(const SurfaceSample& a, const SurfaceSample& m, const SurfaceSample& b) {
+    const float na = glm::length(a.Ng), nm = glm::length(m.Ng), nb = glm::length(b.Ng);
+    if (!(na > 0.0f && nm > 0.0f && nb > 0.0f) || !std::isfinite(na + nm + nb)) return false;
+    constexpr float kParallel = 1.0f - 1e-6f;  // cosine: within about 0.08 degrees
+    return glm::dot(a.Ng, m.Ng) > kParallel * na * nm && glm::dot(b.Ng, m.Ng) > kParallel * nb * nm;
+}
+
+// alongNormal (DicingOptions::chartExact false): where the surface is flat between a and
+// b, only the distance along its normal counts -- the facet lies on it however the chart
+// coordinates run. Where it bends, the whole distance counts as before: interpolated
+// normals, which shading reads, need the facets a curved chart is diced into.
 float deviation(const SurfaceSample& a, const SurfaceSample& m, const SurfaceSample& b,
-                bool diagonal) {
+                bool diagonal, bool alongNormal = false) {
     if (diagonal && (collapsed(a) || collapsed(b))) return 0.0f;
     const float scale = glm::length(a.P) + glm::length(b.P) + glm::length(m.P);
-    const float d = glm::length(m.P - 0.5f * (a.P + b.P));
+    const glm::vec3 off = m.P - 0.5f * (a.P + b.P);
+    const float d = alongNormal && flatBetween(a, m, b)
+                        ? std::fabs(glm::dot(off, m.Ng)) / glm::length(m.Ng)
+                        : glm::length(off);
     return d > 1e-6f * scale ? d : 0.0f;
 }
 
@@ -199,6 +214,7 @@ class PatchSurveyor {
           views_(views),
           options_(options),
           flatness_(options.target == DicingTarget::Flatness),
+          chartExact_(options.chartExact),
           projected_(options.target == DicingTarget::EdgeLength && !options.overRange &&
                      view.projects),
           edgeTarget_(options.maxEdgePixels / std::sqrt(2.0f)),  // diagonals too
@@ -226,15 +242,16 @@ class PatchSurveyor {
         sv.desired[3] = line(0, 0, 0, 1);
         sv.innerU = sv.innerV = 1;
         for (int j = 0; j <= kFine; j += 2) {
-            sv.innerU = std::max(sv.innerU, line(0, j, 1, 0));
-            sv.innerV = std::max(sv.innerV, line(j, 0, 0, 1));
+            sv.innerU = std::max(sv.innerU, line(0, j, 1, 0, !chartExact_));
+            sv.innerV = std::max(sv.innerV, line(j, 0, 0, 1, !chartExact_));
         }
         if (flatness_) {
             // Cell diagonals: the facets' third edges.
             float most = 0.0f;
             for (int j = 0; j < kFine; j += 2)
                 for (int i = 0; i < kFine; i += 2)
-                    most = std::max({most, chord(i, j, 1, 1), chord(i + 2, j, -1, 1)});
+                    most = std::max({most, chord(i, j, 1, 1, !chartExact_),
+                                     chord(i + 2, j, -1, 1, !chartExact_)});
             const int r = rate(most);
             sv.innerU = std::max(sv.innerU, r);
             sv.innerV = std::max(sv.innerV, r);
@@ -275,7 +292,7 @@ class PatchSurveyor {
     }
     // The chord from survey point (i0, j0) to (i0 + 2 di, j0 + 2 dj) in pixels: its length
     // (EdgeLength), or its midpoint's deviation from the surface (Flatness).
-    float chord(int i0, int j0, int di, int dj) const {
+    float chord(int i0, int j0, int di, int dj, bool alongNormal = false) const {
         const SurfaceSample &a = at(i0, j0), &m = at(i0 + di, j0 + dj),
                             &b = at(i0 + 2 * di, j0 + 2 * dj);
         double ax, ay, mx, my, bx, by;
@@ -284,7 +301,7 @@ class PatchSurveyor {
         const float length = glm::length(m.P - a.P) + glm::length(b.P - m.P);
         const float scale = pixelsPerUnitAt(m.P, 0.5f * length);
         if (!flatness_) return length * scale;
-        return deviation(a, m, b, di != 0 && dj != 0) * scale;
+        return deviation(a, m, b, di != 0 && dj != 0, alongNormal) * scale;
     }
     int rate(float maxPixels) const {
         const float r = flatness_ ? kGrid * std::sqrt(maxPixels / options_.flatnessPixels)
@@ -294,10 +311,10 @@ class PatchSurveyor {
     // The rate a line of kGrid chords needs. Its facets split every chord alike (the
     // tessellation is uniform in the chart), so the longest chord -- or the one deviating
     // most -- decides.
-    int line(int i0, int j0, int di, int dj) const {
+    int line(int i0, int j0, int di, int dj, bool alongNormal = false) const {
         float most = 0.0f;
         for (int k = 0; k < kGrid; ++k)
-            most = std::max(most, chord(i0 + 2 * k * di, j0 + 2 * k * dj, di, dj));
+            most = std::max(most, chord(i0 + 2 * k * di, j0 + 2 * k * dj, di, dj, alongNormal));
         return rate(most);
     }
 
@@ -305,7 +322,7 @@ class PatchSurveyor {
     const DicingView& view_;
     const RangeViews& views_;
     const DicingOptions& options_;
-    const bool flatness_, projected_;
+    const bool flatness_, chartExact_, projected_;
     const float edgeTarget_;
     std::vector<ChartPoint> grid_;
     std::vector<SurfaceSample> g_;

@@ -62,6 +62,14 @@ struct DicingOptions {
     size_t maxFacets =
         4'000'000;  // per object; beyond it every rate scales down alike (counted as capped)
     bool frustumCull = true;  // drop patches no view of the range can see
+    // Flatness: whether facets must also keep interpolated chart coordinates on the surface
+    // (a shader map is probed at them, or the shader reads u, v, s, t or dPdu, dPdv), so a
+    // chord's midpoint counts its whole distance from the surface point at the mid chart
+    // coordinates. False: inside a patch, where the surface is flat, only the distance along
+    // its normal counts -- a flat chart's facets lie on it however its coordinates run --
+    // while the patch's edges (silhouettes, chart borders) and curved parts, whose
+    // interpolated normals shading reads, still count it whole.
+    bool chartExact = true;
     // Survey the whole charts only: DicedSurface has estimatedFacets (from their rates,
     // uncapped) and the patch count, nothing else.
     bool surveyOnly = false;

@@ -313,7 +313,7 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     const bool useMap = kind == Representation::ShaderMap;
     const bool combined = !useMap && !direct;
     const DicingView view = dicingView(state, camera);
-    const DicingOptions& dicing = combined ? options_.combinedDicing : options_.separateDicing;
+    const DicingOptions dicing = dicingFor(index, combined, direct);
 
     auto rep = std::make_unique<ObjectRepresentation>();
     rep->kind = combined ? Representation::Facets : kind;
@@ -383,6 +383,19 @@ bool StaticPhase::stores(size_t index) const {
 
 // What dicing object `index` for this frame depends on: the engine, the geometry, the
 // object's state and the camera at the frame (so its dicing view), the options and range.
+DicingOptions StaticPhase::dicingFor(size_t index, bool combined, bool direct) const {
+    if (combined) return options_.combinedDicing;
+    DicingOptions d = options_.separateDicing;
+    const ObjectShading& obj = *objects_[index];
+    const bool mapped = !direct && !obj.factored.staticPart.channelOutputs.empty();
+    const std::vector<int>& rows = direct ? obj.directRows : obj.geometryRows;
+    const bool readsChart = std::any_of(rows.begin(), rows.end(), [](int row) {
+        return row >= VertexAttributes::dPdux && row < VertexAttributes::kGeometryRows;
+    });
+    d.chartExact = d.chartExact && (mapped || readsChart);
+    return d;
+}
+
 void StaticPhase::addDicingInputs(ContentHasher& h, size_t index, const DicingOptions& d,
                                   const ObjectState& state, const CameraState& camera) const {
     const SceneObject& object = scene_.objects[index];
@@ -397,7 +410,7 @@ void StaticPhase::addDicingInputs(ContentHasher& h, size_t index, const DicingOp
     h.addFloat(camera.zFar).addI32(camera.width).addI32(camera.height);
     h.addI32(static_cast<int32_t>(d.target)).addFloat(d.maxEdgePixels).addFloat(d.flatnessPixels);
     h.addI32(d.overRange).addI32(d.maxEdgeRate).addI32(d.maxSplitDepth).addI32(d.maxPatches);
-    h.addU64(d.maxFacets).addI32(d.frustumCull).addI32(d.surveyOnly);
+    h.addU64(d.maxFacets).addI32(d.frustumCull).addI32(d.surveyOnly).addI32(d.chartExact);
     h.addFloat(object.range.distanceFactor).addFloat(object.range.angle);
 }
 
@@ -409,8 +422,7 @@ Digest128 StaticPhase::representationKey(size_t index, bool combined, bool direc
     const ObjectShading& obj = *objects_[index];
     ContentHasher h;
     h.addString("mpshade representation");
-    addDicingInputs(h, index, combined ? options_.combinedDicing : options_.separateDicing, state,
-                    camera);
+    addDicingInputs(h, index, dicingFor(index, combined, direct), state, camera);
     h.addI32(combined).addI32(direct);
     const std::vector<int>& rows = direct ? obj.directRows : obj.geometryRows;
     h.addU64(rows.size()).addBytes(rows.data(), rows.size() * sizeof(int));

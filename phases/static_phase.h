@@ -131,6 +131,10 @@ class StaticPhase {
     StoredTiles storedTiles(size_t index, const ShadingUniforms& uniforms,
                             const ShaderMapOptions& map) const;
     bool stores(size_t index) const;
+    // The dicing of an object's combined facets, or of its separate or direct ones: chart
+    // coordinates kept exact (DicingOptions::chartExact) unless nothing reads them -- no
+    // map, and a dynamic part that reads no u, v, s, t, dPdu or dPdv.
+    DicingOptions dicingFor(size_t index, bool combined, bool direct) const;
     void addDicingInputs(ContentHasher& h, size_t index, const DicingOptions& dicing,
                          const ObjectState& state, const CameraState& camera) const;
     Digest128 representationKey(size_t index, bool combined, bool direct, const ObjectState& state,

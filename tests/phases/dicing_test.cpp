@@ -8,6 +8,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "dicing_view.h"
+#include "geometry/point_cloud.h"
 #include "phases/dicing.h"
 
 namespace mpshade {
@@ -60,6 +61,61 @@ TEST(Dicing, FlatnessHoldsAQuarterPixelAtTheRepresentativeView) {
         EXPECT_GT(worst, 0.02) << "diced far finer than asked";
         EXPECT_LT(d.triangles.size() / 3, 100000u) << surfaceTypeName(surface);
     }
+}
+
+TEST(Dicing, WithoutChartCoordinatesOnlyTheSurfaceAndItsOutlineCount) {
+    // A disc is flat, but its polar chart's diagonals stray far from the chart's own
+    // points: kept exact, they dice it finely; when nothing reads chart coordinates
+    // (chartExact false) its facets need only follow the rim, within a quarter pixel.
+    PointCloud disc;
+    disc.centers = {glm::vec3(0.0f)};
+    disc.normals = {glm::vec3(0, 1, 0)};
+    disc.radii = {1.0f};
+    const Surface surface = disc;
+    const View view(glm::vec3(0.6f, 4.0f, 0.8f), glm::vec3(0.0f), 640, 360);
+    DicingOptions loose = kFlat;
+    loose.chartExact = false;
+    const DicedSurface exact = diceSurface(surface, view.dicing, RangeOptions{}, kFlat);
+    const DicedSurface d = diceSurface(surface, view.dicing, RangeOptions{}, loose);
+    EXPECT_LT(4 * d.triangles.size(), exact.triangles.size());
+    double worst = 0.0;
+    size_t rimEdges = 0;
+    for (size_t f = 0; f < d.triangles.size(); f += 3)
+        for (int e = 0; e < 3; ++e) {
+            const glm::vec3 a = d.attributeGeometry[d.triangles[f + e]].P;
+            const glm::vec3 b = d.attributeGeometry[d.triangles[f + (e + 1) % 3]].P;
+            EXPECT_NEAR(a.y, 0.0f, 1e-6f);
+            if (std::fabs(glm::length(a) - 1.0f) > 1e-4f ||
+                std::fabs(glm::length(b) - 1.0f) > 1e-4f)
+                continue;
+            ++rimEdges;
+            const glm::vec3 mid = 0.5f * (a + b);
+            glm::dvec2 p, q;
+            if (view.project(mid, p) && view.project(mid / glm::length(mid), q))
+                worst = std::max(worst, glm::length(p - q));
+        }
+    EXPECT_GE(rimEdges, 16u);
+    EXPECT_LE(worst, 0.25 * 1.1);
+    EXPECT_GT(worst, 0.02) << "the rim diced far finer than asked";
+    // A sphere bends everywhere: its interpolated normals need the facets exact chart
+    // coordinates give it, so it is diced as with them, every facet edge's midpoint within
+    // a quarter pixel of the surface.
+    const Surface sphere = Sphere{1.0f};
+    const View near(glm::vec3(0.3f, 0.8f, 3.2f), glm::vec3(0.0f), 640, 360);
+    const DicedSurface s = diceSurface(sphere, near.dicing, RangeOptions{}, loose);
+    EXPECT_EQ(s.triangles.size(),
+              diceSurface(sphere, near.dicing, RangeOptions{}, kFlat).triangles.size());
+    double deepest = 0.0;
+    for (size_t f = 0; f < s.triangles.size(); f += 3)
+        for (int e = 0; e < 3; ++e) {
+            const glm::vec3 mid = 0.5f * (s.attributeGeometry[s.triangles[f + e]].P +
+                                          s.attributeGeometry[s.triangles[f + (e + 1) % 3]].P);
+            glm::dvec2 p, q;
+            if (glm::dot(mid, near.camera.eye - mid) > 0.0f && near.project(mid, p) &&
+                near.project(mid / glm::length(mid), q))
+                deepest = std::max(deepest, glm::length(p - q));
+        }
+    EXPECT_LE(deepest, 0.25 * 1.1);
 }
 
 TEST(Dicing, EdgesUnderHalfAPixelAtTheRepresentativeView) {
