@@ -18,20 +18,6 @@ bool sameProbe(const ProbeOptions& a, const ProbeOptions& b) {
            a.levelAnisotropy == b.levelAnisotropy;
 }
 
-// The pointer of ShadingInputs that batch row r (ShadingBatch::Row) feeds.
-const float*& inputRow(ShadingInputs& in, int r) {
-    if (r < ShadingBatch::N) return in.P[r - ShadingBatch::P];
-    if (r < ShadingBatch::Ng) return in.N[r - ShadingBatch::N];
-    if (r < ShadingBatch::dPdu) return in.Ng[r - ShadingBatch::Ng];
-    if (r < ShadingBatch::dPdv) return in.dPdu[r - ShadingBatch::dPdu];
-    if (r < ShadingBatch::I) return in.dPdv[r - ShadingBatch::dPdv];
-    if (r < ShadingBatch::U) return in.I[r - ShadingBatch::I];
-    if (r == ShadingBatch::U) return in.u;
-    if (r == ShadingBatch::V) return in.v;
-    if (r == ShadingBatch::S) return in.s;
-    return in.t;
-}
-
 }  // namespace
 
 bool ViewKey::operator==(const ViewKey& o) const {
@@ -60,7 +46,7 @@ void BandInputs::restore(ShadingInputs& in, std::vector<const float*>& channels,
                          size_t& cursor) const {
     const float* at = values_.data() + cursor;
     for (int r : rows) {
-        inputRow(in, r) = at;
+        ShadingBatch::input(in, r) = at;
         at += n;
     }
     channels.resize(channelCount);

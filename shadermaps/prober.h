@@ -202,14 +202,15 @@ struct Prober {
                       w01 * Texels::load(t01 + c) + w11 * Texels::load(t11 + c);
     }
 
-    // accumulate() for up to 8 channels in 4-float vectors: each texel's channels are loaded
+    // accumulate() for up to 8 channels in 4-float vectors (sumLine chooses it by the type
+    // of its running sum): each texel's channels are loaded
     // whole, lanes past the last channel carrying the next texel's values (or the pool's
     // slack after the last tile), which are never stored.
     // kInterior: x and y are known to be >= 0, where the floor is the truncation.
     static constexpr int kVectors = kFixed && kChannels <= 8 ? (kChannels + 3) / 4 : 0;
     template <bool kInterior = false>
-    void accumulateVectors(const Storage* __restrict t, int ox, int oy, float x, float y, float w,
-                           Float4* acc) const {
+    void accumulate(const Storage* __restrict t, int ox, int oy, float x, float y, float w,
+                    Float4* acc) const {
         const float fx0 = kInterior ? static_cast<float>(static_cast<int32_t>(x)) : floorOf(x);
         const float fy0 = kInterior ? static_cast<float>(static_cast<int32_t>(y)) : floorOf(y);
         const int li = static_cast<int>(fx0) - ox + border,
@@ -359,7 +360,6 @@ struct Prober {
     // the line is not inside.
     bool lineInTile(int chart, int level, float u0, float v0, float du, float dv, int n,
                     const float* weight, float scale, float* sum) const {
-        const int channels = kFixed ? kChannels : runtimeChannels;
         const float fres = levelRes[level];
         const float x0 = u0 * fres - 0.5f, y0 = v0 * fres - 0.5f;
         const float dx = du * fres, dy = dv * fres;
@@ -370,32 +370,39 @@ struct Prober {
             return false;
         int tx = -1, ty = -1, ox = 0, oy = 0;
         const Storage* t = nullptr;
-        float x = x0, y = y0;
-        auto tileOfTap = [&](float tapX, float tapY) {
-            const int ix = static_cast<int>(tapX), iy = static_cast<int>(tapY);
+        return sumLine(n, x0, y0, dx, dy, sum, [&](int i, float x, float y, auto* acc) {
+            const int ix = static_cast<int>(x), iy = static_cast<int>(y);
             if ((ix >> tileShift) != tx || (iy >> tileShift) != ty) {
                 tx = ix >> tileShift, ty = iy >> tileShift;
                 ox = tx << tileShift, oy = ty << tileShift;
                 t = tileAt(chart, level, tx, ty);
             }
-            return t != nullptr;
-        };
+            if (!t) return false;
+            accumulate<true>(t, ox, oy, x, y, weight[i] * scale, acc);
+            return true;
+        });
+    }
+
+    // Sums a line's n taps, from texel coordinates (x, y) by (dx, dy), into sum:
+    // tap(i, x, y, acc) adds tap i to the running sum acc by accumulate(), or returns false
+    // to give the line up, sum untouched. Within up to 8 channels the taps sum in vectors
+    // from zero, added to sum at the end; otherwise in a copy of sum the compiler can keep
+    // in registers.
+    template <typename Tap>
+    bool sumLine(int n, float x, float y, float dx, float dy, float* sum, Tap&& tap) const {
+        const int channels = kFixed ? kChannels : runtimeChannels;
         if constexpr (kVectors > 0) {
             Float4 acc[kVectors] = {};
-            for (int i = 0; i < n; ++i, x += dx, y += dy) {
-                if (!tileOfTap(x, y)) return false;
-                accumulateVectors<true>(t, ox, oy, x, y, weight[i] * scale, acc);
-            }
+            for (int i = 0; i < n; ++i, x += dx, y += dy)
+                if (!tap(i, x, y, acc)) return false;
             float lanes[4 * (kVectors > 0 ? kVectors : 1)];
             for (int k = 0; k < kVectors; ++k) storeFloat4(lanes + 4 * k, acc[k]);
             for (int c = 0; c < channels; ++c) sum[c] += lanes[c];
         } else {
             float acc[kArr];
             for (int c = 0; c < channels; ++c) acc[c] = sum[c];
-            for (int i = 0; i < n; ++i, x += dx, y += dy) {
-                if (!tileOfTap(x, y)) return false;
-                accumulate<true>(t, ox, oy, x, y, weight[i] * scale, acc);
-            }
+            for (int i = 0; i < n; ++i, x += dx, y += dy)
+                if (!tap(i, x, y, acc)) return false;
             for (int c = 0; c < channels; ++c) sum[c] = acc[c];
         }
         fastProbes += static_cast<uint64_t>(n);
@@ -429,25 +436,11 @@ struct Prober {
             if (ix0 >= ox - border && ix1 + 1 < ox + size + border && iy0 >= oy - border &&
                 iy1 + 1 < oy + size + border) {
                 if (const Storage* t = tileAt(chart, level, tx, ty)) {
-                    float x = x0, y = y0;
-                    if constexpr (kVectors > 0) {
-                        Float4 acc[kVectors] = {};
-                        for (int i = 0; i < n; ++i, x += dx, y += dy)
-                            accumulateVectors(t, ox, oy, std::clamp(x, lo, hi),
-                                              std::clamp(y, lo, hi), weight[i] * scale, acc);
-                        float lanes[4 * (kVectors > 0 ? kVectors : 1)];
-                        for (int k = 0; k < kVectors; ++k) storeFloat4(lanes + 4 * k, acc[k]);
-                        for (int c = 0; c < channels; ++c) sum[c] += lanes[c];
-                    } else {
-                        // A local accumulator the compiler can keep in registers.
-                        float acc[kArr];
-                        for (int c = 0; c < channels; ++c) acc[c] = sum[c];
-                        for (int i = 0; i < n; ++i, x += dx, y += dy)
-                            accumulate(t, ox, oy, std::clamp(x, lo, hi), std::clamp(y, lo, hi),
-                                       weight[i] * scale, acc);
-                        for (int c = 0; c < channels; ++c) sum[c] = acc[c];
-                    }
-                    fastProbes += static_cast<uint64_t>(n);
+                    sumLine(n, x0, y0, dx, dy, sum, [&](int i, float x, float y, auto* acc) {
+                        accumulate(t, ox, oy, std::clamp(x, lo, hi), std::clamp(y, lo, hi),
+                                   weight[i] * scale, acc);
+                        return true;
+                    });
                     return;
                 }
                 // The whole line finds its tile missing: it falls back as a line, to the next

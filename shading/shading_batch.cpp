@@ -10,21 +10,28 @@ void ShadingBatch::resize(size_t n, size_t channels) {
     channelData_.resize(std::max<size_t>(channels, 1) * n);
     channels_.resize(channels);
     channelsIn_.resize(channels);
+    for (int r = 0; r < kInputRows; ++r) input(in, r) = row(r);
     for (int k = 0; k < 3; ++k) {
-        in.P[k] = row(P + k);
-        in.N[k] = row(N + k);
-        in.Ng[k] = row(Ng + k);
-        in.dPdu[k] = row(dPdu + k);
-        in.dPdv[k] = row(dPdv + k);
-        in.I[k] = row(I + k);
         out.Ci[k] = row(kInputRows + k);
         out.Oi[k] = row(kInputRows + 3 + k);
     }
-    in.u = row(U), in.v = row(V), in.s = row(S), in.t = row(T);
     for (size_t c = 0; c < channels; ++c)
         channels_[c] = channelData_.data() + c * n, channelsIn_[c] = channels_[c];
     in.channels = channelsIn_.data();
     out.channels = channels_.data();
+}
+
+const float*& ShadingBatch::input(ShadingInputs& in, int r) {
+    if (r < N) return in.P[r - P];
+    if (r < Ng) return in.N[r - N];
+    if (r < dPdu) return in.Ng[r - Ng];
+    if (r < dPdv) return in.dPdu[r - dPdu];
+    if (r < I) return in.dPdv[r - dPdv];
+    if (r < U) return in.I[r - I];
+    if (r == U) return in.u;
+    if (r == V) return in.v;
+    if (r == S) return in.s;
+    return in.t;
 }
 
 void ShadingBatch::setPoint(size_t i, const SurfaceSample& g, const ChartPoint& at,

@@ -37,6 +37,9 @@ class ShadingBatch {
     float* ci(int k) { return out.Ci[k]; }
     float* oi(int k) { return out.Oi[k]; }
 
+    // The pointer of `in` that input row r (Row, below kInputRows) feeds.
+    static const float*& input(ShadingInputs& in, int r);
+
     // Point i: the surface's differential geometry at `at`, seen along unit direction I.
     void setPoint(size_t i, const SurfaceSample& g, const ChartPoint& at, const glm::vec3& I);
 
