@@ -5,8 +5,14 @@
 namespace mpshade {
 
 BandRange::BandRange(const SampleLayout& layout, int layers, int row0_, int row1_)
+    : BandRange(layout, layers, row0_, row1_, 0, layout.width()) {}
+
+BandRange::BandRange(const SampleLayout& layout, int layers, int row0_, int row1_, int col0_,
+                     int col1_)
     : row0(row0_),
       row1(row1_),
+      col0(col0_),
+      col1(col1_),
       firstSample(layout.index(0, row0_, 0)),
       endSample(layout.index(0, row1_, 0)),
       firstSlot(firstSample * static_cast<size_t>(layers)),
@@ -27,22 +33,24 @@ void samplePoints(const SampleLayout& layout, const VisibilityBuffer& vis, const
                   size_t objects, BandPoints& pts, BandPointScratch& s) {
     const int layers = vis.layers;
     pts.pixelPoint.clear();
-    for (size_t smp = r.firstSample; smp < r.endSample; ++smp)
-        for (int l = 0; l < vis.count[smp]; ++l)
-            ++pts.objectStart[vis.object[smp * layers + l] + 1];
+    for (int py = r.row0; py < r.row1; ++py)
+        for (size_t smp = layout.index(r.col0, py, 0); smp < layout.index(r.col1, py, 0); ++smp)
+            for (int l = 0; l < vis.count[smp]; ++l)
+                ++pts.objectStart[vis.object[smp * layers + l] + 1];
     sizePoints(pts, objects);
     s.cursor.assign(pts.objectStart.begin(), pts.objectStart.end() - 1);
-    for (size_t smp = r.firstSample; smp < r.endSample; ++smp)
-        for (int l = 0; l < vis.count[smp]; ++l) {
-            const size_t slot = smp * layers + l;
-            const uint32_t o = vis.object[slot];
-            const uint32_t at = s.cursor[o]++;
-            pts.object[at] = o;
-            pts.facet[at] = vis.facet[slot];
-            pts.x[at] = layout.x(smp);
-            pts.y[at] = layout.y(smp);
-            pts.fragmentPoint[slot - r.firstSlot] = at;
-        }
+    for (int py = r.row0; py < r.row1; ++py)
+        for (size_t smp = layout.index(r.col0, py, 0); smp < layout.index(r.col1, py, 0); ++smp)
+            for (int l = 0; l < vis.count[smp]; ++l) {
+                const size_t slot = smp * layers + l;
+                const uint32_t o = vis.object[slot];
+                const uint32_t at = s.cursor[o]++;
+                pts.object[at] = o;
+                pts.facet[at] = vis.facet[slot];
+                pts.x[at] = layout.x(smp);
+                pts.y[at] = layout.y(smp);
+                pts.fragmentPoint[slot - r.firstSlot] = at;
+            }
 }
 
 // Per pixel or per block of 2x2 pixels: the points of the band's blocks in the order made,
@@ -170,18 +178,20 @@ class BlockPoints {
             pts_.x[at] = s_.unsortedX[p];
             pts_.y[at] = s_.unsortedY[p];
         }
-        for (size_t pixel = r_.firstPixel; pixel < r_.endSample / spp_; ++pixel) {
-            uint32_t& whole = pts_.pixelPoint[pixel - r_.firstPixel];
-            if (whole != kNoPoint) {
-                whole = s_.permutation[whole];
-                continue;
-            }
-            for (size_t smp = pixel * spp_; smp < (pixel + 1) * spp_; ++smp)
-                for (int l = 0; l < vis_.count[smp]; ++l) {
-                    uint32_t& point = pts_.fragmentPoint[smp * layers_ + l - r_.firstSlot];
-                    point = s_.permutation[point];
+        const size_t width = static_cast<size_t>(layout_.width());
+        for (int py = r_.row0; py < r_.row1; ++py)
+            for (size_t pixel = py * width + r_.col0; pixel < py * width + r_.col1; ++pixel) {
+                uint32_t& whole = pts_.pixelPoint[pixel - r_.firstPixel];
+                if (whole != kNoPoint) {
+                    whole = s_.permutation[whole];
+                    continue;
                 }
-        }
+                for (size_t smp = pixel * spp_; smp < (pixel + 1) * spp_; ++smp)
+                    for (int l = 0; l < vis_.count[smp]; ++l) {
+                        uint32_t& point = pts_.fragmentPoint[smp * layers_ + l - r_.firstSlot];
+                        point = s_.permutation[point];
+                    }
+            }
     }
 
   private:
@@ -230,14 +240,14 @@ void buildBandPoints(const SampleLayout& layout, const VisibilityBuffer& vis,
         samplePoints(layout, vis, range, objects, pts, scratch);
     } else {
         const int block = options.rate == ShadingRate::Quad ? 2 : 1;
-        const int width = layout.width();
+        const int width = range.col1;
         BlockPoints blocks(layout, vis, range, block, pts, scratch);
         for (int by = range.row0; by < range.row1; by += block)
-            for (int bx = 0; bx < width; bx += block) {
+            for (int bx = range.col0; bx < width; bx += block) {
                 if (block == 1 && options.wholePixelShortcut && blocks.wholePixel(bx, by)) continue;
                 const int y1 = std::min(range.row1, by + block), x1 = std::min(width, bx + block);
                 if (block == 2 && options.wholePixelShortcut && x1 - bx == 2 && y1 - by == 2 &&
-                    by % 2 == 0 && blocks.wholeQuad(bx, by))
+                    by % 2 == 0 && bx % 2 == 0 && blocks.wholeQuad(bx, by))
                     continue;
                 blocks.groupFragments(bx, by, x1, y1);
             }

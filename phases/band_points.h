@@ -21,13 +21,17 @@ namespace mpshade {
 inline constexpr uint32_t kNoPoint = ~uint32_t{0};
 
 // Pixel rows [row0, row1) of the image, with their samples [firstSample, endSample) in the
-// layout's order, their first visibility slot and their first pixel.
+// layout's order, their first visibility slot and their first pixel; of those rows, the
+// columns [col0, col1) (a band: every column; a refined image tile: its own). Per-band
+// arrays (fragmentPoint, pixelPoint) span the rows' whole width either way.
 struct BandRange {
-    int row0 = 0, row1 = 0;
+    int row0 = 0, row1 = 0, col0 = 0, col1 = 0;
     size_t firstSample = 0, endSample = 0;
     size_t firstSlot = 0, firstPixel = 0;
 
     BandRange(const SampleLayout& layout, int layers, int row0, int row1);
+    BandRange(const SampleLayout& layout, int layers, int row0, int row1, int col0, int col1);
+    bool wholeRows(const SampleLayout& layout) const { return col0 == 0 && col1 == layout.width(); }
 };
 
 // A band's shading points and their results. Kept while the band is unfinished (its points

@@ -1,12 +1,14 @@
 #include "phases/dynamic_phase.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <glm/geometric.hpp>
 
 #include "phases/band_points.h"
@@ -106,6 +108,8 @@ struct DynamicPhase::Band {
     std::vector<BandPoints> states;
     std::vector<BandInputs> inputs;  // per band, while the view holds still (view_reuse.h)
     tbb::enumerable_thread_specific<Scratch> scratch;
+    // refine()'s, apart, so that its counts stay out of the frame's.
+    tbb::enumerable_thread_specific<Scratch> refine;
 };
 
 bool DynamicPhase::Band::Scratch::shadeFresh(std::span<const ObjectView> views,
@@ -225,54 +229,64 @@ namespace {
 // covers whole has all its samples alike: only its first is composited and written, the one
 // the resolve reads (at per-pixel shading, three quarters of the samples' passes over
 // memory).
-void compositeBand(const BandPoints& pts, const BandRange& r, const VisibilityBuffer& vis, int spp,
-                   const glm::vec3& background, float* rgbaOut, uint8_t* uniform) {
+inline void compositePixel(const BandPoints& pts, const BandRange& r, const VisibilityBuffer& vis,
+                           size_t pixel, int spp, const glm::vec3& background, float* rgbaOut,
+                           uint8_t* uniform) {
     const int layers = vis.layers;
-    for (size_t pixel = r.firstPixel; pixel < r.endSample / spp; ++pixel) {
-        const size_t first = pixel * static_cast<size_t>(spp);
-        if (!pts.pixelPoint.empty()) {
-            if (const uint32_t p = pts.pixelPoint[pixel - r.firstPixel]; p != kNoPoint) {
-                SampleComposite c;
+    const size_t first = pixel * static_cast<size_t>(spp);
+    if (!pts.pixelPoint.empty()) {
+        if (const uint32_t p = pts.pixelPoint[pixel - r.firstPixel]; p != kNoPoint) {
+            SampleComposite c;
+            c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
+            c.finish(background, &rgbaOut[4 * first]);
+            uniform[pixel] = 1;
+            return;
+        }
+    }
+    // Whether the pixel's samples came out alike is decided on the values in registers:
+    // reading the samples back from rgbaOut waited on their stores (the whole band's
+    // composite took a fifth of the shading time of a one-sphere scene).
+    float firstRgba[4];
+    bool same = true;
+    for (size_t smp = first; smp < first + spp; ++smp) {
+        float rgba[4];
+        if (vis.count[smp] == 1) {
+            // One surface (most samples): SampleComposite's arithmetic written out for one
+            // layer, the same bits without its loops over layers and channels.
+            const uint32_t p = pts.fragmentPoint[smp * layers - r.firstSlot];
+            const float* ci = &pts.color[3 * p];
+            const float* oi = &pts.opacity[3 * p];
+            float t[3];
+            for (int k = 0; k < 3; ++k) {
+                t[k] = 1.0f - oi[k];
+                rgba[k] = (0.0f + oi[k] * ci[k]) + t[k] * background[k];
+            }
+            rgba[3] = 1.0f - (t[0] + t[1] + t[2]) / 3.0f;
+        } else {
+            SampleComposite c;
+            for (int l = 0; l < vis.count[smp]; ++l) {
+                const uint32_t p = pts.fragmentPoint[smp * layers + l - r.firstSlot];
                 c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
-                c.finish(background, &rgbaOut[4 * first]);
-                uniform[pixel] = 1;
-                continue;
             }
+            c.finish(background, rgba);
         }
-        // Whether the pixel's samples came out alike is decided on the values in registers:
-        // reading the samples back from rgbaOut waited on their stores (the whole band's
-        // composite took a fifth of the shading time of a one-sphere scene).
-        float firstRgba[4];
-        bool same = true;
-        for (size_t smp = first; smp < first + spp; ++smp) {
-            float rgba[4];
-            if (vis.count[smp] == 1) {
-                // One surface (most samples): SampleComposite's arithmetic written out for one
-                // layer, the same bits without its loops over layers and channels.
-                const uint32_t p = pts.fragmentPoint[smp * layers - r.firstSlot];
-                const float* ci = &pts.color[3 * p];
-                const float* oi = &pts.opacity[3 * p];
-                float t[3];
-                for (int k = 0; k < 3; ++k) {
-                    t[k] = 1.0f - oi[k];
-                    rgba[k] = (0.0f + oi[k] * ci[k]) + t[k] * background[k];
-                }
-                rgba[3] = 1.0f - (t[0] + t[1] + t[2]) / 3.0f;
-            } else {
-                SampleComposite c;
-                for (int l = 0; l < vis.count[smp]; ++l) {
-                    const uint32_t p = pts.fragmentPoint[smp * layers + l - r.firstSlot];
-                    c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
-                }
-                c.finish(background, rgba);
-            }
-            std::memcpy(&rgbaOut[4 * smp], rgba, sizeof rgba);
-            if (smp == first)
-                std::memcpy(firstRgba, rgba, sizeof rgba);
-            else
-                same = same && std::memcmp(rgba, firstRgba, sizeof rgba) == 0;
-        }
-        uniform[pixel] = same ? 1 : 0;
+        std::memcpy(&rgbaOut[4 * smp], rgba, sizeof rgba);
+        if (smp == first)
+            std::memcpy(firstRgba, rgba, sizeof rgba);
+        else
+            same = same && std::memcmp(rgba, firstRgba, sizeof rgba) == 0;
+    }
+    uniform[pixel] = same ? 1 : 0;
+}
+
+// A band's (or a refined tile's) pixels, row by row.
+void compositeBand(const BandPoints& pts, const BandRange& r, const VisibilityBuffer& vis,
+                   int width, int spp, const glm::vec3& background, float* rgbaOut,
+                   uint8_t* uniform) {
+    for (int py = r.row0; py < r.row1; ++py) {
+        const size_t row = static_cast<size_t>(py) * static_cast<size_t>(width);
+        for (size_t pixel = row + r.col0; pixel < row + r.col1; ++pixel)
+            compositePixel(pts, r, vis, pixel, spp, background, rgbaOut, uniform);
     }
 }
 
@@ -571,8 +585,8 @@ void DynamicPhase::finishBand(size_t band, const BandRange& range, const BandPoi
                               std::vector<ObjectFrameCost>& costs,
                               DynamicFrameStats::ShadeParts& parts) {
     const auto began = Clock::now();
-    compositeBand(pts, range, visibility_, layout_->spp(), scene_.settings.background,
-                  samples_.rgba.data(), uniform_.data());
+    compositeBand(pts, range, visibility_, layout_->width(), layout_->spp(),
+                  scene_.settings.background, samples_.rgba.data(), uniform_.data());
     parts.composite += secondsSince(began);
     for (size_t o = 0; o < objects_.size(); ++o)
         costs[o].shadingPoints += pts.objectStart[o + 1] - pts.objectStart[o];
@@ -580,12 +594,75 @@ void DynamicPhase::finishBand(size_t band, const BandRange& range, const BandPoi
 }
 
 void DynamicPhase::resolve(Image& out) {
+    stats_.resolveSeconds = resolveAgain(out);
+}
+
+double DynamicPhase::resolveAgain(Image& out) {
     const auto start = Clock::now();
     const ScopedSpan span(options_.trace, "resolve", PhaseKind::Resolve, SpanLevel::Phase, -1,
                           frame_->index);
     layout_->resolve(samples_.rgba.data(), uniform_.data(), out,
                      options_.shadingRate == ShadingRate::Quad);
-    stats_.resolveSeconds = secondsSince(start);
+    return secondsSince(start);
+}
+
+RefineCounts DynamicPhase::refine(std::span<const PixelRect> tiles, const RefinePass& pass,
+                                  std::vector<TileRequest>& missing) {
+    const auto start = Clock::now();
+    RefineCounts counts;
+    if (stats_.raster.abandoned || !complete() || tiles.empty()) return counts;
+    const ScopedSpan span(options_.trace, "refine", PhaseKind::Dynamic, SpanLevel::Phase, -1,
+                          frame_->index);
+    refineViews_ = views_;
+    const float footprint = pass.footprintScale * footprintPixels(pass.rate, layout_->spp());
+    for (ObjectView& v : refineViews_) v.footprintScale = footprint;
+    const size_t objects = objects_.size();
+    // Every worker takes the next tile in order, so the tiles done are a prefix of the list.
+    std::atomic<size_t> next{0};
+    tbb::enumerable_thread_specific<std::vector<TileRequest>> found;
+    const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
+    tbb::parallel_for(0, workers, [&](int) {
+        Band::Scratch& s = scratch_->refine.local();
+        if (s.costs.size() != objects) s.costs.assign(objects, ObjectFrameCost{});
+        s.batchMissed.resize(kBatch);
+        while (Clock::now() < pass.deadline) {
+            const size_t t = next++;
+            if (t >= tiles.size()) break;
+            const PixelRect& rect = tiles[t];
+            const BandRange range(*layout_, visibility_.layers, rect.y0, rect.y1, rect.x0, rect.x1);
+            const auto began = Clock::now();
+            BandPoints& pts = s.work;
+            buildBandPoints(*layout_, visibility_, range, objects,
+                            {pass.rate, options_.wholePixelShortcut}, pts, s.points);
+            s.parts.points += secondsSince(began);
+            s.stillPending.clear();
+            s.shadeFresh(refineViews_, options_.probe, false, pts, found.local(), inputLayout_,
+                         nullptr);
+            pts.built = false;
+            const auto compositing = Clock::now();
+            compositeBand(pts, range, visibility_, layout_->width(), layout_->spp(),
+                          scene_.settings.background, samples_.rgba.data(), uniform_.data());
+            s.parts.composite += secondsSince(compositing);
+            for (size_t o = 0; o < objects; ++o)
+                s.costs[o].shadingPoints += pts.objectStart[o + 1] - pts.objectStart[o];
+        }
+    });
+    counts.tiles = std::min(next.load(), tiles.size());
+    for (Band::Scratch& s : scratch_->refine) {
+        for (ObjectFrameCost& c : s.costs) {
+            counts.shadingPoints += c.shadingPoints;
+            counts.probes += c.probes;
+            counts.probeFallbacks += c.probeFallbacks;
+            c = ObjectFrameCost{};
+        }
+        counts.parts += s.parts;
+        s.parts = {};
+        s.counters = SurfaceShadingCounters{};
+    }
+    for (const std::vector<TileRequest>& l : found)
+        missing.insert(missing.end(), l.begin(), l.end());
+    counts.seconds = secondsSince(start);
+    return counts;
 }
 
 }  // namespace mpshade

@@ -150,6 +150,29 @@ struct DynamicFrameStats {
     }
 };
 
+// A rectangle of image pixels: columns [x0, x1), rows [y0, y1).
+struct PixelRect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    int area() const { return (x1 - x0) * (y1 - y0); }
+};
+
+// One pass of DynamicPhase::refine().
+struct RefinePass {
+    ShadingRate rate = ShadingRate::Sample;
+    float footprintScale = 1.0f;  // times footprintPixels(rate, spp), as DynamicOptions'
+    // No tile starts after this moment; one started is finished.
+    std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+};
+
+// What a refine() pass did: the first `tiles` of those asked were shaded again, at so many
+// points; its wall seconds, and where its CPU time went (as DynamicFrameStats').
+struct RefineCounts {
+    size_t tiles = 0;
+    uint64_t shadingPoints = 0, probes = 0, probeFallbacks = 0;
+    double seconds = 0.0;
+    DynamicFrameStats::ShadeParts parts;
+};
+
 class DynamicPhase {
   public:
     explicit DynamicPhase(const Scene& scene);
@@ -174,6 +197,20 @@ class DynamicPhase {
     const SampleBuffer& samples() const { return samples_; }
     // Filters the samples into pixels.
     void resolve(Image& out);
+
+    // After shade() completed every band: shades the pixels of `tiles` again, in their
+    // order, at the pass's rate and footprint, with fallbacks (a missing tile reads a
+    // coarser level and is appended to `missing`), each tile's samples composited anew.
+    // Tiles are taken in order by every thread and none starts after the pass's deadline,
+    // so those done are always a prefix. resolveAgain() then makes the pixels.
+    // The frame's own stats (stats(), objectCosts()) are left as shade() made them.
+    RefineCounts refine(std::span<const PixelRect> tiles, const RefinePass& pass,
+                        std::vector<TileRequest>& missing);
+    // resolve() again after refine(); returns its seconds (stats() keeps the first's).
+    double resolveAgain(Image& out);
+    // Per pixel (row-major): 1 where its samples came out alike in the last composite (one
+    // surface shaded once for the pixel, or the same result for each), else 0.
+    const std::vector<uint8_t>& alikePixels() const { return uniform_; }
 
     const DynamicFrameStats& stats() const { return stats_; }
     const std::vector<ObjectFrameCost>& objectCosts() const { return costs_; }
@@ -208,6 +245,7 @@ class DynamicPhase {
     std::vector<uint8_t> bandDone_;
     bool abandoned_ = false;
     std::unique_ptr<Band> scratch_;
+    std::vector<ObjectView> refineViews_;  // views_ at a refine pass's footprint
     // The last frame's view (view_reuse.h); whether its visibility is whole; whether this
     // frame reuses it, and whether its bands keep their inputs.
     ViewKey lastView_;

@@ -15,15 +15,19 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include "phases/dynamic_frame.h"
 #include "phases/dynamic_phase.h"
-#include "phases/static_phase.h"
 #include "scene/scene.h"
 #include "test_support.h"
 
 namespace mpshade {
 namespace {
 
-constexpr int kWidth = 16, kHeight = 12, kSpp = 4;
+using test::Frame;
+using test::kHeight;
+using test::kSpp;
+using test::kWidth;
+using test::shadeWhole;
 
 // Two planes filling the view from above: a half-opaque red one in front of an opaque green
 // one, over a blue-grey background. Or, with `back` false, the red one alone.
@@ -63,34 +67,6 @@ std::string writeSphereScene(const std::string& name) {
                      "shader": "red" } ] })";
     return dir + "scene.json";
 }
-
-// A scene's objects built for frame 0 (each as `kind`), and a dynamic phase over them.
-struct Frame {
-    Scene scene;
-    SceneResources resources{scene, SceneResources::RayScenes::ForOcclusion};
-    StaticPhase statics{scene, resources};
-    FrameState state;
-    std::vector<std::unique_ptr<ObjectRepresentation>> reps;
-    std::vector<const ObjectRepresentation*> drawn;
-    std::shared_ptr<const SampleLayout> layout;
-
-    Frame(const std::string& path, Representation kind, int width = kWidth, int height = kHeight)
-        : scene(loadScene(path)) {
-        state = frameStateAt(resources, 0, width, height, kSpp);
-        for (size_t i = 0; i < scene.objects.size(); ++i) {
-            StaticCosts costs;
-            reps.push_back(statics.build(i, kind, state.objects[i], state.camera, state.uniforms[i],
-                                         nullptr, costs));
-            drawn.push_back(reps.back().get());
-        }
-        layout = std::make_shared<const SampleLayout>(width, height, kSpp, 7u);
-    }
-    DynamicOptions options(ShadingRate rate) const {
-        DynamicOptions o;
-        o.shadingRate = rate;
-        return o;
-    }
-};
 
 TEST(DynamicPhase, CompositesFrontToBackOverTheBackgroundAtEveryRate) {
     // Red at half opacity over opaque green: (0.5, 0.5, 0), full coverage. The red one alone
@@ -295,20 +271,6 @@ TEST(DynamicPhase, AcceptingFallbacksFinishesInOnePassFromCoarserLevels) {
     EXPECT_GT(phase.stats().probeFallbacks, 0u);
     EXPECT_LE(phase.stats().probeFallbacks, phase.stats().probes);
     for (float v : phase.samples().rgba) ASSERT_TRUE(std::isfinite(v));
-}
-
-// Shades `state` to completion, filling what its probes find missing (or, accepting
-// fallbacks, in one pass and filling nothing).
-void shadeWhole(Frame& f, DynamicPhase& phase, const FrameState& state, const DynamicOptions& o,
-                bool acceptFallbacks = false) {
-    phase.begin(state, f.drawn, f.layout, o);
-    std::vector<TileRequest> missing = phase.shade(acceptFallbacks);
-    for (int pass = 0; !acceptFallbacks && !missing.empty() && pass < 8; ++pass) {
-        StaticCosts costs;
-        f.statics.fill(missing, f.drawn, costs);
-        missing = phase.shade();
-    }
-    ASSERT_TRUE(phase.complete());
 }
 
 // The lamplight example: a still camera over the vase and floor, a point light circling.
