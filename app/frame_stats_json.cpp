@@ -128,6 +128,29 @@ nlohmann::json playFrameJson(const Scene& scene, const FrameStats& s,
           {"evicted", s.background.tilesEvicted},
           {"seconds", s.background.seconds}}},
         {"shaded_points", s.shadedPoints}};
+    if (s.refine.ran) {
+        // Per step from the frame's own (level) up: the share of the image's pixels there.
+        nlohmann::json share = nlohmann::json::array(), refined = nlohmann::json::array();
+        uint64_t pixels = 0;
+        for (int k = 0; k < s.refine.steps; ++k) pixels += s.refine.pixelsAt[k];
+        for (int k = 0; k < s.refine.steps; ++k) {
+            share.push_back(
+                {{"level", quality.level - k},
+                 {"pixel_share", pixels > 0 ? static_cast<double>(s.refine.pixelsAt[k]) /
+                                                  static_cast<double>(pixels)
+                                            : 0.0},
+                 {"tiles", k == 0 ? 0 : s.refine.refined[k]}});
+        }
+        entry["refine"] = {{"tile_size", s.refine.tileSize},
+                           {"tiles_seeing_surfaces", s.refine.tiles},
+                           {"steps", share},
+                           {"priority_threshold", s.refine.threshold},
+                           {"gain_mse", s.refine.gainMse},
+                           {"points", s.refine.shadingPoints},
+                           {"seconds", s.refine.seconds},
+                           {"resolve_seconds", s.refine.resolveSeconds}};
+        if (s.refine.estimatedPsnr >= 0.0) entry["refine"]["estimated_psnr"] = s.refine.estimatedPsnr;
+    }
     addMultiphaseFrameJson(scene, s, entry);
     return entry;
 }

@@ -172,6 +172,20 @@ int main(int argc, char** argv) {
     playCmd->add_flag("--no-background-fills", play.noBackgroundFills,
                       "Fill missing tiles only in frames' slack, on no worker thread alongside "
                       "them (for comparisons)");
+    playCmd
+        ->add_option("--refine", play.refine,
+                     "'on': each frame, once shaded at its step, refined by image tile at finer "
+                     "rates in order of need in the time left; 'off': the whole frame at one step")
+        ->capture_default_str();
+    playCmd
+        ->add_option("--refine-tile", play.refineTile,
+                     "Refinement's image tiles, pixels a side (even, 4..256)")
+        ->capture_default_str();
+    playCmd->add_option(
+        "--compare-to", play.compareTo,
+        "Folder of constant-quality frames (`render` at the same size): each played "
+        "frame's PSNR against its frame there, and the temporal error, in stats.json "
+        "and the summary");
     playCmd->add_flag("--quiet", play.quiet, "No progress or summary on stderr");
     mpshade::addRunOptions(*playCmd, play.run);
 

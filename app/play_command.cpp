@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "app/interrupt_watch.h"
 #include "app/memory_limit.h"
 #include "app/output_files.h"
+#include "app/played_quality.h"
 #include "controller/playback.h"
 #include "geometry/error.h"
 #include "scene/scene.h"
@@ -48,7 +50,7 @@ double median(std::vector<double> v) {
 // Where the frames' time went, and what each quality step costs: why the frames played at
 // the quality they did.
 void printPlaySummary(const std::vector<PlaybackStep>& steps, const std::vector<FrameStats>& played,
-                      int spp, double fps) {
+                      int spp, double fps, const PlayedQuality* quality) {
     std::fprintf(stderr,
                  "  steps, best first: the first frame's dynamic phase at each (measured in "
                  "the pre-roll; the slot is %.1f ms), and the frames played there\n",
@@ -93,22 +95,57 @@ void printPlaySummary(const std::vector<PlaybackStep>& steps, const std::vector<
                  static_cast<unsigned long long>(prefetch.filled),
                  static_cast<unsigned long long>(prefetch.used),
                  static_cast<unsigned long long>(prefetch.wasted));
+    std::vector<double> refined, estimated, refineMs;
+    for (const FrameStats& s : played) {
+        if (!s.refine.ran) continue;
+        uint64_t all = 0;
+        for (int k = 0; k < s.refine.steps; ++k) all += s.refine.pixelsAt[k];
+        refined.push_back(all > 0 ? 100.0 * static_cast<double>(all - s.refine.pixelsAt[0]) /
+                                        static_cast<double>(all)
+                                  : 0.0);
+        if (s.refine.estimatedPsnr >= 0.0) estimated.push_back(s.refine.estimatedPsnr);
+        refineMs.push_back(1e3 * s.refine.seconds);
+    }
+    if (!refined.empty()) {
+        std::fprintf(stderr,
+                     "  refinement (%zu of %zu frames): median %.0f%% of pixels shaded again at "
+                     "a better step, in %.1f ms",
+                     refined.size(), played.size(), median(refined), median(refineMs));
+        if (!estimated.empty())
+            std::fprintf(stderr, "; estimated %.1f dB from constant quality", median(estimated));
+        std::fprintf(stderr, "\n");
+    }
+    if (quality && !quality->frames().empty()) {
+        std::vector<double> psnr, temporal;
+        int good = 0;
+        for (const PlayedFrameQuality& q : quality->frames()) {
+            psnr.push_back(q.psnr);
+            good += q.psnr >= 38.0 ? 1 : 0;
+            if (q.temporalRmse >= 0.0) temporal.push_back(q.temporalRmse);
+        }
+        const double least = *std::min_element(psnr.begin(), psnr.end());
+        std::fprintf(stderr,
+                     "  against the constant-quality frames: median %.2f dB (least %.2f), %d of "
+                     "%zu at 38 dB or more; temporal RMSE median %.5f\n",
+                     median(psnr), least, good, psnr.size(), median(temporal));
+    }
 }
 
-}  // namespace
-
-int runPlayCommand(const PlayCommandOptions& options) {
+// The options checked, and playback's options from them and the request.
+PlaybackOptions playbackOptions(const PlayCommandOptions& options, const FrameRequest& request) {
     if (!(options.fps >= 0.1 && options.fps <= 1000.0))
         throw InputError({"--fps", 0, 0, {}}, "expected 0.1..1000 frames per second, found " +
                                                   std::to_string(options.fps));
     if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
         throw InputError({"--cache-mb", 0, 0, {}},
                          "expected 1..1048576 MB, found " + std::to_string(options.cacheMb));
-    const FrameRequest request =
-        loadFrameRequest({options.scene, options.frames, options.size, options.spp, options.seed});
-    const Scene& scene = request.scene;
-    const int width = request.resolved.width, height = request.resolved.height,
-              spp = request.resolved.samplesPerPixel;
+    if (options.refine != "on" && options.refine != "off")
+        throw InputError({"--refine", 0, 0, {}},
+                         "expected 'on' or 'off', found '" + options.refine + "'");
+    if (options.refineTile < 4 || options.refineTile > 256 || options.refineTile % 2 != 0)
+        throw InputError({"--refine-tile", 0, 0, {}},
+                         "expected an even number of pixels 4..256, found " +
+                             std::to_string(options.refineTile));
     PlaybackOptions po;
     po.fps = options.fps;
     po.render = request.render;
@@ -117,7 +154,23 @@ int runPlayCommand(const PlayCommandOptions& options) {
     po.cacheBytes = static_cast<size_t>(options.cacheMb) << 20;
     po.prefetch = !options.noPrefetch;
     po.backgroundFills = !options.noBackgroundFills;
+    po.refine.enabled = options.refine == "on";
+    po.refine.tileSize = options.refineTile;
+    return po;
+}
+
+}  // namespace
+
+int runPlayCommand(const PlayCommandOptions& options) {
+    const FrameRequest request =
+        loadFrameRequest({options.scene, options.frames, options.size, options.spp, options.seed});
+    PlaybackOptions po = playbackOptions(options, request);
     po.store = openStore(options.run);
+    const Scene& scene = request.scene;
+    const int width = request.resolved.width, height = request.resolved.height,
+              spp = request.resolved.samplesPerPixel;
+    std::unique_ptr<PlayedQuality> measured;
+    if (!options.compareTo.empty()) measured = std::make_unique<PlayedQuality>(options.compareTo);
     prepareOutputFolder(options.outDir);
     const std::filesystem::path dir(options.outDir);
     const bool tty = !options.quiet && isatty(STDERR_FILENO);
@@ -179,6 +232,11 @@ int runPlayCommand(const PlayCommandOptions& options) {
             ++steps[static_cast<size_t>(quality.level)].frames;
         playedFrames.push_back(s);
         nlohmann::json entry = playFrameJson(scene, s, quality, spp, writeSeconds);
+        if (measured) {
+            const PlayedFrameQuality q = measured->measure(image, s.index);
+            entry["constant_quality"] = {{"psnr", q.psnr}};
+            if (q.temporalRmse >= 0.0) entry["constant_quality"]["temporal_rmse"] = q.temporalRmse;
+        }
         frames.push_back(std::move(entry));
         if (tty)
             std::fprintf(stderr, "\rframe %d: %.1f ms of %.1f, %d of %zu on time", s.index,
@@ -208,7 +266,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
                      summary.frames > 0 ? 100.0 * summary.deadlinesMet / summary.frames : 100.0,
                      summary.prerollSeconds, (dir / "stats.json").string().c_str());
     if (!options.quiet && !playedFrames.empty())
-        printPlaySummary(summary.steps, playedFrames, spp, options.fps);
+        printPlaySummary(summary.steps, playedFrames, spp, options.fps, measured.get());
     return 0;
 }
 

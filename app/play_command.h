@@ -23,6 +23,11 @@ struct PlayCommandOptions {
     bool noWrite = false;            // measure without the disk: stats.json only
     bool noPrefetch = false;         // no predicted or adjacent tiles filled ahead (comparisons)
     bool noBackgroundFills = false;  // no worker thread filling deferred tiles (comparisons)
+    std::string refine = "on";       // "on" or "off": refinement by image tile (tile_refiner.h)
+    int refineTile = 16;             // refinement's tiles, pixels a side: even, 4..256
+    // A folder of constant-quality frames (frame_NNNN.exr, as `render` writes them): each
+    // played frame measured against its own there. Empty: none.
+    std::string compareTo;
     bool quiet = false;
     RunOptions run;  // the shader-map store, threads
 };

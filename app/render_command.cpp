@@ -271,8 +271,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
         if (interrupted()) break;
     }
     if (skipped > 0 && !options.quiet)
-        std::fprintf(stderr, "mpshade: %d frame(s) already in %s were not written again\n",
-                     skipped, options.outDir.c_str());
+        std::fprintf(stderr, "mpshade: %d frame(s) already in %s were not written again\n", skipped,
+                     options.outDir.c_str());
     bar.finish();
     cleanUpStore(store, options.run);
     if (interrupted()) {

@@ -80,6 +80,23 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
     missing_.clear();
 }
 
+void MultiphaseRenderer::refineWithinBudget(Clock::time_point start, Image& image,
+                                            FrameStats& stats) {
+    if (!dynamic_.complete() || dynamic_.abandoned() || refineSteps_.empty()) return;
+    // Room left for the resolve that follows, as long as the last one took.
+    const double until =
+        options_.refine.until * options_.frameBudgetSeconds - refiner_.lastResolveSeconds();
+    const auto deadline =
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(until));
+    const size_t before = missing_.size();
+    refiner_.refine(dynamic_, {dynamicOptions_.shadingRate, dynamicOptions_.footprintScale},
+                    refineSteps_, deadline, image, stats.refine, missing_);
+    if (missing_.size() > before) {
+        sortUniqueTiles(missing_);
+        stats.tiles.missing += missing_.size() - before;
+    }
+}
+
 // The missing tiles from `from` on, for the background filler (made at the first frame
 // that needs it), at most MultiphaseOptions::backgroundQueue of them.
 void MultiphaseRenderer::queueForBackground(size_t from) {

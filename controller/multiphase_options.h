@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <optional>
 
+#include "controller/tile_refiner.h"
 #include "phases/dynamic_phase.h"
 #include "phases/phase_trace.h"
 #include "phases/representation_choice.h"
@@ -56,6 +57,9 @@ struct MultiphaseOptions {
     // With a frame budget, the share of it static work gets even when the dynamic phase
     // took the whole budget: frames late anyway still make progress towards full quality.
     double minimumStaticShare = 0.1;
+    // With a frame budget: the frame, once resolved, refined by image tile at finer rates in
+    // order of priority (tile_refiner.h). Off by default; playback turns it on.
+    RefineOptions refine;
     // The photometric re-run trigger (static_inputs.h): an object whose static part reads
     // animated inputs (through bake()) runs its static phase again once one of them moved
     // by more than this share of its span over the scene since the last run.

@@ -35,7 +35,8 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
       cache_(options.mapMemoryBytes),
       tiles_(static_, cache_),
       planner_(scene, static_, options.costModel, options.representation),
-      slots_(scene.objects.size()) {
+      slots_(scene.objects.size()),
+      refiner_(options.refine) {
     options_.dynamic.trace = options.trace;
     std::vector<StaticInputs> inputs(slots_.size());
     for (size_t i = 0; i < slots_.size(); ++i) {
@@ -431,6 +432,7 @@ void MultiphaseRenderer::renderFrame(int frame, const RenderOptions& options, Fr
     stats.dynamic.resolveSeconds = dynamic_.stats().resolveSeconds;
     if (options_.frameBudgetSeconds > 0.0) {
         lastDynamicSeconds_ = dynamic_.stats().seconds();
+        if (options_.refine.enabled) refineWithinBudget(start, image, stats);
         fillWithinBudget(start, stats);
     }
     stats.wallSeconds = secondsSince(start);

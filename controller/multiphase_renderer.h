@@ -17,6 +17,7 @@
 #include "controller/representation_planner.h"
 #include "controller/tile_cache.h"
 #include "controller/tile_filler.h"
+#include "controller/tile_refiner.h"
 #include "phases/dynamic_phase.h"
 #include "phases/reference_renderer.h"
 #include "phases/sample_layout_cache.h"
@@ -50,6 +51,9 @@ class MultiphaseRenderer : public Renderer {
     // The current representation of object i (null before a frame has seen it).
     const ObjectRepresentation* representation(size_t object) const;
     const FactoredShader& factored(size_t object) const;
+    // With MultiphaseOptions::refine on and a frame budget: the steps the frames that follow
+    // refine their tiles to, better and better (tile_refiner.h); none: no refinement.
+    void setRefineSteps(std::vector<RefineStep> steps) { refineSteps_ = std::move(steps); }
     // Sets MultiphaseOptions::frameBudgetSeconds for the frames that follow (0: constant
     // quality), as playback does after rendering its first frame at constant quality.
     void setFrameBudget(double seconds);
@@ -109,6 +113,10 @@ class MultiphaseRenderer : public Renderer {
     // With a frame budget: fills this frame's missing tiles (missing_) until the budget,
     // counted from `start`, is spent; queues what is left for the background filler.
     void fillWithinBudget(std::chrono::steady_clock::time_point start, FrameStats& stats);
+    // With a frame budget and MultiphaseOptions::refine on: the frame just resolved into
+    // `image` refined by tile (tile_refiner.h) until RefineOptions::until of the budget.
+    void refineWithinBudget(std::chrono::steady_clock::time_point start, Image& image,
+                            FrameStats& stats);
     void queueForBackground(size_t from);
     void settlePrefetched(FrameStats& stats);  // prefetch_ledger.h
     std::vector<const ObjectRepresentation*> representations() const;
@@ -137,6 +145,8 @@ class MultiphaseRenderer : public Renderer {
     std::vector<const ObjectRepresentation*> drawn_;
     double lastDynamicSeconds_ = 0.0;
     PrefetchLedger prefetched_;  // the tiles prefetched and not yet read
+    TileRefiner refiner_;
+    std::vector<RefineStep> refineSteps_;
     // The background filler (made at the first frame that defers tiles), and its totals at
     // the last frame. Last: destroyed (its worker joined) before anything it uses.
     BackgroundTotals fillerTotals_;

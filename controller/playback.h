@@ -32,6 +32,14 @@ struct PlaybackOptions {
     // What frames give up when the dynamic phase alone takes most of the budget: shading
     // rate, then probe footprint (quality_regulator.h).
     QualityRegulatorOptions regulator;
+    // Each frame, once shaded at the regulator's step, refined by image tile at finer rates
+    // in order of priority in the time left (tile_refiner.h); the regulator's shares are then
+    // scaled by RefineOptions::baseShare. Off (`play --refine off`): the whole-frame step alone.
+    RefineOptions refine = [] {
+        RefineOptions r;
+        r.enabled = true;
+        return r;
+    }();
     // Looking ahead: objects the next frames up to this many seconds of scene time will see,
     // not built yet, are built in a frame's slack (MultiphaseRenderer::buildAhead), so an
     // object entering the view is ready before its first frame. 0: no look-ahead.

@@ -33,12 +33,22 @@ QualityRegulator::QualityRegulator(ShadingRate sceneRate, int spp,
     steps_.push_back({ShadingRate::Quad, 2.0f});
     if (spp > 2) steps_.push_back({ShadingRate::Quad, 2.0f, spp / 2});
     if (spp > 1) steps_.push_back({ShadingRate::Quad, 2.0f, 1});
+    lastFullSamples_ = 0;
+    for (int k = 0; k < levels(); ++k)
+        if (steps_[static_cast<size_t>(k)].samplesPerPixel == 0) lastFullSamples_ = k;
     // Until measured: as if the whole dynamic phase scaled with the shading points (an
     // overestimate: rasterization and resolve do not).
     ratioAbove_.assign(steps_.size(), 1.0);
     for (size_t k = 1; k < steps_.size(); ++k)
         ratioAbove_[k] = pointsPerPixel(steps_[k - 1].rate, std::max(1, spp)) /
                          pointsPerPixel(steps_[k].rate, std::max(1, spp));
+}
+
+double QualityRegulator::share(int level) const {
+    // The best step and the cheapest at the request's samples per pixel have the whole
+    // budget: the first needs no refining, and below the second only fewer samples remain.
+    if (level == 0 || level >= lastFullSamples_) return 1.0;
+    return options_.refinedShare;
 }
 
 void QualityRegulator::calibrate(std::span<const double> seconds, double budget) {
@@ -50,7 +60,7 @@ void QualityRegulator::calibrate(std::span<const double> seconds, double budget)
     const double target = 0.5 * (options_.slowDownAt + options_.speedUpAt) * budget;
     current_ = levels() - 1;
     for (int k = 0; k < levels(); ++k)
-        if (seconds[static_cast<size_t>(k)] <= target) {
+        if (seconds[static_cast<size_t>(k)] <= target * share(k)) {
             current_ = k;
             break;
         }
@@ -72,7 +82,10 @@ void QualityRegulator::update(const FrameStats& stats, double budget) {
             ratioAbove_[static_cast<size_t>(below)] = std::max(1.0, upper / lower);
         }
     }
-    const bool wasOver = lastLevel_ == current_ && lastDynamic_ > options_.slowDownAt * budget;
+    // The budget of a frame at the current step, and of one at the step above.
+    const double here = share(current_) * budget;
+    const double above = share(std::max(0, current_ - 1)) * budget;
+    const bool wasOver = lastLevel_ == current_ && lastDynamic_ > options_.slowDownAt * here;
     lastLevel_ = current_;
     lastDynamic_ = dynamic;
     lastReused_ = reused;
@@ -82,12 +95,12 @@ void QualityRegulator::update(const FrameStats& stats, double budget) {
     }
     // One frame over the share may be the machine (a frame's time varies by a tenth or
     // more): a step down waits for a second one, unless the frame nearly took the budget.
-    if (dynamic > options_.dropAt * budget || (dynamic > options_.slowDownAt * budget && wasOver)) {
+    if (dynamic > options_.dropAt * here || (dynamic > options_.slowDownAt * here && wasOver)) {
         current_ = std::min(current_ + 1, levels() - 1);
         calm_ = probeCalm_ = 0;
         return;
     }
-    if (dynamic > options_.slowDownAt * budget || current_ == 0) {
+    if (dynamic > options_.slowDownAt * here || current_ == 0) {
         calm_ = probeCalm_ = 0;
         return;
     }
@@ -96,9 +109,9 @@ void QualityRegulator::update(const FrameStats& stats, double budget) {
     const double base =
         reused && freshLevel_ == current_ ? std::max(dynamic, freshDynamic_) : dynamic;
     const double predicted = base * ratioAbove_[static_cast<size_t>(current_)];
-    if (predicted >= options_.speedUpAt * budget) {
+    if (predicted >= options_.speedUpAt * above) {
         calm_ = 0;
-        probeCalm_ = predicted < options_.dropAt * budget ? probeCalm_ + 1 : 0;
+        probeCalm_ = predicted < options_.dropAt * above ? probeCalm_ + 1 : 0;
         if (probeCalm_ >= options_.probeFrames) {
             --current_;
             probeCalm_ = 0;

@@ -49,6 +49,12 @@ struct QualityRegulatorOptions {
     // overstate the step above for good (a teapot run stayed a mip level coarser for 45 of
     // 48 frames); predicted under dropAt, the frame tried is on time either way.
     int probeFrames = 16;
+    // The shares above, for the steps that are refined by tile afterwards (tile_refiner.h),
+    // are times this: a frame there is shaded at its step within this part of what it would
+    // otherwise get, and the rest is refinement's. The best step (nothing to refine) and the
+    // cheapest with the request's samples per pixel (what is left below it has fewer
+    // samples, which refinement cannot add) keep the whole shares. 1: not refining.
+    double refinedShare = 1.0;
 };
 
 class QualityRegulator {
@@ -74,7 +80,10 @@ class QualityRegulator {
     double costRatioAbove(int level) const { return ratioAbove_[level]; }
 
   private:
+    double share(int level) const;  // QualityRegulatorOptions::refinedShare, where it applies
+
     std::vector<QualityStep> steps_;
+    int lastFullSamples_ = 0;         // the last step at the request's samples per pixel
     std::vector<double> ratioAbove_;  // per level >= 1
     QualityRegulatorOptions options_;
     int current_ = 0;

@@ -70,7 +70,18 @@ class BlockPoints {
           s_(s) {
         s.unsortedObject.clear(), s.unsortedFacet.clear();
         s.unsortedX.clear(), s.unsortedY.clear();
-        pts.pixelPoint.assign(static_cast<size_t>(r.row1 - r.row0) * layout.width(), kNoPoint);
+        // Only the range's own pixels are read back (a refined tile's: its columns).
+        const size_t width = static_cast<size_t>(layout.width());
+        if (r.wholeRows(layout)) {
+            pts.pixelPoint.assign(static_cast<size_t>(r.row1 - r.row0) * width, kNoPoint);
+        } else {
+            pts.pixelPoint.resize(static_cast<size_t>(r.row1 - r.row0) * width);
+            for (int y = r.row0; y < r.row1; ++y) {
+                const auto row =
+                    pts.pixelPoint.begin() + static_cast<std::ptrdiff_t>((y - r.row0) * width);
+                std::fill(row + r.col0, row + r.col1, kNoPoint);
+            }
+        }
         s.member.resize(static_cast<size_t>(block * block) * pixelSlots_);
     }
 

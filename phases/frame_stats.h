@@ -106,6 +106,34 @@ struct BudgetStats {
     int builtAhead = 0;  // objects built in this frame's slack for frames ahead that see them
 };
 
+// Refinement by image tile in a played frame (controller/tile_refiner.h): the frame shaded
+// at its step, then tiles in order of priority shaded again at better steps until the
+// refinement's deadline.
+struct RefineStats {
+    static constexpr int kMaxSteps = 8;
+    bool ran = false;  // refinement was on and had a better step to go to
+    int tileSize = 0;  // pixels a side
+    int tiles = 0;     // image tiles that see any surface
+    int steps = 0;     // the frame's step and those better it could go to
+    // Per step (0: the frame's own, k: the k-th better one), the pixels of the image there
+    // once refined, and the tiles refined to it (a tile counts at its last).
+    uint64_t pixelsAt[kMaxSteps] = {};
+    int refined[kMaxSteps] = {};
+    // The priority (errorWeight and ageWeight normalized over the image, hysteresis
+    // included) of the last tile refined: tiles below it stayed at the cheap step. 0: none
+    // refined, or every tile.
+    double threshold = 0.0;
+    // The mean squared difference over RGB (clamped to [0, 1], as compareImages) that
+    // refinement made in the tiles it refined; and the frame's estimated PSNR against
+    // constant quality, from the tiles left cheaper times the measured error per unit of
+    // their contrast (tile_refiner.h). 99: nothing left; -1: nothing measured yet.
+    double gainMse = 0.0;
+    double estimatedPsnr = 99.0;
+    uint64_t shadingPoints = 0;  // shaded again
+    double seconds = 0.0;        // wall: priorities, the passes and the resolve again
+    double resolveSeconds = 0.0;
+};
+
 // Prefetching in the frame's slack (playback.h): tiles predicted by a low-resolution look
 // at a frame ahead (claim 11) and next to missing tiles (claim 10), those filled; and of the
 // tiles prefetched before, those this frame's probes read first (used) and those dropped,
@@ -168,6 +196,7 @@ struct FrameStats {
     BudgetStats budget;
     PrefetchStats prefetch;
     BackgroundStats background;
+    RefineStats refine;
     // The controller's own work, within wallSeconds: re-run triggers and deferrals, cache
     // bookkeeping (eviction, prefetch accounting), the regulator.
     double controllerSeconds = 0.0;

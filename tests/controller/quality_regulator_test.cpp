@@ -96,6 +96,34 @@ TEST(QualityRegulator, StartsAtTheBestStepItsCalibrationFits) {
     EXPECT_EQ(none.level(), 4);
 }
 
+TEST(QualityRegulator, RefinedStepsGetTheirShareOfTheBudget) {
+    // Seven steps at 4 spp; refinement gives the steps it refines (1 to 3) half the shares,
+    // the best step (nothing to refine) and the last at 4 spp (below it only fewer samples)
+    // the whole of them: the start is within 5/8 there, 5/16 at steps 1 to 3.
+    QualityRegulatorOptions o = exactShares();
+    o.refinedShare = 0.5;
+    const double bestFits[] = {0.625, 0.3125, 0.3, 0.2, 0.1, 0.05, 0.025};
+    QualityRegulator best(ShadingRate::Sample, 4, o);
+    best.calibrate(bestFits, 1.0);
+    EXPECT_EQ(best.level(), 0);
+    const double thirdFits[] = {0.7, 0.4, 0.35, 0.3125, 0.1, 0.05, 0.025};
+    QualityRegulator third(ShadingRate::Sample, 4, o);
+    third.calibrate(thirdFits, 1.0);
+    EXPECT_EQ(third.level(), 3);  // step 1 would fit the whole share, not its half
+    const double lastFullFits[] = {0.7, 0.5, 0.45, 0.4, 0.625, 0.2, 0.1};
+    QualityRegulator lastFull(ShadingRate::Sample, 4, o);
+    lastFull.calibrate(lastFullFits, 1.0);
+    EXPECT_EQ(lastFull.level(), 4);  // not the 2 spp below it
+    // At step 3, frames over half of slowDownAt (3/8) twice in a row step down; a frame
+    // under it does not.
+    third.update(frame(0.375, 0.0), 1.0);
+    third.update(frame(0.375, 0.0), 1.0);
+    EXPECT_EQ(third.level(), 3);
+    third.update(frame(0.376, 0.0), 1.0);
+    third.update(frame(0.376, 0.0), 1.0);
+    EXPECT_EQ(third.level(), 4);
+}
+
 TEST(QualityRegulator, StepsUpAfterCalmFramesPredictingTheStepAboveFits) {
     QualityRegulator r(ShadingRate::Sample, 1, exactShares());  // five steps; calmFrames 8
     const double seconds[] = {1.0, 0.5, 0.375, 0.25, 0.125};
