@@ -148,8 +148,10 @@ nlohmann::json playFrameJson(const Scene& scene, const FrameStats& s,
                            {"gain_mse", s.refine.gainMse},
                            {"points", s.refine.shadingPoints},
                            {"seconds", s.refine.seconds},
+                           {"pass_seconds", s.refine.passSeconds},
                            {"resolve_seconds", s.refine.resolveSeconds}};
-        if (s.refine.estimatedPsnr >= 0.0) entry["refine"]["estimated_psnr"] = s.refine.estimatedPsnr;
+        if (s.refine.estimatedPsnr >= 0.0)
+            entry["refine"]["estimated_psnr"] = s.refine.estimatedPsnr;
     }
     addMultiphaseFrameJson(scene, s, entry);
     return entry;

@@ -83,9 +83,12 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
 void MultiphaseRenderer::refineWithinBudget(Clock::time_point start, Image& image,
                                             FrameStats& stats) {
     if (!dynamic_.complete() || dynamic_.abandoned() || refineSteps_.empty()) return;
-    // Room left for the resolve that follows, as long as the last one took.
-    const double until =
-        options_.refine.until * options_.frameBudgetSeconds - refiner_.lastResolveSeconds();
+    // Room left for the resolve and the accounting that follow: as long as they last took,
+    // and at least twice this frame's first resolve (refined pixels' samples are read one
+    // by one).
+    const double reserve =
+        std::max(refiner_.lastFinishSeconds(), 2.0 * dynamic_.stats().resolveSeconds);
+    const double until = options_.refine.until * options_.frameBudgetSeconds - reserve;
     const auto deadline =
         start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(until));
     const size_t before = missing_.size();

@@ -48,6 +48,14 @@ class Player {
         FrameStats stats;
         renderer_.renderFrame(options_.first, first, stats, image_);
         calibrate(summary);
+        if (options_.refine.enabled && regulator_.level() > 0) {
+            // The first frame refined once before the clock: refinement's buffers made, its
+            // error per unit of contrast and its resolve's time measured, and the tiles its
+            // finer footprints read filled (the first played frame had run late without).
+            renderer_.setRefineSteps(betterSteps(regulator_.level()));
+            renderer_.renderFrame(options_.first, atStep(options_.render, regulator_.step(), true),
+                                  stats, image_);
+        }
         if (options_.prefetch) warmCache();
         renderer_.setFrameBudget(budget_);
     }

@@ -146,6 +146,7 @@ void TileRefiner::refine(DynamicPhase& dynamic, const RefineStep& base,
     if (options_.maxTiles > 0 && rects.size() > static_cast<size_t>(options_.maxTiles))
         rects.resize(static_cast<size_t>(options_.maxTiles));
     for (Tile& t : tiles_) t.step = 0;
+    const auto passes = Clock::now();
     // One pass per better step, each over the tiles in order; a pass cut short by the
     // deadline ends refinement.
     for (size_t k = 0; k < better.size(); ++k) {
@@ -158,14 +159,15 @@ void TileRefiner::refine(DynamicPhase& dynamic, const RefineStep& base,
                 counts.tiles < ranked.size() ? tiles_[ranked[counts.tiles - 1]].priority : 0.0;
         if (counts.tiles < rects.size()) break;
     }
+    stats.passSeconds = std::chrono::duration<double>(Clock::now() - passes).count();
     if (tiles_.empty() ||
         std::all_of(tiles_.begin(), tiles_.end(), [](const Tile& t) { return t.step == 0; })) {
         std::swap(cheap_, image);  // nothing refined: the cheap image stands
     } else {
-        lastResolve_ = dynamic.resolveAgain(image);
-        stats.resolveSeconds = lastResolve_;
+        stats.resolveSeconds = dynamic.resolveAgain(image);
     }
     account(cheap_, image, static_cast<int>(better.size()), stats);
+    lastFinish_ = std::chrono::duration<double>(Clock::now() - passes).count() - stats.passSeconds;
     stats.seconds = std::chrono::duration<double>(Clock::now() - start).count();
 }
 

@@ -131,6 +131,7 @@ struct RefineStats {
     double estimatedPsnr = 99.0;
     uint64_t shadingPoints = 0;  // shaded again
     double seconds = 0.0;        // wall: priorities, the passes and the resolve again
+    double passSeconds = 0.0;    // of seconds: the passes (shading and compositing tiles)
     double resolveSeconds = 0.0;
 };
 
