@@ -208,9 +208,6 @@ class DynamicPhase {
                         std::vector<TileRequest>& missing);
     // resolve() again after refine(); returns its seconds (stats() keeps the first's).
     double resolveAgain(Image& out);
-    // Per pixel (row-major): 1 where its samples came out alike in the last composite (one
-    // surface shaded once for the pixel, or the same result for each), else 0.
-    const std::vector<uint8_t>& alikePixels() const { return uniform_; }
 
     const DynamicFrameStats& stats() const { return stats_; }
     const std::vector<ObjectFrameCost>& objectCosts() const { return costs_; }
