@@ -1,6 +1,5 @@
 #include "app/played_quality.h"
 
-#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <utility>
@@ -8,6 +7,7 @@
 #include "app/eval_metrics.h"
 #include "app/image_output.h"
 #include "geometry/error.h"
+#include "phases/image_compare.h"
 
 namespace mpshade {
 
@@ -32,7 +32,7 @@ PlayedFrameQuality PlayedQuality::measure(const Image& played, int frame) {
                              ", the frames played " + std::to_string(played.width) + "x" +
                              std::to_string(played.height));
     PlayedFrameQuality q;
-    q.psnr = std::min(99.0, psnrOfMse(meanSquaredError(played, truth)));  // 99: the same
+    q.psnr = compareImages(played, truth).psnr;
     if (lastFrame_ == frame - 1)
         q.temporalRmse = temporalRmse(lastPlayed_, played, lastTruth_, truth);
     lastPlayed_ = played;

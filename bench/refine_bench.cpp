@@ -1,8 +1,9 @@
 // Refinement by image tile (controller/tile_refiner.h) against shading in bands: a frame
 // shaded per 2x2 pixels at 640x360, then every tile of it shaded again per pixel -- the
-// same points a frame shaded per pixel shades in its bands. refine_ns_per_point beside
-// band_ns_per_point (the per-pixel frame's own shading, in the same run) is what refining
-// a tile costs over shading it in the first place.
+// same points a frame shaded per pixel shades in its bands. refine_ns_per_point (the
+// passes' wall time over their points) beside band_ns_per_point (the per-pixel frame's own
+// shading, in the same run) is what shading a point again in a tile costs against shading
+// it in the first place.
 #include <string>
 
 #include <benchmark/benchmark.h>
@@ -39,7 +40,7 @@ void refineAll(benchmark::State& state, const char* path) {
         multi.renderFrame(frame, pixel, bands, image);
         multi.setRefineSteps({{ShadingRate::Pixel, 1.0f}});
         multi.renderFrame(frame, cheap, stats, image);
-        refineSeconds += stats.refine.seconds - stats.refine.resolveSeconds;
+        refineSeconds += stats.refine.passSeconds;
         refinePoints += stats.refine.shadingPoints;
         bandSeconds += bands.dynamic.shadeSeconds;
         bandPoints += bands.shadedPoints;

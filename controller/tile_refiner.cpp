@@ -10,8 +10,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// A channel clamped to [0, 1] as compareImages clamps it; a NaN (which compareImages would
+// carry through) counts as 0, so one bad pixel cannot make every priority NaN.
 float clamp01(float v) {
-    return std::min(1.0f, std::max(0.0f, v));  // NaN to 0, as compareImages reads it
+    return std::min(1.0f, std::max(0.0f, v));
 }
 
 // Sum over the rectangle's pixels of the squared RGB difference between a and b, each
@@ -41,7 +43,8 @@ void TileRefiner::layOut(int width, int height) {
     if (width == width_ && height == height_) return;
     width_ = width, height_ = height;
     tiles_.clear();
-    const int ts = std::max(2, options_.tileSize & ~1);  // even: 2x2 blocks stay whole
+    tileSize_ = std::max(2, options_.tileSize & ~1);  // even: 2x2 blocks stay whole
+    const int ts = tileSize_;
     for (int y = 0; y < height; y += ts)
         for (int x = 0; x < width; x += ts) {
             Tile t;
@@ -49,6 +52,7 @@ void TileRefiner::layOut(int width, int height) {
             tiles_.push_back(t);
         }
     errorPerContrast_.assign(errorPerContrast_.size(), -1.0);
+    meansKept_ = false;
 }
 
 // Per tile: whether it sees any surface, its contrast in the cheap image (each pixel against
@@ -84,7 +88,7 @@ void TileRefiner::measure(const DynamicPhase& dynamic, const Image& image) {
         double change = 0.0;
         for (int k = 0; k < 3; ++k) {
             mean[k] /= r.area();
-            if (t.hasMean) change += (mean[k] - t.mean[k]) * (mean[k] - t.mean[k]);
+            if (meansKept_) change += (mean[k] - t.mean[k]) * (mean[k] - t.mean[k]);
         }
         // As squared differences summed over the tile's pixels, the contrast's units.
         t.error = (errorPerContrast_.back() > 0.0 ? errorPerContrast_.back() : 1.0) * contrast +
@@ -135,7 +139,7 @@ void TileRefiner::refine(DynamicPhase& dynamic, const RefineStep& base,
         better_.assign(better.begin(), better.end());
         errorPerContrast_.assign(better.size() + 1, -1.0);
     }
-    stats.tileSize = tiles_.empty() ? 0 : tiles_[0].rect.x1 - tiles_[0].rect.x0;
+    stats.tileSize = tileSize_;
     // The cheap image moves aside (resolveAgain writes every pixel of `image`).
     std::swap(cheap_, image);
     measure(dynamic, cheap_);
@@ -185,8 +189,8 @@ void TileRefiner::account(const Image& cheap, const Image& image, int best, Refi
                 for (int k = 0; k < 3; ++k) mean[k] += clamp01(c[k]);
         }
         for (int k = 0; k < 3; ++k) t.mean[k] = static_cast<float>(mean[k] / t.rect.area());
-        t.hasMean = true;
     });
+    meansKept_ = true;
     std::vector<double> stepGain(static_cast<size_t>(best) + 1, 0.0), stepContrast = stepGain;
     double gained = 0.0;
     uint64_t gainedPixels = 0;

@@ -84,12 +84,11 @@ class TileRefiner {
         PixelRect rect;
         double contrast = 0.0;  // this frame's, in the cheap image
         double error = 0.0, priority = 0.0;
-        float mean[3] = {0, 0, 0};  // the final image's mean RGB, last frame
-        bool hasMean = false;
-        int age = 0;               // frames since last refined to the best step
-        bool refinedLast = false;  // refined (to any step) in the last frame
-        bool seen = false;         // any surface in it this frame
-        int step = 0;              // where it ended this frame: 0 the base, k better[k - 1]
+        float mean[3] = {0, 0, 0};  // the final image's mean RGB, last frame (meansKept_)
+        int age = 0;                // frames since last refined to the best step
+        bool refinedLast = false;   // refined (to any step) in the last frame
+        bool seen = false;          // any surface in it this frame
+        int step = 0;               // where it ended this frame: 0 the base, k better[k - 1]
     };
     void layOut(int width, int height);
     void measure(const DynamicPhase& dynamic, const Image& image);
@@ -97,7 +96,8 @@ class TileRefiner {
     void account(const Image& cheap, const Image& image, int best, RefineStats& stats);
 
     RefineOptions options_;
-    int width_ = 0, height_ = 0;
+    int width_ = 0, height_ = 0, tileSize_ = 0;
+    bool meansKept_ = false;  // the tiles' means are a last frame's (not since layOut)
     std::vector<Tile> tiles_;
     Image cheap_;               // the frame before refinement
     std::vector<double> gain_;  // per tile: the squared change refinement made

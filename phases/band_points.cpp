@@ -251,12 +251,12 @@ void buildBandPoints(const SampleLayout& layout, const VisibilityBuffer& vis,
         samplePoints(layout, vis, range, objects, pts, scratch);
     } else {
         const int block = options.rate == ShadingRate::Quad ? 2 : 1;
-        const int width = range.col1;
         BlockPoints blocks(layout, vis, range, block, pts, scratch);
         for (int by = range.row0; by < range.row1; by += block)
-            for (int bx = range.col0; bx < width; bx += block) {
+            for (int bx = range.col0; bx < range.col1; bx += block) {
                 if (block == 1 && options.wholePixelShortcut && blocks.wholePixel(bx, by)) continue;
-                const int y1 = std::min(range.row1, by + block), x1 = std::min(width, bx + block);
+                const int y1 = std::min(range.row1, by + block),
+                          x1 = std::min(range.col1, bx + block);
                 if (block == 2 && options.wholePixelShortcut && x1 - bx == 2 && y1 - by == 2 &&
                     by % 2 == 0 && bx % 2 == 0 && blocks.wholeQuad(bx, by))
                     continue;

@@ -608,7 +608,6 @@ double DynamicPhase::resolveAgain(Image& out) {
 
 RefineCounts DynamicPhase::refine(std::span<const PixelRect> tiles, const RefinePass& pass,
                                   std::vector<TileRequest>& missing) {
-    const auto start = Clock::now();
     RefineCounts counts;
     if (stats_.raster.abandoned || !complete() || tiles.empty()) return counts;
     const ScopedSpan span(options_.trace, "refine", PhaseKind::Dynamic, SpanLevel::Phase, -1,
@@ -630,19 +629,15 @@ RefineCounts DynamicPhase::refine(std::span<const PixelRect> tiles, const Refine
             if (t >= tiles.size()) break;
             const PixelRect& rect = tiles[t];
             const BandRange range(*layout_, visibility_.layers, rect.y0, rect.y1, rect.x0, rect.x1);
-            const auto began = Clock::now();
             BandPoints& pts = s.work;
             buildBandPoints(*layout_, visibility_, range, objects,
                             {pass.rate, options_.wholePixelShortcut}, pts, s.points);
-            s.parts.points += secondsSince(began);
             s.stillPending.clear();
             s.shadeFresh(refineViews_, options_.probe, false, pts, found.local(), inputLayout_,
                          nullptr);
             pts.built = false;
-            const auto compositing = Clock::now();
             compositeBand(pts, range, visibility_, layout_->width(), layout_->spp(),
                           scene_.settings.background, samples_.rgba.data(), uniform_.data());
-            s.parts.composite += secondsSince(compositing);
             for (size_t o = 0; o < objects; ++o)
                 s.costs[o].shadingPoints += pts.objectStart[o + 1] - pts.objectStart[o];
         }
@@ -655,13 +650,11 @@ RefineCounts DynamicPhase::refine(std::span<const PixelRect> tiles, const Refine
             counts.probeFallbacks += c.probeFallbacks;
             c = ObjectFrameCost{};
         }
-        counts.parts += s.parts;
-        s.parts = {};
+        s.parts = {};  // what shadeFresh timed: not the frame's
         s.counters = SurfaceShadingCounters{};
     }
     for (const std::vector<TileRequest>& l : found)
         missing.insert(missing.end(), l.begin(), l.end());
-    counts.seconds = secondsSince(start);
     return counts;
 }
 

@@ -165,12 +165,10 @@ struct RefinePass {
 };
 
 // What a refine() pass did: the first `tiles` of those asked were shaded again, at so many
-// points; its wall seconds, and where its CPU time went (as DynamicFrameStats').
+// points and bilinear probes, of them so many answered from a coarser level.
 struct RefineCounts {
     size_t tiles = 0;
     uint64_t shadingPoints = 0, probes = 0, probeFallbacks = 0;
-    double seconds = 0.0;
-    DynamicFrameStats::ShadeParts parts;
 };
 
 class DynamicPhase {

@@ -149,6 +149,53 @@ TEST(TileRefiner, AgeAloneVisitsEveryTileOnceBeforeAnyTwice) {
     EXPECT_EQ(visited.size(), 12u);
 }
 
+TEST(TileRefiner, ATileWhoseColourChangedSinceTheLastFrameGoesFirst) {
+    // Watson's temporal error: the last frame's means kept, a flat tile away from the
+    // stripes brightened by 0.3 in this frame's cheap image outranks the striped tiles
+    // when the temporal term weighs enough (planting "means never kept" fails it).
+    Frame f(writeStripedPlane(), Representation::Facets, kW, kH);
+    RefineOptions o;
+    o.maxTiles = 1;
+    o.errorWeight = 1.0;
+    o.ageWeight = 0.0;
+    o.hysteresis = 0.0;
+    o.temporalWeight = 1000.0;
+    TileRefiner refiner(o);
+    const std::vector<RefineStep> best = {{ShadingRate::Sample, 1.0f}};
+    RefineStats stats;
+    std::vector<TileRequest> missing;
+    Cheap first(f);
+    refiner.refine(first.phase, kQuad, best, kNever, first.image, stats, missing);
+    Cheap second(f);
+    // The flat tile: a column of tiles without stripes, in the middle row.
+    int column = -1;
+    for (int tx = 0; tx < kW / 16 && column < 0; ++tx)
+        if (!striped(second.image, tx * 16) && !striped(second.image, tx * 16 + 15)) column = tx;
+    ASSERT_GE(column, 0);
+    const PixelRect flat{16 * column, 16, 16 * column + 16, 32};
+    for (int y = flat.y0; y < flat.y1; ++y)
+        for (int x = flat.x0; x < flat.x1; ++x)
+            for (int k = 0; k < 3; ++k)
+                second.image.rgba[4 * (static_cast<size_t>(y) * kW + x) + k] += 0.3f;
+    const Image before = second.image;
+    refiner.refine(second.phase, kQuad, best, kNever, second.image, stats, missing);
+    ASSERT_EQ(stats.refined[1], 1);
+    // The refined tile's pixels lose the 0.3 (its samples are resolved anew); beyond the
+    // filter's pixel around it nothing changes by as much.
+    double inside = 0.0, outside = 0.0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            const size_t i = 4 * (static_cast<size_t>(y) * kW + x);
+            const double d = std::fabs(second.image.rgba[i] - before.rgba[i]);
+            const bool in = x > flat.x0 && x + 1 < flat.x1 && y > flat.y0 && y + 1 < flat.y1;
+            const bool near = x + 1 >= flat.x0 && x <= flat.x1 && y + 1 >= flat.y0 && y <= flat.y1;
+            if (in) inside = std::max(inside, d);
+            if (!near) outside = std::max(outside, d);
+        }
+    EXPECT_GT(inside, 0.25);
+    EXPECT_LT(outside, 0.25);
+}
+
 TEST(TileRefiner, APassedDeadlineRefinesNothingAndAmpleTimeReachesTheBestStep) {
     Frame f(writeStripedPlane(), Representation::Facets, kW, kH);
     Cheap cheap(f);

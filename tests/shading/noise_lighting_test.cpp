@@ -4,6 +4,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -247,13 +248,8 @@ TEST(Occlusion, EveryLaneOfALongRunCountsItsOwnRays) {
     for (int l = 0; l < m; ++l) EXPECT_EQ(open[l], expected[l]) << "lane " << l;
 }
 
-TEST(Lighting, EveryLaneOfARunMatchesTheOneLaneFormula) {
-    // shadeLight takes four lanes at a time in vector registers and the rest one at a time;
-    // each lane must be the one-lane formula's value, at edge inputs too: a point at the
-    // light, a normal facing away, roughness NaN, 0 and above 1, a zero normal.
-    std::mt19937 rng(17);
-    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
-    constexpr int m = 23;  // five runs of four and three single lanes
+// A point light above and to the side, and a distant one: the lights the lane tests shade.
+std::pair<LightSample, LightSample> pointAndDistantLights() {
     LightSample point, distant;
     point.kind = LightKind::Point;
     point.position = glm::vec3(0.3f, 2.0f, -0.5f);
@@ -261,6 +257,17 @@ TEST(Lighting, EveryLaneOfARunMatchesTheOneLaneFormula) {
     distant.kind = LightKind::Distant;
     distant.toLight = glm::normalize(glm::vec3(0.2f, 1.0f, 0.4f));
     distant.color = glm::vec3(0.5f, 1.0f, 1.5f);
+    return {point, distant};
+}
+
+TEST(Lighting, EveryLaneOfARunMatchesTheOneLaneFormula) {
+    // shadeLight takes four lanes at a time in vector registers and the rest one at a time;
+    // each lane must be the one-lane formula's value, at edge inputs too: a point at the
+    // light, a normal facing away, roughness NaN, 0 and above 1, a zero normal.
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    constexpr int m = 23;  // five runs of four and three single lanes
+    const auto [point, distant] = pointAndDistantLights();
     std::vector<float> in(10 * m), out(3 * m);
     for (int l = 0; l < m; ++l) {
         const glm::vec3 N = glm::normalize(glm::vec3(uni(rng), 1.0f, uni(rng)));
@@ -307,13 +314,7 @@ TEST(Lighting, EightLanesInAvx2AreTheBaselineBitForBit) {
     std::mt19937 rng(29);
     std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
     constexpr int m = 37;
-    LightSample point, distant;
-    point.kind = LightKind::Point;
-    point.position = glm::vec3(0.3f, 2.0f, -0.5f);
-    point.color = glm::vec3(3.0f, 2.0f, 1.0f);
-    distant.kind = LightKind::Distant;
-    distant.toLight = glm::normalize(glm::vec3(0.2f, 1.0f, 0.4f));
-    distant.color = glm::vec3(0.5f, 1.0f, 1.5f);
+    const auto [point, distant] = pointAndDistantLights();
     std::vector<float> in(10 * m);
     for (float& x : in) x = uni(rng);
     for (int l = 0; l < m; ++l) in[9 * m + l] = 0.5f + 0.5f * uni(rng);
