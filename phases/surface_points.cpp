@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <type_traits>
 
 #include <glm/geometric.hpp>
 
@@ -13,52 +14,126 @@
 namespace mpshade {
 namespace {
 
+// Points come in runs on one facet (the samples of a pixel, the pixels of a facet's row):
+// scratch.runs holds each run's first point, then n. The steps below take a facet's
+// constants once a run and its points four at a time, in vectors whose lanes do exactly
+// the scalar arithmetic, in the same order: the last points of a run, done one by one,
+// get the same bits as they would in a lane.
+void findRuns(const SurfacePoints& points, std::vector<uint32_t>& runs) {
+    runs.clear();
+    for (size_t i = 0; i < points.n; ++i)
+        if (i == 0 || points.facet[i] != points.facet[i - 1])
+            runs.push_back(static_cast<uint32_t>(i));
+    runs.push_back(static_cast<uint32_t>(points.n));
+}
+
+// One facet's constants for step 1, broadcast: a lane type T is float or Float4.
+template <typename T>
+struct FacetRay {
+    T P0[3], e1[3], e2[3], A1[3], A2[3], Dn[3];
+    T dxA1, dyA1, dxA2, dyA2, dxDn, dyDn;
+    T d0[3], dx[3], dy[3];
+};
+
+template <typename T>
+T splatAs(float x) {
+    if constexpr (std::is_same_v<T, float>)
+        return x;
+    else
+        return splatFloat4(x);
+}
+
+template <typename T>
+FacetRay<T> facetRay(const ObjectView& view, const FacetMesh& mesh, uint32_t facet) {
+    const uint32_t* p = &mesh.positionIndex[3 * static_cast<size_t>(facet)];
+    const glm::vec3 P0 = mesh.format.dequantize(mesh.qx[p[0]], mesh.qy[p[0]], mesh.qz[p[0]]);
+    const glm::vec3 e1 = mesh.format.dequantize(mesh.qx[p[1]], mesh.qy[p[1]], mesh.qz[p[1]]) - P0;
+    const glm::vec3 e2 = mesh.format.dequantize(mesh.qx[p[2]], mesh.qy[p[2]], mesh.qz[p[2]]) - P0;
+    const glm::vec3 tv = view.eye - P0;
+    // b1 = (d . A1) / (d . Dn), b2 = (d . A2) / (d . Dn): Moller-Trumbore's weights with
+    // the triple products rearranged around the direction d.
+    const glm::vec3 A1 = glm::cross(e2, tv), A2 = glm::cross(tv, e1), Dn = glm::cross(e2, e1);
+    FacetRay<T> f;
+    for (int k = 0; k < 3; ++k) {
+        f.P0[k] = splatAs<T>(P0[k]), f.e1[k] = splatAs<T>(e1[k]), f.e2[k] = splatAs<T>(e2[k]);
+        f.A1[k] = splatAs<T>(A1[k]), f.A2[k] = splatAs<T>(A2[k]), f.Dn[k] = splatAs<T>(Dn[k]);
+        f.d0[k] = splatAs<T>(view.d0[k]), f.dx[k] = splatAs<T>(view.dx[k]);
+        f.dy[k] = splatAs<T>(view.dy[k]);
+    }
+    f.dxA1 = splatAs<T>(glm::dot(view.dx, A1)), f.dyA1 = splatAs<T>(glm::dot(view.dy, A1));
+    f.dxA2 = splatAs<T>(glm::dot(view.dx, A2)), f.dyA2 = splatAs<T>(glm::dot(view.dy, A2));
+    f.dxDn = splatAs<T>(glm::dot(view.dx, Dn)), f.dyDn = splatAs<T>(glm::dot(view.dy, Dn));
+    return f;
+}
+
+// Step 1 at one point (T float) or four (Float4): the barycentric weights, their screen
+// derivatives and P. A ray (nearly) parallel to the facet, or weights that are not finite,
+// give the facet's centroid and no derivatives.
+template <typename T>
+struct RayHit {
+    T b1, b2, db1dx, db1dy, db2dx, db2dy, P[3];
+};
+
+template <typename T>
+RayHit<T> hitFacet(const FacetRay<T>& f, T x, T y) {
+    T d[3];
+    for (int k = 0; k < 3; ++k) d[k] = f.d0[k] + x * f.dx[k] + y * f.dy[k];
+    const T den = d[0] * f.Dn[0] + d[1] * f.Dn[1] + d[2] * f.Dn[2];
+    const T tiny = splatAs<T>(1e-30f), one = splatAs<T>(1.0f), zero = splatAs<T>(0.0f);
+    const auto big = den > tiny || den < -tiny;
+    const T inv = one / (big ? den : one);
+    const T c1 = (d[0] * f.A1[0] + d[1] * f.A1[1] + d[2] * f.A1[2]) * inv;
+    const T c2 = (d[0] * f.A2[0] + d[1] * f.A2[1] + d[2] * f.A2[2]) * inv;
+    // x - x is 0 for a finite x, NaN otherwise.
+    const auto ok = big && (c1 - c1 == zero) && (c2 - c2 == zero);
+    const T third = splatAs<T>(1.0f / 3.0f);
+    RayHit<T> h;
+    h.b1 = ok ? c1 : third, h.b2 = ok ? c2 : third;
+    h.db1dx = ok ? (f.dxA1 - h.b1 * f.dxDn) * inv : zero;
+    h.db1dy = ok ? (f.dyA1 - h.b1 * f.dyDn) * inv : zero;
+    h.db2dx = ok ? (f.dxA2 - h.b2 * f.dxDn) * inv : zero;
+    h.db2dy = ok ? (f.dyA2 - h.b2 * f.dyDn) * inv : zero;
+    for (int k = 0; k < 3; ++k) h.P[k] = f.P0[k] + h.b1 * f.e1[k] + h.b2 * f.e2[k];
+    return h;
+}
+
 // Step 1: where each point's ray meets its facet: the barycentric weights (and, for a probe,
-// their screen derivatives, 4 per point) and P. Per facet (consecutive points mostly share
-// one: the samples of a pixel, the pixels of a facet): its corners and the rearranged triple
-// products. The loops after this one have no branch on the facet and vectorize.
+// their screen derivatives, 4 rows of n) and P.
 void intersectFacets(const ObjectView& view, const FacetMesh& mesh, const SurfacePoints& points,
-                     float* __restrict bary1, float* __restrict bary2, float* __restrict px,
-                     float* __restrict py, float* __restrict pz, float* __restrict derivatives) {
-    size_t facet = ~size_t{0};
-    glm::vec3 P0(0.0f), e1(0.0f), e2(0.0f), A1(0.0f), A2(0.0f), Dn(0.0f);
-    float dxA1 = 0.0f, dyA1 = 0.0f, dxA2 = 0.0f, dyA2 = 0.0f, dxDn = 0.0f, dyDn = 0.0f;
-    for (size_t i = 0; i < points.n; ++i) {
-        if (points.facet[i] != facet) {
-            facet = points.facet[i];
-            const uint32_t* p = &mesh.positionIndex[3 * facet];
-            P0 = mesh.format.dequantize(mesh.qx[p[0]], mesh.qy[p[0]], mesh.qz[p[0]]);
-            e1 = mesh.format.dequantize(mesh.qx[p[1]], mesh.qy[p[1]], mesh.qz[p[1]]) - P0;
-            e2 = mesh.format.dequantize(mesh.qx[p[2]], mesh.qy[p[2]], mesh.qz[p[2]]) - P0;
-            const glm::vec3 tv = view.eye - P0;
-            // b1 = (d . A1) / (d . Dn), b2 = (d . A2) / (d . Dn): Moller-Trumbore's weights
-            // with the triple products rearranged around the direction d.
-            A1 = glm::cross(e2, tv), A2 = glm::cross(tv, e1), Dn = glm::cross(e2, e1);
-            dxA1 = glm::dot(view.dx, A1), dyA1 = glm::dot(view.dy, A1);
-            dxA2 = glm::dot(view.dx, A2), dyA2 = glm::dot(view.dy, A2);
-            dxDn = glm::dot(view.dx, Dn), dyDn = glm::dot(view.dy, Dn);
-        }
-        const glm::vec3 d = view.d0 + points.x[i] * view.dx + points.y[i] * view.dy;
-        const float den = glm::dot(d, Dn);
-        float b1 = 1.0f / 3.0f, b2 = 1.0f / 3.0f;
-        float db1dx = 0.0f, db1dy = 0.0f, db2dx = 0.0f, db2dy = 0.0f;
-        if (std::fabs(den) > 1e-30f) {
-            const float inv = 1.0f / den;
-            const float c1 = glm::dot(d, A1) * inv, c2 = glm::dot(d, A2) * inv;
-            if (std::isfinite(c1) && std::isfinite(c2)) {
-                b1 = c1, b2 = c2;
-                db1dx = (dxA1 - b1 * dxDn) * inv;
-                db1dy = (dyA1 - b1 * dyDn) * inv;
-                db2dx = (dxA2 - b2 * dxDn) * inv;
-                db2dy = (dyA2 - b2 * dyDn) * inv;
+                     const std::vector<uint32_t>& runs, float* __restrict bary1,
+                     float* __restrict bary2, float* __restrict px, float* __restrict py,
+                     float* __restrict pz, float* __restrict derivatives) {
+    const size_t n = points.n;
+    float* const P[3] = {px, py, pz};
+    for (size_t r = 0; r + 1 < runs.size(); ++r) {
+        const size_t first = runs[r], end = runs[r + 1];
+        const uint32_t facet = points.facet[first];
+        size_t i = first;
+        if (end - first >= 4) {
+            const FacetRay<Float4> f = facetRay<Float4>(view, mesh, facet);
+            for (; i + 4 <= end; i += 4) {
+                const RayHit<Float4> h =
+                    hitFacet(f, loadFloat4(points.x + i), loadFloat4(points.y + i));
+                storeFloat4(bary1 + i, h.b1), storeFloat4(bary2 + i, h.b2);
+                for (int k = 0; k < 3; ++k) storeFloat4(P[k] + i, h.P[k]);
+                if (derivatives) {
+                    storeFloat4(derivatives + i, h.db1dx);
+                    storeFloat4(derivatives + n + i, h.db1dy);
+                    storeFloat4(derivatives + 2 * n + i, h.db2dx);
+                    storeFloat4(derivatives + 3 * n + i, h.db2dy);
+                }
             }
         }
-        bary1[i] = b1, bary2[i] = b2;
-        const glm::vec3 P = P0 + b1 * e1 + b2 * e2;
-        px[i] = P.x, py[i] = P.y, pz[i] = P.z;
-        if (derivatives) {
-            float* dd = &derivatives[4 * i];
-            dd[0] = db1dx, dd[1] = db1dy, dd[2] = db2dx, dd[3] = db2dy;
+        if (i == end) continue;
+        const FacetRay<float> f = facetRay<float>(view, mesh, facet);
+        for (; i < end; ++i) {
+            const RayHit<float> h = hitFacet(f, points.x[i], points.y[i]);
+            bary1[i] = h.b1, bary2[i] = h.b2;
+            for (int k = 0; k < 3; ++k) P[k][i] = h.P[k];
+            if (derivatives) {
+                derivatives[i] = h.db1dx, derivatives[n + i] = h.db1dy;
+                derivatives[2 * n + i] = h.db2dx, derivatives[3 * n + i] = h.db2dy;
+            }
         }
     }
 }
@@ -98,12 +173,24 @@ void viewDirections(const ObjectView& view, const SurfacePoints& points, const f
 
 // Step 3: a vertex attribute row at each point's weights.
 void interpolateRow(const uint32_t* __restrict attributeIndex, const SurfacePoints& points,
-                    const float* __restrict bary1, const float* __restrict bary2,
-                    const float* __restrict r, float* __restrict out) {
-    for (size_t i = 0; i < points.n; ++i) {
-        const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[i])];
-        const float b1 = bary1[i], b2 = bary2[i];
-        out[i] = (1.0f - b1 - b2) * r[a[0]] + b1 * r[a[1]] + b2 * r[a[2]];
+                    const std::vector<uint32_t>& runs, const float* __restrict bary1,
+                    const float* __restrict bary2, const float* __restrict r,
+                    float* __restrict out) {
+    const Float4 one4 = splatFloat4(1.0f);
+    for (size_t k = 0; k + 1 < runs.size(); ++k) {
+        const size_t first = runs[k], end = runs[k + 1];
+        const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[first])];
+        const float r0 = r[a[0]], r1 = r[a[1]], r2 = r[a[2]];
+        size_t i = first;
+        const Float4 r04 = splatFloat4(r0), r14 = splatFloat4(r1), r24 = splatFloat4(r2);
+        for (; i + 4 <= end; i += 4) {
+            const Float4 b1 = loadFloat4(bary1 + i), b2 = loadFloat4(bary2 + i);
+            storeFloat4(out + i, (one4 - b1 - b2) * r04 + b1 * r14 + b2 * r24);
+        }
+        for (; i < end; ++i) {
+            const float b1 = bary1[i], b2 = bary2[i];
+            out[i] = (1.0f - b1 - b2) * r0 + b1 * r1 + b2 * r2;
+        }
     }
 }
 
@@ -129,26 +216,30 @@ void normalizeRows(size_t n, float* __restrict nx, float* __restrict ny, float* 
 // Step 4, with a shader map: each point's chart point and its footprint (the weights'
 // screen derivatives carried to the chart, times footprintScale).
 void chartQueries(const ObjectView& view, const FacetMesh& mesh, const SurfacePoints& points,
-                  const float* __restrict bary1, const float* __restrict bary2,
-                  const float* __restrict dd, ProbeQuery* queries) {
+                  const std::vector<uint32_t>& runs, const float* __restrict bary1,
+                  const float* __restrict bary2, const float* __restrict dd, ProbeQuery* queries) {
     const float s = view.footprintScale;
+    const size_t n = points.n;
     const uint32_t* const attributeIndex = mesh.attributeIndex.data();
-    for (size_t i = 0; i < points.n; ++i) {
-        const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[i])];
+    for (size_t k = 0; k + 1 < runs.size(); ++k) {
+        const size_t first = runs[k], end = runs[k + 1];
+        const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[first])];
         const ChartPoint& c0 = mesh.attributeChartPoint[a[0]];
         const ChartPoint& c1 = mesh.attributeChartPoint[a[1]];
         const ChartPoint& c2 = mesh.attributeChartPoint[a[2]];
         const float du1 = c1.u - c0.u, du2 = c2.u - c0.u, dv1 = c1.v - c0.v, dv2 = c2.v - c0.v;
-        const float b1 = bary1[i], b2 = bary2[i];
-        const float* d = dd + 4 * i;
-        ProbeQuery& q = queries[i];
-        q.chart = c0.chart;
-        q.u = c0.u + b1 * du1 + b2 * du2;
-        q.v = c0.v + b1 * dv1 + b2 * dv2;
-        q.dudx = s * (du1 * d[0] + du2 * d[2]);
-        q.dudy = s * (du1 * d[1] + du2 * d[3]);
-        q.dvdx = s * (dv1 * d[0] + dv2 * d[2]);
-        q.dvdy = s * (dv1 * d[1] + dv2 * d[3]);
+        for (size_t i = first; i < end; ++i) {
+            const float b1 = bary1[i], b2 = bary2[i];
+            const float d0 = dd[i], d1 = dd[n + i], d2 = dd[2 * n + i], d3 = dd[3 * n + i];
+            ProbeQuery& q = queries[i];
+            q.chart = c0.chart;
+            q.u = c0.u + b1 * du1 + b2 * du2;
+            q.v = c0.v + b1 * dv1 + b2 * dv2;
+            q.dudx = s * (du1 * d0 + du2 * d2);
+            q.dudy = s * (du1 * d1 + du2 * d3);
+            q.dvdx = s * (dv1 * d0 + dv2 * d2);
+            q.dvdy = s * (dv1 * d1 + dv2 * d3);
+        }
     }
 }
 
@@ -259,25 +350,26 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
     const float* py = rows[ShadingBatch::P + 1];
     const float* pz = rows[ShadingBatch::P + 2];
 
-    intersectFacets(view, mesh, points, scratch.b1.data(), scratch.b2.data(), rows[ShadingBatch::P],
-                    rows[ShadingBatch::P + 1], rows[ShadingBatch::P + 2],
+    findRuns(points, scratch.runs);
+    intersectFacets(view, mesh, points, scratch.runs, scratch.b1.data(), scratch.b2.data(),
+                    rows[ShadingBatch::P], rows[ShadingBatch::P + 1], rows[ShadingBatch::P + 2],
                     useMap ? scratch.derivatives.data() : nullptr);
     viewDirections(view, points, px, py, pz, rows[ShadingBatch::I], rows[ShadingBatch::I + 1],
                    rows[ShadingBatch::I + 2]);
     const uint32_t* const attributeIndex = mesh.attributeIndex.data();
     for (int row : rep.geometryRows)
-        interpolateRow(attributeIndex, points, bary1, bary2,
+        interpolateRow(attributeIndex, points, scratch.runs, bary1, bary2,
                        attr.rows[static_cast<size_t>(row)].data(),
                        rows[row < VertexAttributes::U ? row : row + 3]);
     if (!attr.rows[VertexAttributes::Nx].empty())
         normalizeRows(n, rows[ShadingBatch::N], rows[ShadingBatch::N + 1],
                       rows[ShadingBatch::N + 2]);
     if (useMap) {
-        chartQueries(view, mesh, points, bary1, bary2, scratch.derivatives.data(),
+        chartQueries(view, mesh, points, scratch.runs, bary1, bary2, scratch.derivatives.data(),
                      scratch.queries.data());
     } else {
         for (size_t c = 0; c < channels; ++c)
-            interpolateRow(attributeIndex, points, bary1, bary2,
+            interpolateRow(attributeIndex, points, scratch.runs, bary1, bary2,
                            attr.rows[VertexAttributes::kGeometryRows + c].data(), batch.channel(c));
     }
     if (stopAtMissing && missed) std::fill(missed, missed + n, uint8_t{0});
