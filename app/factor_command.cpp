@@ -7,7 +7,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/factor_measures.h"
 #include "geometry/error.h"
+#include "phases/map_demand.h"
+#include "phases/scene_resources.h"
 #include "phases/split_verification.h"
 #include "scene/scene.h"
 #include "scene/variability.h"
@@ -174,11 +177,51 @@ nlohmann::json factoringJson(const std::string& shaderFile, const ShaderAst& ast
     return doc;
 }
 
+// What the scene's frames ask of a binding's shader map (phases/map_demand.h).
+struct BoundMap {
+    MapDemand demand;
+    bool half = false;  // the object's "shadermap_precision"
+};
+
+void printMapDemand(const BoundMap& map, int floats) {
+    const MapDemand& d = map.demand;
+    const char* precision = map.half ? "binary16" : "float32";
+    const double pinned = d.bytes(d.pinnedTiles, floats, map.half) / 1048576.0;
+    std::printf(
+        "  at this scene's maps (level 0 %d texels a chart side; frames spread over the "
+        "scene, hidden parts left out):\n",
+        d.resolution);
+    if (d.frame < 0)
+        std::printf("    no frame looked at sees it");
+    else
+        std::printf(
+            "    frame %d asks most: about %.0f tiles, down to level %d (%d texels a "
+            "side), for %.0f covered pixels: %.2f MB as %s (%.2f MB as %s)",
+            d.frame, d.tiles, d.finestLevel, d.resolution >> d.finestLevel, d.coveredPixels,
+            d.bytes(floats, map.half) / 1048576.0, precision,
+            d.bytes(floats, !map.half) / 1048576.0, map.half ? "float32" : "binary16");
+    std::printf(";\n    play keeps %.0f tiles of coarse levels resident besides: %.2f MB\n",
+                d.pinnedTiles, pinned);
+}
+
+nlohmann::json mapDemandJson(const BoundMap& map, int floats) {
+    const MapDemand& d = map.demand;
+    return {{"resolution", d.resolution},
+            {"frame", d.frame},
+            {"covered_pixels", d.coveredPixels},
+            {"tiles", d.tiles},
+            {"pinned_tiles", d.pinnedTiles},
+            {"finest_level", d.finestLevel},
+            {"precision", map.half ? "half" : "float"},
+            {"bytes", d.bytes(floats, map.half)},
+            {"pinned_bytes", d.bytes(d.pinnedTiles, floats, map.half)}};
+}
+
 // The factoring for a reader: the n-tuple's channels, the costs, the dynamic lines with
 // what reaches them, and with --dump both parts.
 void printFactoring(const FactorCommandOptions& options, const std::string& shaderFile,
                     const ShaderAst& ast, const std::string& bindingText, const FactoredShader& f,
-                    double ratio, int storeAboveCost) {
+                    double ratio, int storeAboveCost, const BoundMap* map) {
     std::printf("%s (%s), factored for %s\n\n", ast.name.c_str(), shaderFile.c_str(),
                 bindingText.c_str());
     std::printf("n-tuple: %d float%s (storing every static value a dynamic operation reads: %d)\n",
@@ -189,22 +232,32 @@ void printFactoring(const FactorCommandOptions& options, const std::string& shad
             "(\"shadermap_precision\": \"half\"), plus a 1-texel border around each "
             "16x16 tile\n",
             4 * f.chosenWidth, 2 * f.chosenWidth);
+    if (f.chosenWidth > 0 && map) printMapDemand(*map, f.chosenWidth);
     if (f.recomputedStaticCost > 0)
         std::printf(
             "  %s: %d cost units of static work a point, cheaper to repeat than "
             "to read back (--store-above-cost %d), run by the dynamic part\n",
             f.chosenWidth == 0 ? "nothing stored" : "some not stored", f.recomputedStaticCost,
             storeAboveCost);
+    const bool perChannelBytes = map && map->demand.frame >= 0;
     if (!f.channels.empty())
-        std::printf("  %-9s %-7s %-18s %s\n", "channel", "type", "holds", "computed at");
+        std::printf("  %-9s %-7s %-18s %s%s\n", "channel", "type", "holds",
+                    perChannelBytes ? "  MB at that frame  " : "", "computed at");
     for (size_t k = 0; k < f.channels.size();) {
         const int group = groupSize(f.channels, k);
         const ChannelInfo& c = f.channels[k];
         const std::string index =
             group == 3 ? std::to_string(k) + "-" + std::to_string(k + 2) : std::to_string(k);
         const char* type = group == 3 ? typeName(c.type) : "float";
-        std::printf("  %-9s %-7s %-18s line %d:%d  %s\n", index.c_str(), type,
-                    channelLabel(c, group).c_str(), c.line, c.column,
+        std::string mb;
+        if (perChannelBytes) {
+            char text[32];
+            std::snprintf(text, sizeof text, "  %17.2f  ",
+                          map->demand.bytes(group, map->half) / 1048576.0);
+            mb = text;
+        }
+        std::printf("  %-9s %-7s %-18s %sline %d:%d  %s\n", index.c_str(), type,
+                    channelLabel(c, group).c_str(), mb.c_str(), c.line, c.column,
                     sourceLine(ast.source, c.line).c_str());
         k += static_cast<size_t>(group);
     }
@@ -254,107 +307,52 @@ void printFactoring(const FactorCommandOptions& options, const std::string& shad
     }
 }
 
-}  // namespace
-
-namespace {
-
-// --verify: the factored shader against the whole one, output by output.
-void printVerification(const SplitVerification& v, double tolerance) {
-    std::printf(
-        "\nverified: %d points over the charts x %d frames, static part run at the "
-        "first, against the whole shader\n",
-        v.points, v.frames);
-    std::printf("  %-12s %12s %12s %12s   %s\n", "", "max abs", "max relative", "rms",
-                "worst at (frame, chart, u, v)");
-    auto row = [](const SplitDifference& d) {
-        std::printf("  %-12s %12.3g %12.3g %12.3g   %d, %d, %.4f, %.4f\n", d.name.c_str(), d.maxAbs,
-                    d.maxRelative, d.rms, d.worst.frame, d.worst.chart, d.worst.u, d.worst.v);
-    };
-    for (const SplitDifference& d : v.outputs) row(d);
-    if (!v.channels.empty()) {
-        std::printf(
-            "  stored channels, against the static part run at each frame (0 unless a "
-            "bake() froze an input):\n");
-        for (const SplitDifference& d : v.channels) row(d);
-    }
-    std::printf("  %s --tolerance %g (largest relative difference %.3g)\n",
-                v.maxRelative() <= tolerance ? "within" : "OVER", tolerance, v.maxRelative());
-}
-
-nlohmann::json verificationJson(const SplitVerification& v, double tolerance) {
-    auto rows = [](const std::vector<SplitDifference>& from) {
-        nlohmann::json out = nlohmann::json::array();
-        for (const SplitDifference& d : from)
-            out.push_back({{"name", d.name},
-                           {"max_abs", d.maxAbs},
-                           {"max_relative", d.maxRelative},
-                           {"rms", d.rms},
-                           {"worst",
-                            {{"frame", d.worst.frame},
-                             {"chart", d.worst.chart},
-                             {"u", d.worst.u},
-                             {"v", d.worst.v}}}});
-        return out;
-    };
-    return {{"points", v.points},
-            {"frames", v.frames},
-            {"outputs", rows(v.outputs)},
-            {"channels", rows(v.channels)},
-            {"max_relative", v.maxRelative()},
-            {"tolerance", tolerance},
-            {"within", v.maxRelative() <= tolerance}};
-}
-
-// The binding with the command's --store and --repeat what-ifs added.
-ShaderBinding withWhatIfs(const ShaderBinding& binding, const FactorCommandOptions& options) {
-    ShaderBinding b = binding;
-    auto add = [&](const std::vector<std::string>& from, FactoringOverride::Kind kind,
-                   const char* flag) {
-        for (const std::string& text : from) {
-            FactoringOverride o;
-            if (!parseFactoringOverride(text, kind, o))
-                throw InputError({flag, 0, 0, {}},
-                                 "expected line:column or a variable's name, found '" + text + "'");
-            b.overrides.push_back(o);
-        }
-    };
-    add(options.store, FactoringOverride::Kind::Store, "--store");
-    add(options.repeat, FactoringOverride::Kind::Repeat, "--repeat");
-    return b;
-}
-
-// One factoring, printed or added to `json`.
+// One factoring, printed or added to `json`; with a what-if, `without` (when set) gets the
+// split without it (else the split itself).
 FactoredShader factorOne(const FactorCommandOptions& options, const std::string& shaderFile,
                          const ShaderAst& ast, const ShaderBinding& binding,
-                         const std::string& bindingText, nlohmann::json* json) {
+                         const std::string& bindingText, const BoundMap* map, nlohmann::json* json,
+                         FactoredShader* without = nullptr) {
     FactorOptions factorOptions;
     factorOptions.storeAboveCost = options.storeAboveCost;
     const ShaderBinding asked = withWhatIfs(binding, options);
     const FactoredShader f = factorShader(ast, asked, factorOptions);
     const double ratio =
         f.staticInstructions > 0 ? double(f.dynamicInstructions) / f.staticInstructions : 0.0;
-    if (json)
+    if (json) {
         *json = factoringJson(shaderFile, ast, bindingText, f, ratio);
-    else
+        if (map && f.chosenWidth > 0) (*json)["map_estimate"] = mapDemandJson(*map, f.chosenWidth);
+    } else {
         printFactoring(options, shaderFile, ast, bindingText, f, ratio,
-                       factorOptions.storeAboveCost);
+                       factorOptions.storeAboveCost, map);
+    }
     if (asked.overrides.size() > binding.overrides.size()) {
         // The what-if against the split without it.
-        const FactoredShader base = factorShader(ast, binding, factorOptions);
+        FactoredShader base = factorShader(ast, binding, factorOptions);
         if (json) {
             (*json)["what_if"] = {{"without",
                                    {{"chosen_width", base.chosenWidth},
                                     {"static_cost", base.staticCost},
                                     {"dynamic_cost", base.dynamicCost}}}};
+            if (map)
+                (*json)["what_if"]["without"]["map_bytes"] =
+                    map->demand.bytes(base.chosenWidth, map->half);
         } else {
             std::printf("\nwhat-if, against the split without it:\n");
             std::printf("  %-16s %8d -> %d\n", "n-tuple floats", base.chosenWidth, f.chosenWidth);
-            std::printf("  %-16s %8d -> %d\n", "bytes a texel", 4 * base.chosenWidth,
-                        4 * f.chosenWidth);
+            const int texel = map && map->half ? 2 : 4;
+            std::printf("  %-16s %8d -> %d\n", "bytes a texel", texel * base.chosenWidth,
+                        texel * f.chosenWidth);
+            if (map)
+                std::printf("  %-16s %8.2f -> %.2f\n", "map MB",
+                            map->demand.bytes(base.chosenWidth, map->half) / 1048576.0,
+                            map->demand.bytes(f.chosenWidth, map->half) / 1048576.0);
             std::printf("  %-16s %8d -> %d\n", "static cost", base.staticCost, f.staticCost);
             std::printf("  %-16s %8d -> %d\n", "dynamic cost", base.dynamicCost, f.dynamicCost);
         }
+        if (without) *without = std::move(base);
     }
+    if (without && asked.overrides.size() == binding.overrides.size()) *without = f;
     return f;
 }
 
@@ -365,10 +363,12 @@ struct SplitGroup {
     std::string key, shader;
     std::vector<std::string> objects;
     int channels = 0, bytesPerTexel = 0, staticCost = 0, dynamicCost = 0;
+    double mapBytes = 0.0;  // estimated, summed over the objects (each at its busiest frame)
 };
 
 void addToGroups(std::vector<SplitGroup>& groups, const SceneObject& object,
-                 const FactoredShader& f) {
+                 const FactoredShader& f, const BoundMap& map) {
+    const double bytes = f.chosenWidth > 0 ? map.demand.bytes(f.chosenWidth, map.half) : 0.0;
     const std::string key = object.shader->file + " " + std::to_string(f.chosenWidth) + " " +
                             std::to_string(f.staticInstructions) + " " +
                             std::to_string(f.dynamicInstructions) + " " +
@@ -377,6 +377,7 @@ void addToGroups(std::vector<SplitGroup>& groups, const SceneObject& object,
     for (SplitGroup& g : groups)
         if (g.key == key) {
             g.objects.push_back(object.name);
+            g.mapBytes += bytes;
             return;
         }
     SplitGroup g;
@@ -387,24 +388,30 @@ void addToGroups(std::vector<SplitGroup>& groups, const SceneObject& object,
     g.bytesPerTexel = f.chosenWidth * (object.shadermapHalf ? 2 : 4);
     g.staticCost = f.staticCost;
     g.dynamicCost = f.dynamicCost;
+    g.mapBytes = bytes;
     groups.push_back(std::move(g));
 }
 
 void printGroups(const std::vector<SplitGroup>& groups, size_t objects) {
     std::printf("\n====\n\nthe scene: %zu objects, %zu kinds of split\n", objects, groups.size());
-    std::printf("  %-32s %-16s %8s %10s %12s %13s\n", "objects", "shader", "floats", "bytes/texel",
-                "static cost", "dynamic cost");
+    std::printf("  %-32s %-16s %8s %10s %12s %13s %10s\n", "objects", "shader", "floats",
+                "bytes/texel", "static cost", "dynamic cost", "map MB");
     long staticTotal = 0, dynamicTotal = 0;
+    double mapTotal = 0.0;
     for (const SplitGroup& g : groups) {
         std::string names = g.objects.front();
         if (g.objects.size() > 1) names += " and " + std::to_string(g.objects.size() - 1) + " more";
-        std::printf("  %-32s %-16s %8d %10d %12d %13d\n", names.c_str(), g.shader.c_str(),
-                    g.channels, g.bytesPerTexel, g.staticCost, g.dynamicCost);
+        std::printf("  %-32s %-16s %8d %10d %12d %13d %10.2f\n", names.c_str(), g.shader.c_str(),
+                    g.channels, g.bytesPerTexel, g.staticCost, g.dynamicCost,
+                    g.mapBytes / 1048576.0);
+        mapTotal += g.mapBytes;
         staticTotal += static_cast<long>(g.staticCost) * static_cast<long>(g.objects.size());
         dynamicTotal += static_cast<long>(g.dynamicCost) * static_cast<long>(g.objects.size());
     }
-    std::printf("  summed over the objects, cost units a point: static %ld, dynamic %ld\n",
-                staticTotal, dynamicTotal);
+    std::printf(
+        "  summed over the objects, cost units a point: static %ld, dynamic %ld; shader "
+        "maps about %.2f MB (each object at the frame that asks most of it)\n",
+        staticTotal, dynamicTotal, mapTotal / 1048576.0);
 }
 
 nlohmann::json groupsJson(const std::vector<SplitGroup>& groups) {
@@ -415,66 +422,66 @@ nlohmann::json groupsJson(const std::vector<SplitGroup>& groups) {
                        {"channels", g.channels},
                        {"bytes_per_texel", g.bytesPerTexel},
                        {"static_cost", g.staticCost},
-                       {"dynamic_cost", g.dynamicCost}});
+                       {"dynamic_cost", g.dynamicCost},
+                       {"map_bytes", g.mapBytes}});
     return out;
+}
+
+// The objects `options` asks to factor: the one named (with a shader file that is not its
+// own factored on its binding instead, said so) or every object of the scene.
+std::vector<size_t> objectsToFactor(Scene& scene, const FactorCommandOptions& options) {
+    std::vector<size_t> objects;
+    if (options.object.empty()) {
+        if (!options.shader.empty())
+            throw InputError({"--scene", 0, 0, {}},
+                             "--scene with a shader file needs --object NAME (without a shader "
+                             "file: every object, each with its own shader)");
+        for (size_t i = 0; i < scene.objects.size(); ++i) objects.push_back(i);
+        return objects;
+    }
+    const SceneObject& object = findObject(scene, options);
+    objects.push_back(static_cast<size_t>(&object - scene.objects.data()));
+    if (!options.shader.empty()) {
+        auto ast = loadShaderFile(options.shader);
+        objectBinding(scene, object, *ast, options.shader);
+        if (!sameFile(options.shader, object.shader->file))
+            std::fprintf(stderr,
+                         "mpshade: note: object '%s' uses %s; factoring %s on its binding "
+                         "instead\n",
+                         object.name.c_str(), object.shader->file.c_str(), options.shader.c_str());
+        scene.objects[objects[0]].shader = ast;
+    }
+    return objects;
+}
+
+int factorShaderAlone(const FactorCommandOptions& options) {
+    if (!options.object.empty()) throw InputError({"--object", 0, 0, {}}, "--object needs --scene");
+    if (options.verify)
+        throw InputError({"--verify", 0, 0, {}},
+                         "--verify needs --scene (its objects' charts and frames)");
+    if (options.shader.empty())
+        throw InputError({"factor", 0, 0, {}},
+                         "give a shader file, --scene SCENE (every object) or --scene SCENE "
+                         "--object NAME");
+    auto ast = loadShaderFile(options.shader);
+    nlohmann::json doc;
+    factorOne(options, options.shader, *ast, defaultBinding(),
+              "parameters at their defaults, a fixed ambient and a fixed distant light", nullptr,
+              options.json ? &doc : nullptr);
+    if (options.json) std::printf("%s\n", doc.dump(2).c_str());
+    return 0;
 }
 
 }  // namespace
 
 int runFactorCommand(const FactorCommandOptions& options) {
-    if (options.scene.empty()) {
-        if (!options.object.empty())
-            throw InputError({"--object", 0, 0, {}}, "--object needs --scene");
-        if (options.verify)
-            throw InputError({"--verify", 0, 0, {}},
-                             "--verify needs --scene (its objects' charts and frames)");
-        if (options.shader.empty())
-            throw InputError({"factor", 0, 0, {}},
-                             "give a shader file, --scene SCENE (every object) or --scene SCENE "
-                             "--object NAME");
-        auto ast = loadShaderFile(options.shader);
-        nlohmann::json doc;
-        factorOne(options, options.shader, *ast, defaultBinding(),
-                  "parameters at their defaults, a fixed ambient and a fixed distant light",
-                  options.json ? &doc : nullptr);
-        if (options.json) std::printf("%s\n", doc.dump(2).c_str());
-        return 0;
-    }
+    if (options.scene.empty()) return factorShaderAlone(options);
     Scene scene = loadScene(options.scene);
-    std::vector<size_t> objects;
-    if (!options.object.empty()) {
-        const SceneObject& object = findObject(scene, options);
-        objects.push_back(static_cast<size_t>(&object - scene.objects.data()));
-        // A shader file that is not the object's is factored (and verified) on its binding
-        // instead: a what-if, said so.
-        if (!options.shader.empty()) {
-            auto ast = loadShaderFile(options.shader);
-            objectBinding(scene, object, *ast, options.shader);
-            if (!sameFile(options.shader, object.shader->file))
-                std::fprintf(stderr,
-                             "mpshade: note: object '%s' uses %s; factoring %s on its binding "
-                             "instead\n",
-                             object.name.c_str(), object.shader->file.c_str(),
-                             options.shader.c_str());
-            scene.objects[objects[0]].shader = ast;
-        }
-    } else if (!options.shader.empty()) {
-        throw InputError({"--scene", 0, 0, {}},
-                         "--scene with a shader file needs --object NAME (without a shader "
-                         "file: every object, each with its own shader)");
-    } else {
-        for (size_t i = 0; i < scene.objects.size(); ++i) objects.push_back(i);
-    }
-    // The shading the renderers would use, for --verify.
-    std::unique_ptr<SceneResources> resources;
-    std::unique_ptr<StaticPhase> statics;
-    if (options.verify) {
-        resources =
-            std::make_unique<SceneResources>(scene, SceneResources::RayScenes::ForOcclusion);
-        StaticPhaseOptions so;
-        so.factor.storeAboveCost = options.storeAboveCost;
-        statics = std::make_unique<StaticPhase>(scene, *resources, so);
-    }
+    const std::vector<size_t> objects = objectsToFactor(scene, options);
+    // Ray scenes of all surfaces: they hide what lies behind, for the maps' estimates.
+    const SceneResources resources(scene, SceneResources::RayScenes::All);
+    const std::vector<MapDemand> demands = estimateMapDemands(resources, objects);
+    SplitMeasures measures(scene, resources, options, objects);
     bool within = true;
     nlohmann::json all = nlohmann::json::array();
     std::vector<SplitGroup> groups;
@@ -483,18 +490,16 @@ int runFactorCommand(const FactorCommandOptions& options) {
         const std::string file = options.shader.empty() ? object.shader->file : options.shader;
         if (k > 0 && !options.json) std::printf("\n----\n\n");
         nlohmann::json doc;
-        const FactoredShader f = factorOne(
-            options, file, *object.shader, objectBinding(scene, object, *object.shader, file),
-            "object '" + object.name + "' in " + options.scene, options.json ? &doc : nullptr);
-        addToGroups(groups, object, f);
-        if (statics) {
-            const SplitVerification v = verifySplit(*statics, *resources, objects[k]);
-            within = within && v.maxRelative() <= options.tolerance;
-            if (options.json)
-                doc["verify"] = verificationJson(v, options.tolerance);
-            else
-                printVerification(v, options.tolerance);
-        }
+        const BoundMap map{demands[k], object.shadermapHalf};
+        FactoredShader without;
+        const FactoredShader f = factorOne(options, file, *object.shader,
+                                           objectBinding(scene, object, *object.shader, file),
+                                           "object '" + object.name + "' in " + options.scene, &map,
+                                           options.json ? &doc : nullptr, &without);
+        addToGroups(groups, object, f, map);
+        within = reportMeasures(options, f, without, resources, measures, objects[k],
+                                options.json ? &doc : nullptr) &&
+                 within;
         if (options.json) {
             if (options.object.empty()) doc["object"] = object.name;
             all.push_back(std::move(doc));

@@ -98,6 +98,31 @@ const char* globalWhy(GlobalId id) {
     }
 }
 
+// dynamic(x) evaluates x every frame: the static work under it moves to the dynamic part
+// (down to free values), and whatever uses it follows. Marks it in `forced` and
+// bt.forcedBy; true if anything moved.
+bool forceUnderDynamic(const IrProgram& program, BindingTimes& bt, std::vector<char>& forced) {
+    bool anyForced = false;
+    const std::vector<int> defining = definingInstructions(program);
+    for (size_t d = 0; d < program.insts.size(); ++d) {
+        const Inst& dyn = program.insts[d];
+        if (dyn.op != Op::Dynamic) continue;
+        std::vector<int32_t> stack(program.argsOf(dyn), program.argsOf(dyn) + dyn.nargs);
+        while (!stack.empty()) {
+            const size_t v = static_cast<size_t>(stack.back());
+            stack.pop_back();
+            if (forced[v] || bt.stage[v] != Stage::Static) continue;
+            const Inst& inst = program.insts[static_cast<size_t>(defining[v])];
+            if (inst.op == Op::Bake) continue;  // an explicit bake wins
+            forced[v] = 1;
+            bt.forcedBy[v] = static_cast<int32_t>(d);
+            anyForced = true;
+            for (int a = 0; a < inst.nargs; ++a) stack.push_back(program.argsOf(inst)[a]);
+        }
+    }
+    return anyForced;
+}
+
 }  // namespace
 
 BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& binding,
@@ -111,6 +136,14 @@ BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& 
     std::vector<char> forced(n, 0);                // made dynamic by a dynamic() override
     std::vector<int32_t>& forcedBy = bt.forcedBy;  // the dynamic() instruction that forced it
     forcedBy.assign(n, -1);
+
+    // Who asks a Dynamic instruction's value to be repeated: a dynamic() in the source, or
+    // (imm k + 1, lower.cpp) the binding's factoring override k.
+    auto askedBy = [&](const Inst& dyn) -> std::string {
+        const auto k = static_cast<size_t>(dyn.imm);
+        if (k == 0 || k > binding.overrides.size()) return "dynamic() asks for it";
+        return "the binding repeats '" + binding.overrides[k - 1].spelled + "'";
+    };
 
     auto pass = [&]() {
         for (const Inst& inst : program.insts) {
@@ -157,7 +190,7 @@ BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& 
                     break;
                 case Op::Dynamic:
                     stage = Stage::Dynamic;
-                    if (cause < 0) why = "dynamic() asks for it";
+                    if (cause < 0) why = askedBy(inst);
                     break;
                 case Op::Diffuse:
                 case Op::Specular:
@@ -186,7 +219,7 @@ BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& 
                 const size_t v = static_cast<size_t>(inst.result + o);
                 if (forced[v] && stage != Stage::Dynamic) {
                     stage = Stage::Dynamic;
-                    why = "dynamic() asks for it";
+                    why = askedBy(program.insts[static_cast<size_t>(forcedBy[v])]);
                     cause = -1;
                 }
                 bt.stage[v] = stage;
@@ -197,27 +230,7 @@ BindingTimes analyzeBindingTimes(const IrProgram& program, const ShaderBinding& 
     };
     pass();
 
-    // dynamic(x) evaluates x every frame: the static work under it moves to the dynamic
-    // part (down to free values), and whatever uses it follows.
-    bool anyForced = false;
-    const std::vector<int> defining = definingInstructions(program);
-    for (size_t d = 0; d < program.insts.size(); ++d) {
-        const Inst& dyn = program.insts[d];
-        if (dyn.op != Op::Dynamic) continue;
-        std::vector<int32_t> stack(program.argsOf(dyn), program.argsOf(dyn) + dyn.nargs);
-        while (!stack.empty()) {
-            const size_t v = static_cast<size_t>(stack.back());
-            stack.pop_back();
-            if (forced[v] || bt.stage[v] != Stage::Static) continue;
-            const Inst& inst = program.insts[static_cast<size_t>(defining[v])];
-            if (inst.op == Op::Bake) continue;  // an explicit bake wins
-            forced[v] = 1;
-            forcedBy[v] = static_cast<int32_t>(d);
-            anyForced = true;
-            for (int a = 0; a < inst.nargs; ++a) stack.push_back(program.argsOf(inst)[a]);
-        }
-    }
-    if (anyForced) pass();
+    if (forceUnderDynamic(program, bt, forced)) pass();
     return bt;
 }
 

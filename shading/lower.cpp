@@ -228,6 +228,17 @@ class Lowerer {
         return v;
     }
 
+    // Whether a 'repeat' override names bake() call `e`: by its line:column, or by the
+    // variable it initializes (unbakeDecl_).
+    bool repeatsThisBake(const Expr& e) const {
+        if (&e == unbakeDecl_) return true;
+        for (const FactoringOverride& o : binding_.overrides)
+            if (o.kind == FactoringOverride::Kind::Repeat && o.line == e.line &&
+                o.column == e.column)
+                return true;
+        return false;
+    }
+
     Val exprUntagged(const Expr& e) {
         at(e.line, e.column);
         switch (e.kind) {
@@ -421,6 +432,9 @@ class Lowerer {
         for (size_t k = 0; k < valueArgs; ++k) a.push_back(expr(*e.args[k]));
         at(e.line, e.column);
         const ValueType rt = e.type;
+        // A binding that repeats a bake() undoes it: its argument runs every frame there,
+        // the override wrapping it as dynamic() would (expr()).
+        if (fn == Builtin::Bake && repeatsThisBake(e)) return a[0];
         if (const std::optional<Op> op = componentwiseOp(fn)) return componentwise(*op, a, rt);
         switch (fn) {
             case Builtin::Dot:
@@ -562,7 +576,13 @@ class Lowerer {
                 stmts(s.body);
                 break;
             case Stmt::Kind::Decl: {
+                unbakeDecl_ = nullptr;
+                for (const FactoringOverride& o : binding_.overrides)
+                    if (o.kind == FactoringOverride::Kind::Repeat && o.line == 0 &&
+                        o.name == s.name)
+                        unbakeDecl_ = s.value.get();
                 Val v = convert(expr(*s.value), s.declType);
+                unbakeDecl_ = nullptr;
                 for (size_t k = 0; k < binding_.overrides.size(); ++k)
                     if (binding_.overrides[k].line == 0 && binding_.overrides[k].name == s.name)
                         v = overridden(v, k, s.value->line, s.value->column);
@@ -628,6 +648,7 @@ class Lowerer {
 
     const ShaderAst& ast_;
     std::vector<int> overrideMatches_;  // per binding override: expressions it wrapped
+    const Expr* unbakeDecl_ = nullptr;  // the bake() call a 'repeat' of its variable undoes
     const ShaderBinding& binding_;
     const LoweringLimits& limits_;
     IrProgram& program_;

@@ -1,5 +1,7 @@
 #include "shading/reassociate.h"
 
+#include <algorithm>
+
 #include "geometry/error.h"
 #include "shading/ir_builder.h"
 
@@ -72,14 +74,18 @@ class Reassociator {
     }
 
     // Leaves of the sum (or product) rooted at v: interior nodes are dynamic sums used
-    // only here, so regrouping them duplicates nothing.
+    // only here, so regrouping them duplicates nothing. A product also opens static
+    // products used only here, so its constant factors come apart from the others: a
+    // colour constant times fbm times a noise, times a dynamic term, is per component
+    // (c_k fbm a) d, three static values, where fbm a is one value shared by the three.
     void flatten(int32_t v, bool negative, bool root, bool product,
                  std::vector<Term>& terms) const {
         const int k = defining_[static_cast<size_t>(v)];
         const Inst& inst = old_.insts[static_cast<size_t>(k)];
         const bool chain =
             product ? inst.op == Op::Mul : (inst.op == Op::Add || inst.op == Op::Sub);
-        if (chain && stage(v) == Stage::Dynamic && (root || uses_[static_cast<size_t>(v)] == 1)) {
+        const bool opens = stage(v) == Stage::Dynamic || (product && stage(v) == Stage::Static);
+        if (chain && opens && (root || uses_[static_cast<size_t>(v)] == 1)) {
             const int32_t* args = old_.argsOf(inst);
             flatten(args[0], negative, false, product, terms);
             flatten(args[1], inst.op == Op::Sub ? !negative : negative, false, product, terms);
@@ -107,12 +113,22 @@ class Reassociator {
         const bool product = inst.op == Op::Mul;
         if (!(product || inst.op == Op::Add || inst.op == Op::Sub)) return false;
         if (stage(inst.result) != Stage::Dynamic) return false;
-        std::vector<Term> terms, fixed, varying;
+        std::vector<Term> terms, fixed, constants, varying;
         flatten(inst.result, false, true, product, terms);
-        for (const Term& t : terms)
-            (stage(t.value) == Stage::Dynamic ? varying : fixed).push_back(t);
-        if (fixed.size() < 2 || varying.empty()) return false;
-        // All the static terms first, as one static value; then the dynamic ones.
+        for (const Term& t : terms) {
+            float unused;
+            if (product && builder_.constantValue(map_[static_cast<size_t>(t.value)], unused))
+                constants.push_back(t);
+            else
+                (stage(t.value) == Stage::Dynamic ? varying : fixed).push_back(t);
+        }
+        if (varying.empty() || fixed.empty() || fixed.size() + constants.size() < 2) return false;
+        // All the static terms first, as one static value (in the order of the old
+        // program's values, so the same factors make the same value); then the constant
+        // factors of a product; then the dynamic terms.
+        std::sort(fixed.begin(), fixed.end(),
+                  [](const Term& a, const Term& b) { return a.value < b.value; });
+        fixed.insert(fixed.end(), constants.begin(), constants.end());
         int acc = combine(fixed, product);
         for (const Term& t : varying) {
             const int v = map_[static_cast<size_t>(t.value)];

@@ -441,11 +441,53 @@ TEST(Cli, FactorTheWholeSceneGroupsSplitsAlike) {
             ++marbleGroups;
             EXPECT_EQ(g["objects"].size(), 11u);
             EXPECT_EQ(g["bytes_per_texel"], 4 * g["channels"].get<int>());
+            double bytes = 0.0;  // the group's estimate is its objects'
+            for (const nlohmann::json& o : doc["objects"])
+                for (const nlohmann::json& name : g["objects"])
+                    if (o["object"] == name) bytes += o["map_estimate"]["bytes"].get<double>();
+            EXPECT_GT(bytes, 0.0);
+            EXPECT_NEAR(g["map_bytes"].get<double>(), bytes, 1e-6 * bytes);
         }
     EXPECT_EQ(marbleGroups, 1);
     EXPECT_NE(mpshade("factor --scene examples/courtyard/scene.json")
                   .output.find("the scene: 51 objects"),
               std::string::npos);
+}
+
+TEST(Cli, FactorEstimatesTheMapBytesARenderOfThatFrameFills) {
+    // Each object's estimate names the frame that asks most of its map; rendering that frame
+    // alone (constant quality: every tile its probes read is filled, and only those) fills
+    // within a quarter of the estimate. The examples' objects are 0.78-1.23x
+    // (docs/factoring.md); the vase's floor, a grazing plane, and the vase itself here.
+    const CliRun run = mpshade("factor --scene examples/vase/scene.json --json");
+    ASSERT_EQ(run.exitCode, 0) << run.output;
+    const nlohmann::json doc = nlohmann::json::parse(run.output);
+    for (const nlohmann::json& object : doc["objects"]) {
+        const std::string name = object["object"];
+        SCOPED_TRACE(name);
+        const nlohmann::json& estimate = object["map_estimate"];
+        const int channels = object["chosen_width"];
+        ASSERT_GT(channels, 0);
+        EXPECT_DOUBLE_EQ(estimate["bytes"].get<double>(),
+                         estimate["tiles"].get<double>() * 18 * 18 * channels * 4);
+        const int frame = estimate["frame"];
+        ASSERT_GE(frame, 0);
+        const std::string out = tempDir("map_estimate_" + name);
+        const CliRun render = mpshade(
+            "render examples/vase/scene.json --no-single-phase "
+            "--no-store --frames " +
+            std::to_string(frame) + ":" + std::to_string(frame + 1) + " --out " + out);
+        ASSERT_EQ(render.exitCode, 0) << render.output;
+        std::ifstream statsFile(out + "/stats.json");
+        const nlohmann::json stats = nlohmann::json::parse(statsFile);
+        double filled = -1.0;
+        for (const nlohmann::json& o : stats["objects"])
+            if (o["name"] == name) filled = o["map_bytes"].get<double>();
+        EXPECT_GT(filled, 0.75 * estimate["bytes"].get<double>());
+        EXPECT_LT(filled, 1.25 * estimate["bytes"].get<double>());
+    }
+    const CliRun text = mpshade("factor --scene examples/vase/scene.json --object floor");
+    EXPECT_NE(text.output.find("asks most: about "), std::string::npos) << text.output;
 }
 
 TEST(Cli, FactorWhatIfStoreComparesWithTheSplitWithout) {
@@ -491,6 +533,49 @@ TEST(Cli, FactorVerifyExitsOneOverItsTolerance) {
     EXPECT_EQ(over.exitCode, 1) << over.output;
     EXPECT_NE(over.output.find("OVER --tolerance 1e-05"), std::string::npos) << over.output;
     EXPECT_EQ(mpshade(what + " --tolerance 1").exitCode, 0);
+}
+
+TEST(Cli, FactorMeasuresWhatABakeFreezesAndAWhatIfThatUndoesIt) {
+    // pulse.sl bakes 0.5 + 0.5 sin(6 t): without --verify, factor says it froze frame 0
+    // (t = 0, the value 0.5) and measures the stored channel's error (it holds the product
+    // with the vase's scale, 2.5): at the worst frame f of the vase's 24 fps,
+    // 2.5 * 0.5 |sin(6 f / 24)|, at least that of the last frame (47).
+    const std::string dir = tempDir("bake-measure");
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "/pulse.sl") << "surface pulse(float scale = 1) {\n"
+                                        "    float p = bake(0.5 + 0.5 * sin(6 * time));\n"
+                                        "    Ci = color(p) * scale;\n}\n";
+    const std::string factor =
+        "factor " + dir + "/pulse.sl --scene examples/vase/scene.json --object vase";
+    const CliRun text = mpshade(factor);
+    ASSERT_EQ(text.exitCode, 0) << text.output;
+    EXPECT_NE(text.output.find("what the bakes freeze: the static run's time and view, frame 0 "
+                               "(t = 0.000 s"),
+              std::string::npos)
+        << text.output;
+    const CliRun json = mpshade(factor + " --json");
+    ASSERT_EQ(json.exitCode, 0) << json.output;
+    // (The note that vase uses another shader comes first, on stderr.)
+    auto parsed = [](const std::string& out) {
+        return nlohmann::json::parse(out.substr(std::min(out.find('{'), out.size())));
+    };
+    const nlohmann::json doc = parsed(json.output);
+    EXPECT_EQ(doc["bake"]["frozen_at"]["frame"], 0);
+    const nlohmann::json& channel = doc["bake"]["measured"]["channels"][0];
+    const double worstTime = channel["worst"]["frame"].get<int>() / 24.0;
+    EXPECT_NEAR(channel["max_abs"].get<double>(), 1.25 * std::abs(std::sin(6.0 * worstTime)), 1e-5);
+    EXPECT_GE(channel["max_abs"].get<double>() + 1e-6, 1.25 * std::abs(std::sin(6.0 * 47 / 24.0)));
+    // Repeating p on this binding undoes the bake: nothing stored, exact, and the what-if
+    // measures both.
+    const CliRun undone = mpshade(factor + " --repeat p --json");
+    ASSERT_EQ(undone.exitCode, 0) << undone.output;
+    const nlohmann::json u = parsed(undone.output);
+    EXPECT_EQ(u["chosen_width"], 0);
+    EXPECT_FALSE(u.contains("bake"));
+    EXPECT_LE(u["what_if"]["with"]["max_relative"].get<double>(), 1e-6);
+    EXPECT_NEAR(u["what_if"]["without"]["max_relative"].get<double>(),
+                doc["bake"]["measured"]["max_relative"].get<double>(), 1e-9);
+    EXPECT_GT(u["what_if"]["without"]["map_bytes"].get<double>(), 0.0);
 }
 
 TEST(Cli, FactorBadInput) {

@@ -216,6 +216,39 @@ TEST(Factoring, PatentExampleStoresTwoValuesNotThree) {
     EXPECT_EQ(expectExact(*ast, b, "patent example, no reassociation", plain).chosenWidth, 3);
 }
 
+TEST(Factoring, ValuesUsedOnlyTogetherAreOneChannel) {
+    // a * rim * b with rim dynamic: the product of the two noises is all the dynamic part
+    // needs, so it is one channel, not two.
+    auto together = compileShaderText("together.sl", R"(
+        surface together() {
+            float a = fbm(P * 4, 4);
+            float b = noise(P * 3);
+            float rim = pow(1 - max(0, dot(N, -I)), 3);
+            Ci = color(a * rim * b);
+        })");
+    const FactoredShader f = expectExact(*together, {}, "together");
+    EXPECT_EQ(f.naiveWidth, 2);
+    EXPECT_EQ(f.chosenWidth, 1);
+    // A constant colour times fbm times a noise, times a dynamic term: per component three
+    // static products, but fbm times the noise is one value for all three.
+    auto tinted = compileShaderText("tinted.sl", R"(
+        surface tinted() {
+            color c = color(0.8, 0.5, 0.2) * fbm(P * 2, 3);
+            float a = noise(P * 5);
+            Ci = c * dot(N, -I) * a;
+        })");
+    EXPECT_EQ(expectExact(*tinted, {}, "tinted").chosenWidth, 1);
+    // Read both as a sum and as a product: the two are needed, and two are kept.
+    auto both = compileShaderText("both.sl", R"(
+        surface both() {
+            float a = fbm(P * 4, 4);
+            float b = noise(P * 3);
+            float rim = pow(1 - max(0, dot(N, -I)), 3);
+            Ci = color(a + rim + b) * a * b;
+        })");
+    EXPECT_EQ(expectExact(*both, {}, "both").chosenWidth, 2);
+}
+
 TEST(Factoring, MinimumCutPrefersTheNarrowerSideAndDoesNotRepeatExpensiveWork) {
     // Five noise values feed one static sum used dynamically: one float, not five.
     auto ast = compileShaderText("cut.sl", R"(
@@ -414,6 +447,47 @@ TEST(Factoring, OverridesOutsideTheSourceAreCheckedAndApplied) {
     EXPECT_FALSE(parseFactoringOverride("1:x", FactoringOverride::Kind::Store, bad));
     EXPECT_FALSE(parseFactoringOverride("a b", FactoringOverride::Kind::Store, bad));
     EXPECT_FALSE(parseFactoringOverride("0:3", FactoringOverride::Kind::Store, bad));
+}
+
+TEST(Factoring, ARepeatOverrideUndoesABakeForItsBindingAlone) {
+    // bake() in the source applies to every binding; a binding that repeats the baked
+    // variable (or names the bake() call) runs its argument every frame instead: nothing
+    // stored, nothing baked, exact. The cause named is the override, not a dynamic().
+    auto ast = compileShaderText("p.sl",
+                                 "surface p(float scale = 1) {\n"
+                                 "  float w = bake(0.5 + 0.5 * sin(6 * time));\n"
+                                 "  Ci = color(w * noise(P)) * scale;\n}");
+    const FactoredShader baked = factorShader(*ast, {});
+    EXPECT_EQ(baked.bakedLines.size(), 1u);
+    for (const char* name : {"w", "2:13"}) {
+        ShaderBinding b;
+        FactoringOverride o;
+        ASSERT_TRUE(parseFactoringOverride(name, FactoringOverride::Kind::Repeat, o));
+        b.overrides.push_back(o);
+        const FactoredShader f = expectExact(*ast, b, name);
+        EXPECT_TRUE(f.bakedLines.empty()) << name;
+        int sines = 0;
+        for (const Inst& inst : f.dynamicPart.insts) sines += inst.op == Op::Sin;
+        EXPECT_EQ(sines, 1) << name;
+        EXPECT_EQ(f.chosenWidth, 1) << name;  // noise(P) alone is stored
+    }
+    // Repeating the baked value as a whole keeps the bake (the binding asks to read it
+    // every frame, not to compute it) and says so.
+    auto onlyRead = compileShaderText("r.sl",
+                                      "surface r() {\n"
+                                      "  float w = bake(sin(time)) * 2;\n"
+                                      "  Ci = color(w);\n}");
+    ShaderBinding b;
+    FactoringOverride o;
+    ASSERT_TRUE(parseFactoringOverride("w", FactoringOverride::Kind::Repeat, o));
+    b.overrides.push_back(o);
+    const FactoredShader r = factorShader(*onlyRead, b);
+    EXPECT_EQ(r.bakedLines.size(), 1u);
+    bool named = false;
+    for (const DynamicLine& line : r.dynamicLines)
+        for (const std::string& step : line.chain)
+            named = named || step.find("the binding repeats 'w'") != std::string::npos;
+    EXPECT_TRUE(named);
 }
 
 TEST(Factoring, AnnotationsThatDoNothingAreWarnedOf) {

@@ -1,0 +1,208 @@
+#include "phases/map_demand.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+#include <embree3/rtcore.h>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
+namespace mpshade {
+namespace {
+
+// A grid of cells over an object's charts (k x k a chart; past the budget, every
+// `stride`-th chart), with the surface at each centre.
+struct ChartCells {
+    int k = 1, stride = 1;
+    std::vector<ChartPoint> at;
+    std::vector<SurfaceSample> geometry;
+};
+
+ChartCells chartCells(const Surface& surface, int budget) {
+    ChartCells c;
+    const int charts = chartCount(surface);
+    if (charts <= 0) return c;
+    c.k = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(budget) / charts)));
+    c.stride = std::max(1, charts / std::max(1, budget));
+    for (int chart = 0; chart < charts; chart += c.stride)
+        for (int j = 0; j < c.k; ++j)
+            for (int i = 0; i < c.k; ++i)
+                c.at.push_back({chart, (i + 0.5f) / c.k, (j + 0.5f) / c.k});
+    c.geometry.resize(c.at.size());
+    evaluateBatch(surface, c.at, c.geometry);
+    return c;
+}
+
+// The pixel position's derivative along the world direction `a`, at camera-space point p.
+glm::dvec2 screenDerivative(const CameraState& c, double ppu, const glm::vec3& p,
+                            const glm::vec3& a) {
+    const double z = glm::dot(p, c.forward);
+    const double x = glm::dot(p, c.right), y = glm::dot(p, c.up);
+    const double dz = glm::dot(a, c.forward);
+    return {ppu * (glm::dot(a, c.right) * z - x * dz) / (z * z),
+            ppu * (glm::dot(a, c.up) * z - y * dz) / (z * z)};
+}
+
+// Whether a surface lies between the eye and P (the object's own included, short of P).
+bool hidden(RTCScene world, const glm::vec3& eye, const glm::vec3& P) {
+    const glm::vec3 d = P - eye;
+    const float distance = glm::length(d);
+    if (!(distance > 0.0f)) return false;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay ray{};
+    ray.org_x = eye.x, ray.org_y = eye.y, ray.org_z = eye.z;
+    ray.dir_x = d.x / distance, ray.dir_y = d.y / distance, ray.dir_z = d.z / distance;
+    ray.tnear = 0.0f;
+    // Short of P by more than the ray scene's tessellation of the surface through it.
+    ray.tfar = distance * 0.98f;
+    ray.mask = 0xFFFFFFFFu;
+    rtcOccluded1(world, &ctx, &ray);
+    return ray.tfar < 0.0f;
+}
+
+uint64_t tileId(int chart, int level, int64_t tx, int64_t ty) {
+    return (static_cast<uint64_t>(chart) << 42) ^ (static_cast<uint64_t>(level) << 37) ^
+           (static_cast<uint64_t>(tx) << 18) ^ static_cast<uint64_t>(ty);
+}
+
+struct FrameDemand {
+    double tiles = 0.0, covered = 0.0;
+    int finest = 0;
+};
+
+FrameDemand frameDemand(const ChartCells& cells, const MapDemand& d, int maxLevel, int tile,
+                        bool closed, const FrameState& frame, const ObjectState& state,
+                        RTCScene world, double footprint, const ProbeOptions& probe,
+                        std::unordered_set<uint64_t>& asked) {
+    const CameraState& camera = frame.camera;
+    const glm::mat3 linear(state.objectToWorld);
+    const double ppu = 0.5 * camera.height / camera.tanHalfFovY;
+    const double R = d.resolution, k = cells.k;
+    asked.clear();
+    FrameDemand out;
+    out.finest = maxLevel;
+    for (size_t c = 0; c < cells.at.size(); ++c) {
+        const SurfaceSample& g = cells.geometry[c];
+        const glm::vec3 P = glm::vec3(state.objectToWorld * glm::vec4(g.P, 1.0f));
+        const glm::vec3 p = P - camera.eye;
+        if (glm::dot(p, camera.forward) <= camera.zNear) continue;
+        float x, y;
+        if (!camera.project(P, x, y) || !(x >= 0.0f && y >= 0.0f && x <= camera.width &&
+                                          y <= camera.height))
+            continue;
+        if (closed && glm::dot(linear * g.Ng, p) >= 0.0f) continue;
+        // Pixels per unit of u and of v; inverted, the chart units a pixel step spans (the
+        // probe query's derivatives, surface_points.cpp), here in level-0 texels.
+        const glm::dvec2 ju = screenDerivative(camera, ppu, p, linear * g.dPdu);
+        const glm::dvec2 jv = screenDerivative(camera, ppu, p, linear * g.dPdv);
+        const double det = ju.x * jv.y - ju.y * jv.x;
+        if (!(std::fabs(det) > 1e-30) || hidden(world, camera.eye, P)) continue;
+        out.covered += std::fabs(det) * cells.stride / (k * k);
+        const double s = footprint * R / det;
+        const double la = std::hypot(jv.y * s, ju.y * s), lb = std::hypot(jv.x * s, ju.x * s);
+        const double major = std::max(la, lb);
+        double minor = std::min(la, lb);
+        // The level the probe reads (probe_batch.h footprintOf): the minor axis, widened.
+        if (probe.cap == AnisotropyCap::ShrinkMajor) {
+            if (probe.levelAnisotropy > 0.0f) minor = std::max(minor, major / probe.levelAnisotropy);
+        } else {
+            minor = std::max(minor, major / probe.maxAnisotropy);
+        }
+        const double lod = std::clamp(std::log2(std::max(minor, 1e-30)), 0.0, double(maxLevel));
+        // Levels l0 and l0 + 1, each read only where its weight is not 0 (prober.h's
+        // narrowBlend: the coarser one's weight rises across levelBlend around the middle).
+        const int l0 = static_cast<int>(lod);
+        const double t = lod - l0, halfBlend = 0.5 * std::min(1.0f, probe.levelBlend);
+        const int l1 = std::min(l0 + 1, maxLevel);
+        const int level = l1 > l0 && (probe.levelBlend >= 1.0f ? t >= 1.0 : t >= 0.5 + halfBlend)
+                              ? l1
+                              : l0;
+        const int last = l1 > l0 && (probe.levelBlend >= 1.0f ? t > 0.0 : t > 0.5 - halfBlend)
+                             ? l1
+                             : l0;
+        out.finest = std::min(out.finest, level);
+        // The tiles the cell's points read on each level: points two a tile side within the
+        // cell (a tile is filled when any probe lands in it, and the cell's box would count
+        // every tile it grazes), or the cell's area where it is many tiles wide.
+        for (int l = level; l <= last; ++l) {
+            const double side = (R / double(1 << l)) / tile;  // tiles a chart side
+            const double extent = side / k;                    // the cell's, in tiles
+            if (extent > 4.0) {
+                out.tiles += extent * extent * cells.stride;
+                continue;
+            }
+            const int m = std::max(1, static_cast<int>(std::ceil(2.0 * extent)));
+            const double u0 = cells.at[c].u - 0.5 / k, v0 = cells.at[c].v - 0.5 / k;
+            for (int j = 0; j < m; ++j)
+                for (int i = 0; i < m; ++i) {
+                    const double u = u0 + (i + 0.5) / (m * k), v = v0 + (j + 0.5) / (m * k);
+                    asked.insert(tileId(cells.at[c].chart, l, static_cast<int64_t>(u * side),
+                                        static_cast<int64_t>(v * side)));
+                }
+        }
+    }
+    out.tiles += static_cast<double>(asked.size()) * cells.stride;
+    return out;
+}
+
+}  // namespace
+
+std::vector<MapDemand> estimateMapDemands(const SceneResources& resources,
+                                          std::span<const size_t> objects,
+                                          const MapDemandOptions& options) {
+    const Scene& scene = resources.scene();
+    const int width = options.width > 0 ? options.width : scene.settings.width;
+    const int height = options.height > 0 ? options.height : scene.settings.height;
+    const int spp = options.samplesPerPixel > 0 ? options.samplesPerPixel
+                                                : scene.settings.samplesPerPixel;
+    const double footprint = options.footprintScale / std::sqrt(static_cast<double>(spp));
+
+    std::vector<MapDemand> demands(objects.size());
+    std::vector<ChartCells> cells(objects.size());
+    std::vector<int> maxLevels(objects.size(), 0), tiles(objects.size(), 1);
+    for (size_t n = 0; n < objects.size(); ++n) {
+        const SceneObject& obj = scene.objects[objects[n]];
+        MapDemand& d = demands[n];
+        const int cap = obj.shadermapResolution > 0 ? obj.shadermapResolution : (1 << 20);
+        d.resolution = 1;
+        while (d.resolution < cap && d.resolution < (1 << 20)) d.resolution *= 2;
+        tiles[n] = std::min(options.tileSize, d.resolution);
+        d.tileTexels = (tiles[n] + 2 * options.border) * (tiles[n] + 2 * options.border);
+        while ((d.resolution >> maxLevels[n]) > 1) ++maxLevels[n];
+        d.pinnedTiles = 9.0 * chartCount(*obj.surface);
+        cells[n] = chartCells(*obj.surface, options.points);
+    }
+
+    const int first = std::max(0, options.firstFrame);
+    const int end = options.lastFrame >= 0 ? options.lastFrame : std::max(1, scene.frameCount());
+    const int count = std::max(1, end - first);
+    const int nFrames = std::clamp(options.frames, 1, count);
+    std::unordered_set<uint64_t> asked;
+    for (int f = 0; f < nFrames; ++f) {
+        const int frame =
+            first + (nFrames == 1 ? 0
+                                  : static_cast<int>(std::lround(double(f) * (count - 1) /
+                                                                 (nFrames - 1))));
+        const FrameState state = frameStateAt(resources, frame, width, height, spp);
+        const WorldRayScene world(resources, state.objects);
+        for (size_t n = 0; n < objects.size(); ++n) {
+            const Surface& surface = *scene.objects[objects[n]].surface;
+            const FrameDemand fd =
+                frameDemand(cells[n], demands[n], maxLevels[n], tiles[n], isClosed(surface), state,
+                            state.objects[objects[n]], world.scene(), footprint, options.probe,
+                            asked);
+            MapDemand& d = demands[n];
+            if (fd.covered > 0.0 && fd.tiles > d.tiles) {
+                d.tiles = fd.tiles;
+                d.frame = frame;
+                d.coveredPixels = fd.covered;
+                d.finestLevel = fd.finest;
+            }
+        }
+    }
+    return demands;
+}
+
+}  // namespace mpshade
