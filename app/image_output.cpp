@@ -15,6 +15,7 @@
 #include "app/output_files.h"
 #include "app/srgb.h"
 #include "geometry/error.h"
+#include "phases/shading_cost_image.h"
 
 namespace mpshade {
 namespace {
@@ -74,6 +75,33 @@ void writeFrameImages(const Image& image, const std::string& dir, int frame) {
     // Side by side: each is one thread's compression (about 12 and 6 ms at 480x270).
     tbb::parallel_invoke([&] { writeExr(image, base + ".exr"); },
                          [&] { writePng(image, base + ".png"); });
+}
+
+void writeShadingCostImages(const ShadingCostImage& cost, const std::string& dir, int frame) {
+    if (cost.width <= 0 || cost.height <= 0) return;
+    const std::string base =
+        (std::filesystem::path(dir) / fmt::format("cost_{:04d}", frame)).string();
+    const size_t pixels = static_cast<size_t>(cost.width) * cost.height;
+    std::vector<float> planes(2 * pixels);
+    float most = 0.0f;
+    for (size_t i = 0; i < pixels; ++i) {
+        planes[2 * i] = cost.points[i];
+        planes[2 * i + 1] = cost.cost[i];
+        most = std::max(most, cost.cost[i]);
+    }
+    OIIO::ImageSpec spec(cost.width, cost.height, 2, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"points", "cost"};
+    spec.attribute("compression", "zip");
+    spec.attribute("mpshade:cost_units", "opCost units a pixel (shading/factoring.h)");
+    write(base + ".exr", "openexr", spec, OIIO::TypeDesc::FLOAT, planes.data());
+    Image grey(cost.width, cost.height);
+    for (size_t i = 0; i < pixels; ++i) {
+        const float v = most > 0.0f ? cost.cost[i] / most : 0.0f;
+        float* o = &grey.rgba[4 * i];
+        o[0] = o[1] = o[2] = v;
+        o[3] = 1.0f;
+    }
+    writePng(grey, base + ".png");
 }
 
 bool frameImagesExist(const std::string& dir, int frame) {

@@ -59,6 +59,9 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--truth-spp", render.truthSpp,
                           "With --compare: also measure both renderers against the reference "
                           "at this many samples per pixel");
+    renderCmd->add_flag("--cost-images", render.costImages,
+                        "Multiphase: also write cost_NNNN.exr and .png, the shading points and "
+                        "the dynamic shader's cost units per pixel");
     renderCmd->add_flag("--skip-existing", render.skipExisting,
                         "Render no frame whose EXR and PNG are in --out already (a retried "
                         "farm task)");

@@ -72,6 +72,29 @@ void checkRenderOptions(const RenderCommandOptions& options) {
                          "expected 1..1024, found " + std::to_string(options.truthSpp));
     if (options.memoryMb < 0)
         throw InputError({"--memory-mb", 0, 0, {}}, "expected a positive number of MB");
+    if (options.costImages && options.mode != "multiphase")
+        throw InputError({"--cost-images", 0, 0, {}},
+                         "--cost-images shows the multi-phase renderer's dynamic phase");
+}
+
+// The frame's shading cost images (--cost-images) and their sums in its stats entry.
+void writeCostImages(const MultiphaseRenderer& renderer, const Scene& scene, const std::string& dir,
+                     int frame, nlohmann::json& entry) {
+    const ShadingCostImage cost = renderer.lastFrameShadingCost();
+    if (cost.width == 0) {
+        entry["cost_image"] = nullptr;  // rendered single-phase: no dynamic phase to show
+        return;
+    }
+    writeShadingCostImages(cost, dir, frame);
+    nlohmann::json objects = nlohmann::json::object();
+    for (size_t i = 0; i < cost.objectPoints.size() && i < scene.objects.size(); ++i)
+        if (cost.objectPoints[i] > 0.0)
+            objects[scene.objects[i].name] = {{"points", cost.objectPoints[i]},
+                                              {"cost", cost.objectCost[i]}};
+    entry["cost_image"] = {{"file", fmt::format("cost_{:04d}.exr", frame)},
+                           {"points", cost.totalPoints()},
+                           {"cost", cost.totalCost()},
+                           {"objects", objects}};
 }
 
 // The multi-phase renderer's options from the command's.
@@ -261,6 +284,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         });
         writeFrameImages(image, options.outDir, frame);
         nlohmann::json entry = renderFrameJson(scene, stats, multiphase, image);
+        if (options.costImages) writeCostImages(*multi, scene, options.outDir, frame, entry);
         if (options.compare)
             compareFrame(frame, image, stats, render, options, *reference, referenceImage, entry);
         frames.push_back(entry);

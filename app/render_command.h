@@ -41,6 +41,10 @@ struct RenderCommandOptions {
     // of it before the request are rendered first, not written, so each frame is the bits a
     // render of A:B gives, whichever request renders it (a farm's shards). Empty: --frames.
     std::string planFrames;
+    // Multiphase: beside each frame, cost_NNNN.exr and .png -- per pixel, the shading points
+    // the frame's dynamic phase made and their cost in opCost units (image_output.h); per
+    // frame in stats.json, the cost per object. A frame rendered single-phase has none.
+    bool costImages = false;
 };
 
 // Returns the exit code: 0, or 130 when stopped by Ctrl-C.

@@ -60,6 +60,20 @@ const FactoredShader& MultiphaseRenderer::factored(size_t object) const {
     return static_.shading(object).factored;
 }
 
+ShadingCostImage MultiphaseRenderer::lastFrameShadingCost() const {
+    if (singlePhaseFrame_ || !dynamic_.layout()) return {};
+    std::vector<float> costPerPoint(slots_.size(), 0.0f);
+    for (size_t i = 0; i < slots_.size(); ++i) {
+        const ObjectRepresentation* rep = slots_[i].representation.get();
+        if (!rep) continue;
+        const FactoredShader& f = factored(i);
+        costPerPoint[i] = static_cast<float>(rep->kind == Representation::Direct ? f.originalCost
+                                                                                 : f.dynamicCost);
+    }
+    return shadingCostImage(*dynamic_.layout(), dynamic_.visibility(), dynamic_.pointOptions(),
+                            costPerPoint);
+}
+
 std::vector<const ObjectRepresentation*> MultiphaseRenderer::representations() const {
     std::vector<const ObjectRepresentation*> out(slots_.size(), nullptr);
     for (size_t i = 0; i < slots_.size(); ++i) out[i] = slots_[i].representation.get();

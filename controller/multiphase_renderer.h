@@ -21,6 +21,7 @@
 #include "phases/dynamic_phase.h"
 #include "phases/reference_renderer.h"
 #include "phases/sample_layout_cache.h"
+#include "phases/shading_cost_image.h"
 
 namespace mpshade {
 
@@ -51,6 +52,12 @@ class MultiphaseRenderer : public Renderer {
     // The current representation of object i (null before a frame has seen it).
     const ObjectRepresentation* representation(size_t object) const;
     const FactoredShader& factored(size_t object) const;
+    // Per pixel, the shading points the last frame's dynamic phase made and their cost in
+    // opCost units: a drawn object's dynamic part per point, or its whole shader where it
+    // is drawn direct (phases/shading_cost_image.h). Before any frame, or when the last
+    // was rendered single-phase, empty (width 0). Points shaded again by the refinement
+    // (MultiphaseOptions::refine) are not in it: the frame's own pass is.
+    ShadingCostImage lastFrameShadingCost() const;
     // With MultiphaseOptions::refine on and a frame budget: the steps the frames that follow
     // refine their tiles to, better and better (tile_refiner.h); none: no refinement.
     void setRefineSteps(std::vector<RefineStep> steps) { refineSteps_ = std::move(steps); }

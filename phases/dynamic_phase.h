@@ -210,6 +210,12 @@ class DynamicPhase {
     const DynamicFrameStats& stats() const { return stats_; }
     const std::vector<ObjectFrameCost>& objectCosts() const { return costs_; }
     const VisibilityBuffer& visibility() const { return visibility_; }
+    // The last frame's sample layout (null before the first) and how its bands made their
+    // shading points from the visibility buffer.
+    const SampleLayout* layout() const { return layout_.get(); }
+    BandPointOptions pointOptions() const {
+        return {options_.shadingRate, options_.wholePixelShortcut};
+    }
 
   private:
     struct Band;
