@@ -306,7 +306,12 @@ std::vector<DynamicCause> causesOf(const IrProgram& p, const BindingTimes& bt,
             c.kind = "ambient_light", c.index = inst.imm;
             add(c);
         } else if (source) {
-            c.kind = "annotation";
+            // dynamic() in the source, or a binding's repeat (imm k + 1, lower.cpp), on this
+            // value or on the value the static work under it feeds.
+            const int32_t by = inst.op == Op::Dynamic ? defining[u] : bt.forcedBy[u];
+            const bool repeat = by >= 0 && p.insts[static_cast<size_t>(by)].op == Op::Dynamic &&
+                                p.insts[static_cast<size_t>(by)].imm > 0;
+            c.kind = repeat ? "override" : "annotation";
             add(c);
         }
         if (inst.op == Op::Bake) continue;

@@ -35,7 +35,8 @@ struct ChannelInfo {
 // One input that makes a line dynamic (or that a bake() freezes).
 struct DynamicCause {
     // "view" (I or E), "time", "parameter" (name: the parameter), "ambient_light" and
-    // "light" (index: the scene light), "annotation" (a dynamic() in the source).
+    // "light" (index: the scene light), "annotation" (a dynamic() in the source),
+    // "override" (the binding's repeat of it: scene "factoring", or factor --repeat).
     std::string kind;
     std::string name;
     int index = -1;

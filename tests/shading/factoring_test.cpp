@@ -483,11 +483,14 @@ TEST(Factoring, ARepeatOverrideUndoesABakeForItsBindingAlone) {
     b.overrides.push_back(o);
     const FactoredShader r = factorShader(*onlyRead, b);
     EXPECT_EQ(r.bakedLines.size(), 1u);
-    bool named = false;
-    for (const DynamicLine& line : r.dynamicLines)
+    bool named = false, kind = false;
+    for (const DynamicLine& line : r.dynamicLines) {
         for (const std::string& step : line.chain)
             named = named || step.find("the binding repeats 'w'") != std::string::npos;
+        for (const DynamicCause& c : line.causes) kind = kind || c.kind == "override";
+    }
     EXPECT_TRUE(named);
+    EXPECT_TRUE(kind);
 }
 
 TEST(Factoring, AnnotationsThatDoNothingAreWarnedOf) {
