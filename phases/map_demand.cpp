@@ -72,25 +72,64 @@ struct FrameDemand {
     int finest = 0;
 };
 
-FrameDemand frameDemand(const ChartCells& cells, const MapDemand& d, int maxLevel, int tile,
-                        bool closed, const FrameState& frame, const ObjectState& state,
-                        RTCScene world, double footprint, const ProbeOptions& probe,
-                        std::unordered_set<uint64_t>& asked) {
+// A cell of the grid, or a quarter of one: its centre, the surface there, and how many
+// times it was split (its side is 1 / (k 2^depth) of its chart's).
+struct Cell {
+    ChartPoint at;
+    SurfaceSample g;
+    int depth = 0;
+};
+
+// A cell is split while it spans more than this many pixels as seen from the eye, so no
+// cell is counted by a centre far from most of what it covers: a floor seen at a grazing
+// angle from close by, whose near cells straddle the image's edge or the near plane.
+constexpr double kSplitPixels = 8.0;
+constexpr int kMaxDepth = 16;
+constexpr size_t kMaxCells = 1 << 18;  // per object and frame, split or not
+
+FrameDemand frameDemand(const Surface& surface, const ChartCells& cells, const MapDemand& d,
+                        int maxLevel, int tile, bool closed, const FrameState& frame,
+                        const ObjectState& state, RTCScene world, double footprint,
+                        const ProbeOptions& probe, std::unordered_set<uint64_t>& asked) {
     const CameraState& camera = frame.camera;
     const glm::mat3 linear(state.objectToWorld);
     const double ppu = 0.5 * camera.height / camera.tanHalfFovY;
-    const double R = d.resolution, k = cells.k;
+    const double R = d.resolution;
     asked.clear();
     FrameDemand out;
     out.finest = maxLevel;
-    for (size_t c = 0; c < cells.at.size(); ++c) {
-        const SurfaceSample& g = cells.geometry[c];
+    std::vector<Cell> stack;
+    for (size_t c = 0; c < cells.at.size(); ++c)
+        stack.push_back({cells.at[c], cells.geometry[c], 0});
+    size_t visited = 0;
+    ChartPoint quarters[4];
+    SurfaceSample quarterGeometry[4];
+    while (!stack.empty()) {
+        const Cell cell = stack.back();
+        stack.pop_back();
+        ++visited;
+        const SurfaceSample& g = cell.g;
+        const double size = 1.0 / (cells.k * double(1 << cell.depth));  // chart units a side
         const glm::vec3 P = glm::vec3(state.objectToWorld * glm::vec4(g.P, 1.0f));
         const glm::vec3 p = P - camera.eye;
+        const double reach =
+            0.5 * size *
+            (double(glm::length(linear * g.dPdu)) + double(glm::length(linear * g.dPdv)));
+        if (cell.depth < kMaxDepth && visited + stack.size() + 4 <= kMaxCells &&
+            reach * ppu > kSplitPixels * double(glm::length(p))) {
+            const float q = static_cast<float>(0.25 * size);
+            for (int k = 0; k < 4; ++k)
+                quarters[k] = {cell.at.chart, cell.at.u + ((k & 1) ? q : -q),
+                               cell.at.v + ((k & 2) ? q : -q)};
+            evaluateBatch(surface, quarters, quarterGeometry);
+            for (int k = 0; k < 4; ++k)
+                stack.push_back({quarters[k], quarterGeometry[k], cell.depth + 1});
+            continue;
+        }
         if (glm::dot(p, camera.forward) <= camera.zNear) continue;
         float x, y;
-        if (!camera.project(P, x, y) || !(x >= 0.0f && y >= 0.0f && x <= camera.width &&
-                                          y <= camera.height))
+        if (!camera.project(P, x, y) ||
+            !(x >= 0.0f && y >= 0.0f && x <= camera.width && y <= camera.height))
             continue;
         if (closed && glm::dot(linear * g.Ng, p) >= 0.0f) continue;
         // Pixels per unit of u and of v; inverted, the chart units a pixel step spans (the
@@ -99,14 +138,15 @@ FrameDemand frameDemand(const ChartCells& cells, const MapDemand& d, int maxLeve
         const glm::dvec2 jv = screenDerivative(camera, ppu, p, linear * g.dPdv);
         const double det = ju.x * jv.y - ju.y * jv.x;
         if (!(std::fabs(det) > 1e-30) || hidden(world, camera.eye, P)) continue;
-        out.covered += std::fabs(det) * cells.stride / (k * k);
+        out.covered += std::fabs(det) * cells.stride * size * size;
         const double s = footprint * R / det;
         const double la = std::hypot(jv.y * s, ju.y * s), lb = std::hypot(jv.x * s, ju.x * s);
         const double major = std::max(la, lb);
         double minor = std::min(la, lb);
         // The level the probe reads (probe_batch.h footprintOf): the minor axis, widened.
         if (probe.cap == AnisotropyCap::ShrinkMajor) {
-            if (probe.levelAnisotropy > 0.0f) minor = std::max(minor, major / probe.levelAnisotropy);
+            if (probe.levelAnisotropy > 0.0f)
+                minor = std::max(minor, major / probe.levelAnisotropy);
         } else {
             minor = std::max(minor, major / probe.maxAnisotropy);
         }
@@ -116,29 +156,27 @@ FrameDemand frameDemand(const ChartCells& cells, const MapDemand& d, int maxLeve
         const int l0 = static_cast<int>(lod);
         const double t = lod - l0, halfBlend = 0.5 * std::min(1.0f, probe.levelBlend);
         const int l1 = std::min(l0 + 1, maxLevel);
-        const int level = l1 > l0 && (probe.levelBlend >= 1.0f ? t >= 1.0 : t >= 0.5 + halfBlend)
-                              ? l1
-                              : l0;
-        const int last = l1 > l0 && (probe.levelBlend >= 1.0f ? t > 0.0 : t > 0.5 - halfBlend)
-                             ? l1
-                             : l0;
+        const int level =
+            l1 > l0 && (probe.levelBlend >= 1.0f ? t >= 1.0 : t >= 0.5 + halfBlend) ? l1 : l0;
+        const int last =
+            l1 > l0 && (probe.levelBlend >= 1.0f ? t > 0.0 : t > 0.5 - halfBlend) ? l1 : l0;
         out.finest = std::min(out.finest, level);
         // The tiles the cell's points read on each level: points two a tile side within the
         // cell (a tile is filled when any probe lands in it, and the cell's box would count
         // every tile it grazes), or the cell's area where it is many tiles wide.
         for (int l = level; l <= last; ++l) {
             const double side = (R / double(1 << l)) / tile;  // tiles a chart side
-            const double extent = side / k;                    // the cell's, in tiles
+            const double extent = side * size;                // the cell's, in tiles
             if (extent > 4.0) {
                 out.tiles += extent * extent * cells.stride;
                 continue;
             }
             const int m = std::max(1, static_cast<int>(std::ceil(2.0 * extent)));
-            const double u0 = cells.at[c].u - 0.5 / k, v0 = cells.at[c].v - 0.5 / k;
+            const double u0 = cell.at.u - 0.5 * size, v0 = cell.at.v - 0.5 * size;
             for (int j = 0; j < m; ++j)
                 for (int i = 0; i < m; ++i) {
-                    const double u = u0 + (i + 0.5) / (m * k), v = v0 + (j + 0.5) / (m * k);
-                    asked.insert(tileId(cells.at[c].chart, l, static_cast<int64_t>(u * side),
+                    const double u = u0 + (i + 0.5) * size / m, v = v0 + (j + 0.5) * size / m;
+                    asked.insert(tileId(cell.at.chart, l, static_cast<int64_t>(u * side),
                                         static_cast<int64_t>(v * side)));
                 }
         }
@@ -155,8 +193,8 @@ std::vector<MapDemand> estimateMapDemands(const SceneResources& resources,
     const Scene& scene = resources.scene();
     const int width = options.width > 0 ? options.width : scene.settings.width;
     const int height = options.height > 0 ? options.height : scene.settings.height;
-    const int spp = options.samplesPerPixel > 0 ? options.samplesPerPixel
-                                                : scene.settings.samplesPerPixel;
+    const int spp =
+        options.samplesPerPixel > 0 ? options.samplesPerPixel : scene.settings.samplesPerPixel;
     const double footprint = options.footprintScale / std::sqrt(static_cast<double>(spp));
 
     std::vector<MapDemand> demands(objects.size());
@@ -182,17 +220,16 @@ std::vector<MapDemand> estimateMapDemands(const SceneResources& resources,
     std::unordered_set<uint64_t> asked;
     for (int f = 0; f < nFrames; ++f) {
         const int frame =
-            first + (nFrames == 1 ? 0
-                                  : static_cast<int>(std::lround(double(f) * (count - 1) /
-                                                                 (nFrames - 1))));
+            first + (nFrames == 1
+                         ? 0
+                         : static_cast<int>(std::lround(double(f) * (count - 1) / (nFrames - 1))));
         const FrameState state = frameStateAt(resources, frame, width, height, spp);
         const WorldRayScene world(resources, state.objects);
         for (size_t n = 0; n < objects.size(); ++n) {
             const Surface& surface = *scene.objects[objects[n]].surface;
-            const FrameDemand fd =
-                frameDemand(cells[n], demands[n], maxLevels[n], tiles[n], isClosed(surface), state,
-                            state.objects[objects[n]], world.scene(), footprint, options.probe,
-                            asked);
+            const FrameDemand fd = frameDemand(
+                surface, cells[n], demands[n], maxLevels[n], tiles[n], isClosed(surface), state,
+                state.objects[objects[n]], world.scene(), footprint, options.probe, asked);
             MapDemand& d = demands[n];
             if (fd.covered > 0.0 && fd.tiles > d.tiles) {
                 d.tiles = fd.tiles;

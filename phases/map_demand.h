@@ -8,7 +8,9 @@
 // footprint's minor axis, widened to major / maxAnisotropy (probe.h, WidenMinor), and the
 // level above it. So over a grid of cells on each chart, at frames spread over the scene:
 // the screen Jacobian of the chart coordinates gives the footprint in texels, hence the
-// level; points two a tile side within the cell give the tiles it reads there. Cells
+// level; points two a tile side within the cell give the tiles it reads there. A cell
+// wider than a few pixels as seen from the eye is split in four until it is not (a floor
+// seen at a grazing angle from close by). Cells
 // outside the image, behind the near plane, facing away on a closed surface or hidden
 // behind another surface (a ray from the eye, through the frame's world) ask for nothing;
 // a transparent surface in front counts as hiding. The always-resident coarse levels (nine
@@ -26,25 +28,26 @@
 namespace mpshade {
 
 struct MapDemandOptions {
-    int points = 4096;            // cells over the charts, at most (at least one a chart)
-    int frames = 8;               // frames spread over the scene, first and last included
-    int firstFrame = 0, lastFrame = -1;  // the frames to spread over, [first, last); -1: the scene's
+    int points = 4096;  // cells over the charts, at most (at least one a chart)
+    int frames = 8;     // frames spread over the scene, first and last included
+    int firstFrame = 0,
+        lastFrame = -1;           // the frames to spread over, [first, last); -1: the scene's
     int width = 0, height = 0;    // the image; 0: the scene's
     int samplesPerPixel = 0;      // 0: the scene's
     float footprintScale = 1.0f;  // DynamicOptions::footprintScale
     ProbeOptions probe = DynamicOptions{}.probe;  // the level it reads (cap, levelAnisotropy)
-    int tileSize = 16;            // texels a tile side (ShaderMapOptions)
-    int border = 1;               // texels around each tile
+    int tileSize = 16;                            // texels a tile side (ShaderMapOptions)
+    int border = 1;                               // texels around each tile
 };
 
 struct MapDemand {
-    int resolution = 0;         // level-0 texels a chart side (the object's cap, a power of two)
-    int frame = -1;             // the frame that asks most; -1: no frame sees the object
-    double coveredPixels = 0.0; // the object's visible screen area at that frame
-    double tiles = 0.0;         // tiles that frame asks for
-    double pinnedTiles = 0.0;   // the always-resident levels' (play fills them up front)
-    int finestLevel = 0;        // the finest level any cell asks for at that frame
-    int tileTexels = 0;         // texels a tile holds, its border included
+    int resolution = 0;          // level-0 texels a chart side (the object's cap, a power of two)
+    int frame = -1;              // the frame that asks most; -1: no frame sees the object
+    double coveredPixels = 0.0;  // the object's visible screen area at that frame
+    double tiles = 0.0;          // tiles that frame asks for
+    double pinnedTiles = 0.0;    // the always-resident levels' (play fills them up front)
+    int finestLevel = 0;         // the finest level any cell asks for at that frame
+    int tileTexels = 0;          // texels a tile holds, its border included
 
     // Bytes of `count` tiles for an n-tuple of `channels` floats, 4 or 2 bytes each.
     double bytes(double count, int channels, bool half) const {

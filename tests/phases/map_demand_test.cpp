@@ -37,7 +37,8 @@ Scene squareScene(const std::string& name, double lod, bool occluder) {
       "duration": 0.1, "samples_per_pixel": 4},
       "camera": {"fov_y": 90, "near": 0.001, "eye": [0, 0, )"
                               << distance << R"(], "target": [0, 0, 0]},
-      "shaders": {"s": "s.sl"}, "objects": [)" << objects << "]}";
+      "shaders": {"s": "s.sl"}, "objects": [)"
+                              << objects << "]}";
     return loadScene(dir + name);
 }
 
@@ -78,6 +79,29 @@ TEST(MapDemand, WhatIsHiddenAsksForNothing) {
     EXPECT_DOUBLE_EQ(d.tiles, 32.0 * 64.0);
     const double side = 524288.0 / std::exp2(10.25);
     EXPECT_NEAR(d.coveredPixels, 0.5 * side * side, 0.01 * side * side);
+}
+
+TEST(MapDemand, AFloorSeenFromCloseByAtAGrazingAngleCoversHalfTheImage) {
+    // A 1000 x 1000 floor, the eye 0.2 above it looking level (fov_y 90, 640 x 480): every
+    // pixel below the horizon, the image's lower half, sees it (the floor's far edge is
+    // 1/20 of a pixel under the horizon). Its near cells are hundreds of pixels wide and
+    // straddle the image's edge, so they are split until each is a few pixels: counted by
+    // their centres alone, the lower half came out a twelfth of itself.
+    const std::string dir = ::testing::TempDir() + "mpshade_map_demand/";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "s.sl") << "surface s() { Ci = color(noise(P * 40)); }";
+    std::ofstream(dir + "floor.json") << R"({"settings": {"width": 640, "height": 480,
+      "fps": 10, "duration": 0.1, "samples_per_pixel": 4},
+      "camera": {"fov_y": 90, "near": 0.01, "far": 10000, "eye": [0, 0.2, 0],
+                 "target": [0, 0.2, -10]},
+      "shaders": {"s": "s.sl"},
+      "objects": [{"name": "floor", "geometry": {"type": "plane", "size": [1000, 1000]},
+                   "shader": "s"}]})";
+    const MapDemand d = demandOf(loadScene(dir + "floor.json"));
+    EXPECT_EQ(d.frame, 0);
+    EXPECT_NEAR(d.coveredPixels, 640.0 * 240.0, 0.02 * 640.0 * 240.0);
+    EXPECT_GT(d.tiles, 0.0);
+    EXPECT_TRUE(std::isfinite(d.tiles));
 }
 
 }  // namespace
