@@ -78,11 +78,18 @@ void checkRenderOptions(const RenderCommandOptions& options) {
 }
 
 // The frame's shading cost images (--cost-images) and their sums in its stats entry.
+// `noted`: whether a frame without one was reported already.
 void writeCostImages(const MultiphaseRenderer& renderer, const Scene& scene, const std::string& dir,
-                     int frame, nlohmann::json& entry) {
+                     int frame, nlohmann::json& entry, bool& noted) {
     const ShadingCostImage cost = renderer.lastFrameShadingCost();
     if (cost.width == 0) {
         entry["cost_image"] = nullptr;  // rendered single-phase: no dynamic phase to show
+        if (!noted)
+            std::fprintf(stderr,
+                         "mpshade: note: frame %d was rendered single-phase, so it has no cost "
+                         "image (--no-single-phase renders every frame multi-phase)\n",
+                         frame);
+        noted = true;
         return;
     }
     writeShadingCostImages(cost, dir, frame);
@@ -269,6 +276,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
     // Without a terminal (a farm's log), a line a frame instead of the bar.
     const bool lines = !options.quiet && !isatty(STDERR_FILENO);
     int skipped = 0;
+    bool notedNoCostImage = false;
     for (int frame = first; frame < last; ++frame) {
         if (options.skipExisting && frameImagesExist(options.outDir, frame)) {
             ++skipped;
@@ -284,7 +292,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
         });
         writeFrameImages(image, options.outDir, frame);
         nlohmann::json entry = renderFrameJson(scene, stats, multiphase, image);
-        if (options.costImages) writeCostImages(*multi, scene, options.outDir, frame, entry);
+        if (options.costImages)
+            writeCostImages(*multi, scene, options.outDir, frame, entry, notedNoCostImage);
         if (options.compare)
             compareFrame(frame, image, stats, render, options, *reference, referenceImage, entry);
         frames.push_back(entry);
