@@ -5,8 +5,9 @@
 //
 // The map is virtual (shader_map.h): level 0 is the object's resolution cap, and a frame
 // fills only the tiles its probes read. A probe reads the level whose texel matches the
-// footprint's minor axis, widened to major / maxAnisotropy (probe.h, WidenMinor), and the
-// level above it. So over a grid of cells on each chart, at frames spread over the scene:
+// footprint's minor axis, widened to major / levelAnisotropy (probe.h's ShrinkMajor cap;
+// major / maxAnisotropy otherwise), and the level above it where the narrow level blend
+// gives that weight. So over a grid of cells on each chart, at frames spread over the scene:
 // the screen Jacobian of the chart coordinates gives the footprint in texels, hence the
 // level; points two a tile side within the cell give the tiles it reads there. A cell
 // wider than a few pixels as seen from the eye is split in four until it is not (a floor
