@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/factor_measures.h"
+#include "controller/multiphase_options.h"
 #include "geometry/error.h"
 #include "phases/map_demand.h"
 #include "phases/scene_resources.h"
@@ -427,6 +428,39 @@ nlohmann::json groupsJson(const std::vector<SplitGroup>& groups) {
     return out;
 }
 
+// The frame whose maps, all objects together, ask for the most bytes at once, against the
+// tile cache that holds them in a render (MultiphaseOptions::mapMemoryBytes, --cache-mb):
+// over it, tiles are dropped and filled again within the frame's work.
+struct BusiestFrame {
+    int frame = -1;
+    double bytes = 0.0;
+    double cacheBytes = static_cast<double>(MultiphaseOptions{}.mapMemoryBytes);
+};
+
+void addToBusiest(std::vector<double>& byFrame, const MapDemand& d, int channels, bool half) {
+    if (byFrame.size() < d.frameTiles.size()) byFrame.resize(d.frameTiles.size(), 0.0);
+    for (size_t f = 0; f < d.frameTiles.size(); ++f)
+        byFrame[f] += channels > 0 ? d.bytes(d.frameTiles[f], channels, half) : 0.0;
+}
+
+BusiestFrame busiestFrame(const std::vector<double>& byFrame, const MapDemand& any) {
+    BusiestFrame b;
+    for (size_t f = 0; f < byFrame.size() && f < any.frames.size(); ++f)
+        if (byFrame[f] > b.bytes) b.frame = any.frames[f], b.bytes = byFrame[f];
+    return b;
+}
+
+void printBusiest(const BusiestFrame& b) {
+    if (b.frame < 0) return;
+    std::printf(
+        "  the frame that asks most of all the maps at once: frame %d, about %.2f MB; the "
+        "tile cache holds %.0f MB (render --cache-mb)%s\n",
+        b.frame, b.bytes / 1048576.0, b.cacheBytes / 1048576.0,
+        b.bytes > b.cacheBytes ? ": OVER it, so tiles are dropped and filled again within "
+                                 "a frame (raise --cache-mb, or store as binary16)"
+                               : "");
+}
+
 // The objects `options` asks to factor: the one named (with a shader file that is not its
 // own factored on its binding instead, said so) or every object of the scene.
 std::vector<size_t> objectsToFactor(Scene& scene, const FactorCommandOptions& options) {
@@ -485,6 +519,7 @@ int runFactorCommand(const FactorCommandOptions& options) {
     bool within = true;
     nlohmann::json all = nlohmann::json::array();
     std::vector<SplitGroup> groups;
+    std::vector<double> byFrame;  // bytes the maps ask for at each frame looked at
     for (size_t k = 0; k < objects.size(); ++k) {
         const SceneObject& object = scene.objects[objects[k]];
         const std::string file = options.shader.empty() ? object.shader->file : options.shader;
@@ -497,6 +532,7 @@ int runFactorCommand(const FactorCommandOptions& options) {
                                            "object '" + object.name + "' in " + options.scene, &map,
                                            options.json ? &doc : nullptr, &without);
         addToGroups(groups, object, f, map);
+        addToBusiest(byFrame, demands[k], f.chosenWidth, object.shadermapHalf);
         within = reportMeasures(options, f, without, resources, measures, objects[k],
                                 options.json ? &doc : nullptr) &&
                  within;
@@ -505,14 +541,20 @@ int runFactorCommand(const FactorCommandOptions& options) {
             all.push_back(std::move(doc));
         }
     }
+    const BusiestFrame busiest =
+        demands.empty() ? BusiestFrame{} : busiestFrame(byFrame, demands.front());
     if (options.json) {
-        const nlohmann::json out =
-            options.object.empty()
-                ? nlohmann::json{{"objects", all}, {"splits", groupsJson(groups)}}
-                : all[0];
+        nlohmann::json out = options.object.empty()
+                                 ? nlohmann::json{{"objects", all}, {"splits", groupsJson(groups)}}
+                                 : all[0];
+        if (options.object.empty())
+            out["busiest_frame"] = {{"frame", busiest.frame},
+                                    {"map_bytes", busiest.bytes},
+                                    {"cache_bytes", busiest.cacheBytes}};
         std::printf("%s\n", out.dump(2).c_str());
     } else if (options.object.empty()) {
         printGroups(groups, objects.size());
+        printBusiest(busiest);
     }
     return within ? 0 : 1;
 }

@@ -231,6 +231,8 @@ std::vector<MapDemand> estimateMapDemands(const SceneResources& resources,
                 surface, cells[n], demands[n], maxLevels[n], tiles[n], isClosed(surface), state,
                 state.objects[objects[n]], world.scene(), footprint, options.probe, asked);
             MapDemand& d = demands[n];
+            d.frames.push_back(frame);
+            d.frameTiles.push_back(fd.covered > 0.0 ? fd.tiles : 0.0);
             if (fd.covered > 0.0 && fd.tiles > d.tiles) {
                 d.tiles = fd.tiles;
                 d.frame = frame;

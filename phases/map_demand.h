@@ -49,6 +49,10 @@ struct MapDemand {
     double pinnedTiles = 0.0;    // the always-resident levels' (play fills them up front)
     int finestLevel = 0;         // the finest level any cell asks for at that frame
     int tileTexels = 0;          // texels a tile holds, its border included
+    // Every frame looked at, in order, and the tiles each asks for (0 where it does not see
+    // the object): the same frames for every object of one estimate.
+    std::vector<int> frames;
+    std::vector<double> frameTiles;
 
     // Bytes of `count` tiles for an n-tuple of `channels` floats, 4 or 2 bytes each.
     double bytes(double count, int channels, bool half) const {
