@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -309,11 +310,11 @@ void printFactoring(const FactorCommandOptions& options, const std::string& shad
 }
 
 // One factoring, printed or added to `json`; with a what-if, `without` (when set) gets the
-// split without it (else the split itself).
+// split without it.
 FactoredShader factorOne(const FactorCommandOptions& options, const std::string& shaderFile,
                          const ShaderAst& ast, const ShaderBinding& binding,
                          const std::string& bindingText, const BoundMap* map, nlohmann::json* json,
-                         FactoredShader* without = nullptr) {
+                         std::optional<FactoredShader>* without = nullptr) {
     FactorOptions factorOptions;
     factorOptions.storeAboveCost = options.storeAboveCost;
     const ShaderBinding asked = withWhatIfs(binding, options);
@@ -353,7 +354,6 @@ FactoredShader factorOne(const FactorCommandOptions& options, const std::string&
         }
         if (without) *without = std::move(base);
     }
-    if (without && asked.overrides.size() == binding.overrides.size()) *without = f;
     return f;
 }
 
@@ -526,15 +526,15 @@ int runFactorCommand(const FactorCommandOptions& options) {
         if (k > 0 && !options.json) std::printf("\n----\n\n");
         nlohmann::json doc;
         const BoundMap map{demands[k], object.shadermapHalf};
-        FactoredShader without;
+        std::optional<FactoredShader> without;
         const FactoredShader f = factorOne(options, file, *object.shader,
                                            objectBinding(scene, object, *object.shader, file),
                                            "object '" + object.name + "' in " + options.scene, &map,
                                            options.json ? &doc : nullptr, &without);
         addToGroups(groups, object, f, map);
         addToBusiest(byFrame, demands[k], f.chosenWidth, object.shadermapHalf);
-        within = reportMeasures(options, f, without, resources, measures, objects[k],
-                                options.json ? &doc : nullptr) &&
+        within = measures.report(f, without ? &*without : nullptr, objects[k],
+                                 options.json ? &doc : nullptr) &&
                  within;
         if (options.json) {
             if (options.object.empty()) doc["object"] = object.name;

@@ -13,13 +13,9 @@
 namespace mpshade {
 namespace {
 
-// --verify: the factored shader against the whole one, output by output.
-void printVerification(const SplitVerification& v, double tolerance, bool verdict = true) {
-    if (verdict)
-        std::printf(
-            "\nverified: %d points over the charts x %d frames, static part run at the "
-            "first, against the whole shader\n",
-            v.points, v.frames);
+// The table of a split's differences from the whole shader, output by output, then stored
+// channel by channel.
+void printDifferences(const SplitVerification& v) {
     std::printf("  %-12s %12s %12s %12s   %s\n", "", "max abs", "max relative", "rms",
                 "worst at (frame, chart, u, v)");
     auto row = [](const SplitDifference& d) {
@@ -33,9 +29,12 @@ void printVerification(const SplitVerification& v, double tolerance, bool verdic
             "bake() froze an input):\n");
         for (const SplitDifference& d : v.channels) row(d);
     }
-    if (verdict)
-        std::printf("  %s --tolerance %g (largest relative difference %.3g)\n",
-                    v.maxRelative() <= tolerance ? "within" : "OVER", tolerance, v.maxRelative());
+}
+
+// --verify's verdict.
+void printVerdict(const SplitVerification& v, double tolerance) {
+    std::printf("  %s --tolerance %g (largest relative difference %.3g)\n",
+                v.maxRelative() <= tolerance ? "within" : "OVER", tolerance, v.maxRelative());
 }
 
 // Where a static run freezes what a bake() reads: the first frame verified, as a render of
@@ -46,21 +45,9 @@ struct FrozenAt {
     glm::vec3 eye{0.0f};
 };
 
-FrozenAt frozenAt(const SceneResources& resources) {
-    const Scene& scene = resources.scene();
-    const FrameState s = frameStateAt(resources, 0, scene.settings.width, scene.settings.height, 1);
-    return {0, s.time, s.camera.eye};
-}
-
-// What the bakes of a binding cost, measured as --verify measures (split_verification.h).
-void printBakeMeasure(const SplitVerification& v, const FrozenAt& at) {
-    std::printf(
-        "\nwhat the bakes freeze: the static run's time and view, frame %d (t = %.3f s, the eye "
-        "at %.3g, %.3g, %.3g; a render starting later freezes them at its first frame, and a "
-        "static run again where the re-run triggers ask). Measured at %d points over the "
-        "charts x %d frames, against the whole shader:\n",
-        at.frame, at.time, at.eye.x, at.eye.y, at.eye.z, v.points, v.frames);
-    printVerification(v, 0.0, false);
+FrozenAt frozenAt(const Scene& scene) {
+    const float time = scene.frameTime(0);
+    return {0, time, cameraAt(scene, time, scene.settings.width, scene.settings.height).eye};
 }
 
 nlohmann::json frozenAtJson(const FrozenAt& at) {
@@ -139,37 +126,40 @@ SplitVerification SplitMeasures::withTheWhatIf(size_t object) {
     return verifySplit(*whatIfStatics_, *whatIfResources_, object);
 }
 
-bool reportMeasures(const FactorCommandOptions& options, const FactoredShader& f,
-                    const FactoredShader& without, const SceneResources& resources,
-                    SplitMeasures& measures, size_t object, nlohmann::json* doc) {
+bool SplitMeasures::report(const FactoredShader& f, const FactoredShader* without, size_t object,
+                           nlohmann::json* doc) {
+    const FactorCommandOptions& options = options_;
+    const Scene& scene = scene_;
     const bool baked = !f.bakedLines.empty();
-    if (!options.verify && !baked && without.bakedLines.empty()) return true;
-    const bool whatIf = !options.store.empty() || !options.repeat.empty();
-    const SplitVerification v =
-        whatIf ? measures.withTheWhatIf(object) : measures.asTheSceneHasIt(object);
+    if (!options.verify && !baked && !(without && !without->bakedLines.empty())) return true;
+    const SplitVerification v = without ? withTheWhatIf(object) : asTheSceneHasIt(object);
     if (doc) {
         if (options.verify) (*doc)["verify"] = verificationJson(v, options.tolerance);
         if (baked)
-            (*doc)["bake"] = {{"frozen_at", frozenAtJson(frozenAt(resources))},
+            (*doc)["bake"] = {{"frozen_at", frozenAtJson(frozenAt(scene))},
                               {"measured", verificationJson(v, options.tolerance)}};
-    } else if (baked) {
-        printBakeMeasure(v, frozenAt(resources));
-        if (options.verify)
-            std::printf("  %s --tolerance %g (largest relative difference %.3g)\n",
-                        v.maxRelative() <= options.tolerance ? "within" : "OVER", options.tolerance,
-                        v.maxRelative());
-    } else if (options.verify) {
-        printVerification(v, options.tolerance);
     } else {
-        std::printf(
-            "\nmeasured, as the split without the what-if has bakes: %d points over the "
-            "charts x %d frames, static part run at the first, against the whole "
-            "shader\n",
-            v.points, v.frames);
-        printVerification(v, options.tolerance, false);
+        if (baked) {
+            const FrozenAt at = frozenAt(scene);
+            std::printf(
+                "\nwhat the bakes freeze: the static run's time and view, frame %d (t = %.3f s, "
+                "the eye at %.3g, %.3g, %.3g; a render starting later freezes them at its first "
+                "frame, and a static run again where the re-run triggers ask). Measured at %d "
+                "points over the charts x %d frames, against the whole shader:\n",
+                at.frame, at.time, at.eye.x, at.eye.y, at.eye.z, v.points, v.frames);
+        } else {
+            std::printf(
+                "\n%s: %d points over the charts x %d frames, static part run at the first, "
+                "against the whole shader\n",
+                options.verify ? "verified"
+                               : "measured, as the split without the what-if has bakes",
+                v.points, v.frames);
+        }
+        printDifferences(v);
+        if (options.verify) printVerdict(v, options.tolerance);
     }
-    if (whatIf) {
-        const SplitVerification base = measures.asTheSceneHasIt(object);
+    if (without) {
+        const SplitVerification base = asTheSceneHasIt(object);
         if (doc) {
             (*doc)["what_if"]["without"]["max_relative"] = base.maxRelative();
             (*doc)["what_if"]["with"] = {{"max_relative", v.maxRelative()}};

@@ -39,6 +39,13 @@ class SplitMeasures {
     SplitVerification asTheSceneHasIt(size_t object);
     SplitVerification withTheWhatIf(size_t object);
 
+    // The measures of object `object`'s split `f` (--verify, its bakes, and with a what-if
+    // `without`, the split without it, measured beside it; null: no what-if), printed to
+    // stdout or, when `doc` is set, added to it. Measures nothing unless options.verify or
+    // either split has bakes. False when --verify finds the split over options.tolerance.
+    bool report(const FactoredShader& f, const FactoredShader* without, size_t object,
+                nlohmann::json* doc);
+
   private:
     const Scene& scene_;
     const SceneResources& resources_;
@@ -50,13 +57,5 @@ class SplitMeasures {
     std::unique_ptr<SceneResources> whatIfResources_;
     std::unique_ptr<StaticPhase> whatIfStatics_;
 };
-
-// The measures of object `object`'s split `f` (--verify, its bakes, the what-if against
-// `without`, the split without it), printed to stdout or, when `doc` is set, added to it.
-// Measures nothing unless options.verify or either split has bakes. False when --verify finds the
-// split over options.tolerance.
-bool reportMeasures(const FactorCommandOptions& options, const FactoredShader& f,
-                    const FactoredShader& without, const SceneResources& resources,
-                    SplitMeasures& measures, size_t object, nlohmann::json* doc);
 
 }  // namespace mpshade

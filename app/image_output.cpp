@@ -77,10 +77,11 @@ void writeFrameImages(const Image& image, const std::string& dir, int frame) {
                          [&] { writePng(image, base + ".png"); });
 }
 
-void writeShadingCostImages(const ShadingCostImage& cost, const std::string& dir, int frame) {
-    if (cost.width <= 0 || cost.height <= 0) return;
-    const std::string base =
-        (std::filesystem::path(dir) / fmt::format("cost_{:04d}", frame)).string();
+std::string writeShadingCostImages(const ShadingCostImage& cost, const std::string& dir,
+                                   int frame) {
+    if (cost.width <= 0 || cost.height <= 0) return {};
+    const std::string name = fmt::format("cost_{:04d}", frame);
+    const std::string base = (std::filesystem::path(dir) / name).string();
     const size_t pixels = static_cast<size_t>(cost.width) * cost.height;
     std::vector<float> planes(2 * pixels);
     float most = 0.0f;
@@ -102,6 +103,7 @@ void writeShadingCostImages(const ShadingCostImage& cost, const std::string& dir
         o[3] = 1.0f;
     }
     writePng(grey, base + ".png");
+    return name + ".exr";
 }
 
 bool frameImagesExist(const std::string& dir, int frame) {

@@ -21,9 +21,10 @@ bool frameImagesExist(const std::string& dir, int frame);
 // Frame `frame`'s shading cost (phases/shading_cost_image.h) as `render --cost-images`
 // writes it: DIR/cost_NNNN.exr, float channels "points" and "cost" (opCost units) per
 // pixel, and DIR/cost_NNNN.png, the cost as grey from 0 (black) to the frame's most costly
-// pixel (white). Nothing is written for an empty image.
+// pixel (white). Returns the EXR's name within `dir`; nothing is written for an empty image
+// (and "" returned).
 struct ShadingCostImage;
-void writeShadingCostImages(const ShadingCostImage& cost, const std::string& dir, int frame);
+std::string writeShadingCostImages(const ShadingCostImage& cost, const std::string& dir, int frame);
 // Reads any image OpenImageIO reads as linear RGBA floats (alpha 1 if it has none; the
 // first three channels as RGB, a single channel as grey). Throws InputError naming the
 // file when it cannot.

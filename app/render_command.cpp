@@ -92,13 +92,13 @@ void writeCostImages(const MultiphaseRenderer& renderer, const Scene& scene, con
         noted = true;
         return;
     }
-    writeShadingCostImages(cost, dir, frame);
+    const std::string file = writeShadingCostImages(cost, dir, frame);
     nlohmann::json objects = nlohmann::json::object();
     for (size_t i = 0; i < cost.objectPoints.size() && i < scene.objects.size(); ++i)
         if (cost.objectPoints[i] > 0.0)
             objects[scene.objects[i].name] = {{"points", cost.objectPoints[i]},
                                               {"cost", cost.objectCost[i]}};
-    entry["cost_image"] = {{"file", fmt::format("cost_{:04d}.exr", frame)},
+    entry["cost_image"] = {{"file", file},
                            {"points", cost.totalPoints()},
                            {"cost", cost.totalCost()},
                            {"objects", objects}};

@@ -539,8 +539,7 @@ void DynamicPhase::shadeBand(size_t band, bool acceptFallbacks, std::vector<Tile
     BandPoints& pts = scratch_->states[band].built ? scratch_->states[band] : s.work;
     if (!pts.built) {
         const auto began = Clock::now();
-        buildBandPoints(*layout_, visibility_, range, objects,
-                        {options_.shadingRate, options_.wholePixelShortcut}, pts, s.points);
+        buildBandPoints(*layout_, visibility_, range, objects, pointOptions(), pts, s.points);
         s.parts.points += secondsSince(began);
     }
 
