@@ -225,6 +225,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
     const int first = request.first, last = request.last;
     prepareOutputFolder(options.outDir);
 
+    const auto setupStart = std::chrono::steady_clock::now();
     std::unique_ptr<ReferenceRenderer> reference;
     if (ask.reference) reference = std::make_unique<ReferenceRenderer>(scene);
     std::unique_ptr<MultiphaseRenderer> multi;
@@ -239,6 +240,8 @@ int runRenderCommand(const RenderCommandOptions& options) {
     int planFirst = first, planLast = last;
     planRange(options, scene, first, last, planFirst, planLast);
     if (multi) multi->plan(planFirst, planLast, render);
+    const double setupSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - setupStart).count();
     Renderer& renderer = multiphase ? static_cast<Renderer&>(*multi) : *reference;
     ProgressBar bar(!options.quiet && isatty(STDERR_FILENO));
     bar.setFirst(first);
@@ -260,6 +263,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
             {"frames_requested", last - first},
             {"memory_limit_mb", request.memoryLimitBytes >> 20},
             {"peak_resident_mb", peakResidentBytes() >> 20},
+            {"setup_seconds", setupSeconds},
             {"total_wall_seconds",
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()},
             {"frames", frames}};

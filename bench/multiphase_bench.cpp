@@ -17,6 +17,7 @@
 #include "phases/facet_rasterizer.h"
 #include "phases/fixed_point_warp.h"
 #include "phases/reference_renderer.h"
+#include "phases/worker_threads.h"
 #include "scene/scene.h"
 
 #include <tbb/global_control.h>
@@ -159,7 +160,7 @@ void frameMultiphase(benchmark::State& state, const char* path, int representati
         stats.shadedPoints ? static_cast<double>(stats.dynamic.probes) / stats.shadedPoints : 0.0;
     // Each stage in nanoseconds per sample per core (stage_limits.h), the last frame's.
     MachineLimits cores;
-    cores.cores = std::max(1, tbb::this_task_arena::max_concurrency());
+    cores.cores = workerThreads();  // the threads that ran the frame
     for (const StageCost& c : dynamicStageCosts({stats}, f.options.samplesPerPixel, cores))
         state.counters["ns_" + c.name.substr(0, c.name.find(' '))] = c.nsPerSample;
 }

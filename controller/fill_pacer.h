@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <cstddef>
 
-#include <tbb/task_arena.h>
+#include "phases/worker_threads.h"
 
 namespace mpshade {
 
@@ -17,8 +17,7 @@ class FillPacer {
   public:
     // lastWorst: what remembered() of the previous pacer gave (0: nothing measured yet).
     explicit FillPacer(double lastWorst)
-        : perTile_(lastWorst),
-          threads_(static_cast<size_t>(tbb::this_task_arena::max_concurrency())) {}
+        : perTile_(lastWorst), threads_(static_cast<size_t>(workerThreads())) {}
 
     // Tiles the next chunk may take with `left` seconds to go; 0: stop here.
     size_t chunk(double left) const {

@@ -9,6 +9,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "phases/worker_threads.h"
+
 namespace mpshade {
 namespace {
 
@@ -37,7 +39,7 @@ double median(std::vector<double> v) {
 
 MachineLimits measureMachineLimits() {
     MachineLimits m;
-    m.cores = std::max(1, tbb::this_task_arena::max_concurrency());
+    m.cores = workerThreads();
     constexpr size_t kBytes = size_t{64} << 20;
     const std::unique_ptr<char[]> from(new char[kBytes]), to(new char[kBytes]);
     std::memset(from.get(), 1, kBytes);

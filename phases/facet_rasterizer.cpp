@@ -107,7 +107,7 @@ void setUp(const ScreenTriangle& tri, int64_t ox, int64_t oy, Setup& s) {
 // inside. The hot loop of the rasterizer: plain arithmetic on doubles that GCC vectorizes,
 // compiled for AVX2 and for the baseline, chosen at run time; one call per facet and tile,
 // since facets a few pixels across made the call per row cost as much as its work.
-__attribute__((target_clones("avx2", "default"))) uint32_t boxDepthTest(
+__attribute__((target_clones("avx512f", "avx2", "default"))) uint32_t boxDepthTest(
     const int32_t* fx, const int32_t* fy, size_t rows, size_t n, size_t stride, int32_t ox,
     int32_t oy, const Setup& s, bool edges, float* inv, uint32_t* object, uint32_t* facet,
     uint32_t o, uint32_t f) {

@@ -278,6 +278,9 @@ TEST(Cli, SppAndSeedOverrideTheScene) {
     EXPECT_GT(stats["memory_limit_mb"], 0);
     EXPECT_GT(stats["peak_resident_mb"], 0);
     EXPECT_LE(stats["peak_resident_mb"], stats["memory_limit_mb"]);
+    // Making the renderer (factoring, compiling, planning) takes time no frame counts.
+    EXPECT_GT(stats["setup_seconds"].get<double>(), 0.0);
+    EXPECT_LT(stats["setup_seconds"].get<double>(), 60.0);
 }
 
 struct BadRun {
