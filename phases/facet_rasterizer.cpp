@@ -105,7 +105,7 @@ void setUp(const ScreenTriangle& tri, int64_t ox, int64_t oy, Setup& s) {
 // Rows of samples against one facet, single layer: a depth test where the sample is
 // inside. `rows` runs of n samples, `stride` apart in every array. Returns the samples
 // inside. The hot loop of the rasterizer: plain arithmetic on doubles that GCC vectorizes,
-// compiled for AVX2 and for the baseline, chosen at run time; one call per facet and tile,
+// compiled for AVX-512, AVX2 and the baseline, chosen at run time; one call per facet and tile,
 // since facets a few pixels across made the call per row cost as much as its work.
 __attribute__((target_clones("avx512f", "avx2", "default"))) uint32_t boxDepthTest(
     const int32_t* fx, const int32_t* fy, size_t rows, size_t n, size_t stride, int32_t ox,
