@@ -36,7 +36,9 @@ def bodies(path):
             if depth <= 0:
                 break
             k += 1
-        name = re.search(r"([\w:~]+)\s*\(", lines[i])
+        # A GCC attribute before the name (target_clones) is not the name.
+        head = re.sub(r"__attribute__\(\(.*?\)\)\s*", "", lines[i])
+        name = re.search(r"([\w:~]+)\s*\(", head)
         yield (name.group(1) if name else lines[i].strip()), i + 1, k - i + 1
         i = k + 1
 
