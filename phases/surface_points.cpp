@@ -19,12 +19,19 @@ namespace {
 // constants once a run and its points four at a time, in vectors whose lanes do exactly
 // the scalar arithmetic, in the same order: the last points of a run, done one by one,
 // get the same bits as they would in a lane.
+// Without a branch: runs of a few points ended in a mispredicted one each (6% of this
+// file's time on the courtyard's frame).
 void findRuns(const SurfacePoints& points, std::vector<uint32_t>& runs) {
-    runs.clear();
-    for (size_t i = 0; i < points.n; ++i)
-        if (i == 0 || points.facet[i] != points.facet[i - 1])
-            runs.push_back(static_cast<uint32_t>(i));
-    runs.push_back(static_cast<uint32_t>(points.n));
+    const size_t n = points.n;
+    runs.resize(n + 1);
+    uint32_t* out = runs.data();
+    size_t count = 0;
+    for (size_t i = 0; i < n; ++i) {
+        out[count] = static_cast<uint32_t>(i);
+        count += (i == 0 || points.facet[i] != points.facet[i - 1]) ? 1 : 0;
+    }
+    out[count++] = static_cast<uint32_t>(n);
+    runs.resize(count);
 }
 
 // One facet's constants for step 1, broadcast: a lane type T is float or Float4.
