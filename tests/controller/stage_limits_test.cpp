@@ -3,7 +3,11 @@
 // core, the bytes each stage must stream and their time at a given bandwidth.
 #include <gtest/gtest.h>
 
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
 #include "controller/stage_limits.h"
+#include "phases/worker_threads.h"
 
 namespace mpshade {
 namespace {
@@ -78,6 +82,18 @@ TEST(StageLimits, TheMeasuredBandwidthIsPlausible) {
     EXPECT_GE(m.cores, 1);
     EXPECT_GT(m.bytesPerSecond, 1e8);   // above 100 MB/s
     EXPECT_LT(m.bytesPerSecond, 1e13);  // below 10 TB/s
+}
+
+// Per-core figures multiply by the threads a frame could use: under a --threads 1 limit
+// that is 1, whatever the arena's own concurrency says (counting every core had doubled
+// one thread's figures on this 2-core machine).
+TEST(StageLimits, CoresAreTheThreadsALimitLeaves) {
+    {
+        const tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        EXPECT_EQ(workerThreads(), 1);
+        EXPECT_EQ(measureMachineLimits().cores, 1);
+    }
+    EXPECT_EQ(workerThreads(), tbb::this_task_arena::max_concurrency());
 }
 
 }  // namespace
