@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 namespace mpshade {
 namespace {
@@ -200,9 +201,17 @@ __attribute__((target("avx2"))) void noiseLanesAvx2(const float* x, const float*
     const int n = kind == NoiseSum::Single ? 1 : octaves;
     for (int first = 0; first < m; first += kLanes) {
         const int count = std::min(kLanes, m - first);
+        // Whole vectors where eight lanes remain: lanes written one by one into a vector go
+        // through memory, a wider load then waiting on the stores.
         Lanes8 px = {}, py = {}, pz = {};
-        for (int l = 0; l < count; ++l)
-            px[l] = x[first + l], py[l] = y[first + l], pz[l] = z[first + l];
+        if (count == kLanes) {
+            std::memcpy(&px, x + first, sizeof px);
+            std::memcpy(&py, y + first, sizeof py);
+            std::memcpy(&pz, z + first, sizeof pz);
+        } else {
+            for (int l = 0; l < count; ++l)
+                px[l] = x[first + l], py[l] = y[first + l], pz[l] = z[first + l];
+        }
         Lanes8 sum = {};
         float amp = 1.0f, freq = 1.0f;
         for (int i = 0; i < n; ++i) {
@@ -226,7 +235,10 @@ __attribute__((target("avx2"))) void noiseLanesAvx2(const float* x, const float*
             amp *= 0.5f;
             freq *= 2.0f;
         }
-        for (int l = 0; l < count; ++l) out[first + l] = sum[l];
+        if (count == kLanes)
+            std::memcpy(out + first, &sum, sizeof sum);
+        else
+            for (int l = 0; l < count; ++l) out[first + l] = sum[l];
     }
 }
 
