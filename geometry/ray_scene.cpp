@@ -6,6 +6,8 @@
 #include <limits>
 
 #include <pmmintrin.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <xmmintrin.h>
 #include <glm/geometric.hpp>
 
@@ -48,77 +50,111 @@ void enableFlushToZero() {
     _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
 }
 
-SurfaceRayScene::SurfaceRayScene(const Surface& surface) : surface_(surface) {
-    RTCDevice device = embreeDevice();
-    scene_ = rtcNewScene(device);
-    rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+namespace {
 
-    if (const auto* cloud = std::get_if<PointCloud>(&surface)) {
-        RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
-        const size_t n = cloud->centers.size();
-        auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
-        auto* nb = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geom, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n));
-        for (size_t k = 0; k < n; ++k) {
-            v[4 * k + 0] = cloud->centers[k].x;
-            v[4 * k + 1] = cloud->centers[k].y;
-            v[4 * k + 2] = cloud->centers[k].z;
-            v[4 * k + 3] = cloud->radii[k];
-            nb[3 * k + 0] = cloud->normals[k].x;
-            nb[3 * k + 1] = cloud->normals[k].y;
-            nb[3 * k + 2] = cloud->normals[k].z;
-        }
-        rtcCommitGeometry(geom);
-        discGeom_ = rtcAttachGeometry(scene_, geom);
-        rtcReleaseGeometry(geom);
-    } else {
-        // A grid of (rate + 1)^2 exact surface points per chart, two triangles per cell.
-        std::vector<float> positions;
-        const int charts = chartCount(surface);
-        for (int chart = 0; chart < charts; ++chart) {
-            const int rate =
-                std::visit([&](const auto& s) { return s.tessellationRate(chart); }, surface);
-            const unsigned base = static_cast<unsigned>(vertexUV_.size() / 2);
-            for (int j = 0; j <= rate; ++j) {
-                for (int i = 0; i <= rate; ++i) {
-                    const float u = static_cast<float>(i) / rate, v = static_cast<float>(j) / rate;
-                    const glm::vec3 p = evaluate(surface, {chart, u, v}).P;
-                    positions.insert(positions.end(), {p.x, p.y, p.z});
-                    vertexUV_.insert(vertexUV_.end(), {u, v});
-                }
-            }
-            const unsigned row = static_cast<unsigned>(rate + 1);
-            for (unsigned j = 0; j < static_cast<unsigned>(rate); ++j) {
-                for (unsigned i = 0; i < static_cast<unsigned>(rate); ++i) {
-                    const unsigned a = base + j * row + i, b = a + 1, c = a + row + 1, d = a + row;
-                    triIndex_.insert(triIndex_.end(), {a, b, c, a, c, d});
-                    triChart_.insert(triChart_.end(), {chart, chart});
-                }
-            }
-        }
-        RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        const size_t nv = positions.size() / 3, nt = triChart_.size();
-        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-            geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
-        std::copy(positions.begin(), positions.end(), vb);
-        auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-            geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt));
-        std::copy(triIndex_.begin(), triIndex_.end(), ib);
-        rtcCommitGeometry(geom);
-        triGeom_ = rtcAttachGeometry(scene_, geom);
-        rtcReleaseGeometry(geom);
+unsigned attachDiscs(RTCDevice device, RTCScene scene, const PointCloud& cloud) {
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
+    const size_t n = cloud.centers.size();
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                          RTC_FORMAT_FLOAT4, 4 * sizeof(float), n));
+    auto* nb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n));
+    for (size_t k = 0; k < n; ++k) {
+        v[4 * k + 0] = cloud.centers[k].x;
+        v[4 * k + 1] = cloud.centers[k].y;
+        v[4 * k + 2] = cloud.centers[k].z;
+        v[4 * k + 3] = cloud.radii[k];
+        nb[3 * k + 0] = cloud.normals[k].x;
+        nb[3 * k + 1] = cloud.normals[k].y;
+        nb[3 * k + 2] = cloud.normals[k].z;
     }
-    rtcCommitScene(scene_);
+    rtcCommitGeometry(geom);
+    const unsigned id = rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+    return id;
+}
+
+}  // namespace
+
+// A grid of (rate + 1)^2 exact surface points per chart, two triangles per cell; the
+// charts evaluated in parallel, each into its own slice, so the result does not depend on
+// the threads.
+unsigned SurfaceRayScene::attachTessellation(RTCDevice device) const {
+    const int charts = chartCount(surface_);
+    std::vector<int> rates(static_cast<size_t>(charts));
+    std::vector<size_t> firstVertex(static_cast<size_t>(charts) + 1, 0);
+    for (int chart = 0; chart < charts; ++chart) {
+        rates[static_cast<size_t>(chart)] =
+            std::visit([&](const auto& s) { return s.tessellationRate(chart); }, surface_);
+        const size_t row = static_cast<size_t>(rates[static_cast<size_t>(chart)]) + 1;
+        firstVertex[static_cast<size_t>(chart) + 1] =
+            firstVertex[static_cast<size_t>(chart)] + row * row;
+    }
+    const size_t nv = firstVertex.back();
+    std::vector<float> positions(3 * nv);
+    vertexUV_.assign(2 * nv, 0.0f);
+    tbb::parallel_for(0, charts, [&](int chart) {
+        const int rate = rates[static_cast<size_t>(chart)];
+        size_t at = firstVertex[static_cast<size_t>(chart)];
+        for (int j = 0; j <= rate; ++j)
+            for (int i = 0; i <= rate; ++i, ++at) {
+                const float u = static_cast<float>(i) / rate, v = static_cast<float>(j) / rate;
+                const glm::vec3 p = evaluate(surface_, {chart, u, v}).P;
+                positions[3 * at] = p.x, positions[3 * at + 1] = p.y, positions[3 * at + 2] = p.z;
+                vertexUV_[2 * at] = u, vertexUV_[2 * at + 1] = v;
+            }
+    });
+    for (int chart = 0; chart < charts; ++chart) {
+        const unsigned rate = static_cast<unsigned>(rates[static_cast<size_t>(chart)]);
+        const unsigned base = static_cast<unsigned>(firstVertex[static_cast<size_t>(chart)]);
+        const unsigned row = rate + 1;
+        for (unsigned j = 0; j < rate; ++j)
+            for (unsigned i = 0; i < rate; ++i) {
+                const unsigned a = base + j * row + i, b = a + 1, c = a + row + 1, d = a + row;
+                triIndex_.insert(triIndex_.end(), {a, b, c, a, c, d});
+                triChart_.insert(triChart_.end(), {chart, chart});
+            }
+    }
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    const size_t nt = triChart_.size();
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+    std::copy(positions.begin(), positions.end(), vb);
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt));
+    std::copy(triIndex_.begin(), triIndex_.end(), ib);
+    rtcCommitGeometry(geom);
+    const unsigned id = rtcAttachGeometry(scene_, geom);
+    rtcReleaseGeometry(geom);
+    return id;
+}
+
+SurfaceRayScene::SurfaceRayScene(const Surface& surface) : surface_(surface) {}
+
+// Within an isolated arena: while the charts' parallel loop waits, this thread runs only
+// its own tasks, never an outer one that could ask for this scene again (call_once is not
+// reentrant).
+void SurfaceRayScene::buildNow() const {
+    tbb::this_task_arena::isolate([this] {
+        RTCDevice device = embreeDevice();
+        scene_ = rtcNewScene(device);
+        rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_ROBUST);
+        if (const auto* cloud = std::get_if<PointCloud>(&surface_))
+            discGeom_ = attachDiscs(device, scene_, *cloud);
+        else
+            triGeom_ = attachTessellation(device);
+        rtcCommitScene(scene_);
+    });
 }
 
 SurfaceRayScene::~SurfaceRayScene() {
-    rtcReleaseScene(scene_);
+    if (scene_) rtcReleaseScene(scene_);
 }
 
 bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, float bv, float tHit,
                                  const glm::vec3& org, const glm::vec3& dir,
                                  SurfaceHit& hit) const {
+    build();
     if (geomID == discGeom_) {
         const auto& cloud = std::get<PointCloud>(surface_);
         hit.at = cloud.chartPointOf(static_cast<int>(primID), org + tHit * dir);
@@ -181,6 +217,7 @@ bool SurfaceRayScene::resolveHit(unsigned geomID, unsigned primID, float bu, flo
 
 bool SurfaceRayScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tnear, float tfar,
                                 SurfaceHit& hit) const {
+    build();
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh{};
@@ -198,6 +235,7 @@ bool SurfaceRayScene::intersect(const glm::vec3& org, const glm::vec3& dir, floa
 void SurfaceRayScene::occluded(const float* const org[3], const float* const dir[3],
                                const uint8_t* active, int n, float tnear, float tfar,
                                uint8_t* blocked) const {
+    build();
     constexpr int kStream = 64;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);

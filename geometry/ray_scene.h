@@ -11,6 +11,7 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include <embree3/rtcore.h>
@@ -32,6 +33,10 @@ struct SurfaceHit {
     bool refined = false;  // Newton converged on the exact surface
 };
 
+// Built on first use (any query, scene() or triangleCount()), once, by whichever thread
+// asks first while the others wait: a run whose shader maps all come from a store never
+// traces an occlusion ray, and the tessellation (about 0.1 s for a subdivision vase) was
+// most of its set-up. The charts are tessellated in parallel.
 class SurfaceRayScene {
   public:
     // The surface must outlive this object.
@@ -40,7 +45,10 @@ class SurfaceRayScene {
     SurfaceRayScene(const SurfaceRayScene&) = delete;
     SurfaceRayScene& operator=(const SurfaceRayScene&) = delete;
 
-    RTCScene scene() const { return scene_; }
+    RTCScene scene() const {
+        build();
+        return scene_;
+    }
     const Surface& surface() const { return surface_; }
 
     // Turns an Embree hit on scene() (geomID, primID, barycentrics) of the object-space ray
@@ -61,16 +69,27 @@ class SurfaceRayScene {
     void occluded(const float* const org[3], const float* const dir[3], const uint8_t* active,
                   int n, float tnear, float tfar, uint8_t* blocked) const;
 
-    size_t triangleCount() const { return triChart_.size(); }
+    size_t triangleCount() const {
+        build();
+        return triChart_.size();
+    }
 
   private:
+    void build() const {
+        std::call_once(built_, [this] { buildNow(); });
+    }
+    void buildNow() const;
+    unsigned attachTessellation(RTCDevice device) const;  // the triangles' geometry id
+
     const Surface& surface_;
-    RTCScene scene_ = nullptr;
-    unsigned triGeom_ = RTC_INVALID_GEOMETRY_ID;
-    unsigned discGeom_ = RTC_INVALID_GEOMETRY_ID;
-    std::vector<int> triChart_;       // chart of each triangle
-    std::vector<unsigned> triIndex_;  // 3 vertex indices per triangle
-    std::vector<float> vertexUV_;     // (u, v) per tessellation vertex
+    // Set once by build(), read only after it.
+    mutable std::once_flag built_;
+    mutable RTCScene scene_ = nullptr;
+    mutable unsigned triGeom_ = RTC_INVALID_GEOMETRY_ID;
+    mutable unsigned discGeom_ = RTC_INVALID_GEOMETRY_ID;
+    mutable std::vector<int> triChart_;       // chart of each triangle
+    mutable std::vector<unsigned> triIndex_;  // 3 vertex indices per triangle
+    mutable std::vector<float> vertexUV_;     // (u, v) per tessellation vertex
 };
 
 }  // namespace mpshade
