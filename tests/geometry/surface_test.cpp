@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -181,6 +182,32 @@ TEST(SphereRays, MatchTheAnalyticIntersection) {
         ASSERT_TRUE(rays.intersect(org, dir, 0.0f, 100.0f, hit));
         const float expected = 10.0f - std::sqrt(4.0f - r2);
         EXPECT_NEAR(hit.t, expected, 2e-4f);
+    }
+}
+
+// The scene is built by the first query, whichever thread asks: queries racing from many
+// threads at once on a scene nobody has used yet all see it whole (the analytic answer).
+TEST(SphereRays, FirstQueriesFromManyThreadsAtOnce) {
+    const Surface sphere = Sphere{2.0f};
+    for (int round = 0; round < 4; ++round) {
+        const SurfaceRayScene rays(sphere);
+        std::vector<float> t(64, -1.0f);
+        std::vector<std::thread> threads;
+        for (int k = 0; k < 8; ++k)
+            threads.emplace_back([&, k] {
+                for (int i = k; i < 64; i += 8) {
+                    const float x = -1.5f + 3.0f * static_cast<float>(i) / 63.0f;
+                    SurfaceHit hit;
+                    if (rays.intersect({x, 0.0f, 10.0f}, {0, 0, -1}, 0.0f, 100.0f, hit))
+                        t[static_cast<size_t>(i)] = hit.t;
+                }
+            });
+        for (std::thread& th : threads) th.join();
+        for (int i = 0; i < 64; ++i) {
+            const float x = -1.5f + 3.0f * static_cast<float>(i) / 63.0f;
+            EXPECT_NEAR(t[static_cast<size_t>(i)], 10.0f - std::sqrt(4.0f - x * x), 2e-4f)
+                << "ray " << i << ", round " << round;
+        }
     }
 }
 
