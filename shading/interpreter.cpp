@@ -29,6 +29,8 @@ template <Op OP>
     for (int l = 0; l < m; ++l) o[l] = scalar::ternary(OP, a[l], b[l], c[l]);
 }
 
+constexpr float kNoOperand[ShaderKernel::kLanes] = {};
+
 // One batch of m lanes (from `start`) through the whole program. Cloned for AVX2 and the
 // baseline, chosen at run time: every op's loop over the lanes is inlined here, so the
 // AVX2 clone runs them eight lanes at a time. AVX2 implies no FMA, so nothing is
@@ -39,9 +41,10 @@ __attribute__((target_clones("avx2", "default"))) void runBatch(
     auto R = [&](int32_t r) { return regs + static_cast<size_t>(r) * ShaderKernel::kLanes; };
     for (const ExecInst& e : code) {
         float* o = R(e.out[0]);
-        const float* a = e.nin > 0 ? S[e.in[0]] : nullptr;
-        const float* b = e.nin > 1 ? S[e.in[1]] : nullptr;
-        const float* c = e.nin > 2 ? S[e.in[2]] : nullptr;
+        // An operand the op does not have reads zeros (no op reads past its own).
+        const float* a = e.nin > 0 ? S[e.in[0]] : kNoOperand;
+        const float* b = e.nin > 1 ? S[e.in[1]] : kNoOperand;
+        const float* c = e.nin > 2 ? S[e.in[2]] : kNoOperand;
         for (int k = 0; k < e.nout; ++k) S[e.out[k]] = R(e.out[k]);
         switch (e.op) {
             case Op::Global: {
