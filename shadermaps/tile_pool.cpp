@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <new>
+
+#include <sys/mman.h>
 
 #include "geometry/error.h"
 
@@ -10,6 +13,64 @@ namespace mpshade {
 TilePool::TilePool(size_t tileBytes)
     : tileBytes_(tileBytes),
       blocks_(std::make_unique<std::unique_ptr<Block>[]>(kMaxTiles / kTilesPerBlock)) {}
+
+namespace {
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitized = true;
+#else
+constexpr bool kAddressSanitized = false;
+#endif
+#else
+constexpr bool kAddressSanitized = false;
+#endif
+constexpr size_t kHugePage = size_t{2} << 20;
+constexpr size_t kChunkBytes = 4 * kHugePage;
+}  // namespace
+
+TilePool::Chunk::~Chunk() {
+    if (base && !owned) ::munmap(base, bytes);
+}
+
+// Under mutex_. Blocks are carved 64-byte aligned from the newest chunk; a block larger
+// than a chunk gets one of its own.
+unsigned char* TilePool::blockStorage(size_t bytes) {
+    if (kAddressSanitized) {
+        // Under AddressSanitizer each block is an allocation of its own, so a read past one
+        // is caught (mapped chunks carry no red zones).
+        auto chunk = std::make_unique<Chunk>();
+        chunk->owned = std::make_unique_for_overwrite<unsigned char[]>(bytes);
+        chunk->bytes = chunk->used = bytes;
+        unsigned char* at = chunk->owned.get();
+        chunks_.push_back(std::move(chunk));
+        return at;
+    }
+    const size_t need = (bytes + 63) & ~size_t{63};
+    if (chunks_.empty() || chunks_.back()->used + need > chunks_.back()->bytes) {
+        auto chunk = std::make_unique<Chunk>();
+        chunk->bytes = std::max(kChunkBytes, (need + kHugePage - 1) / kHugePage * kHugePage);
+        // One huge page more than needed, to start the chunk on a huge-page boundary.
+        const size_t mapped = chunk->bytes + kHugePage;
+        void* p =
+            ::mmap(nullptr, mapped, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (p == MAP_FAILED) throw std::bad_alloc();
+        auto* raw = static_cast<unsigned char*>(p);
+        auto* aligned = reinterpret_cast<unsigned char*>(
+            (reinterpret_cast<uintptr_t>(raw) + kHugePage - 1) & ~(kHugePage - 1));
+        if (aligned > raw) ::munmap(raw, static_cast<size_t>(aligned - raw));
+        const size_t tail = mapped - static_cast<size_t>(aligned - raw) - chunk->bytes;
+        if (tail > 0) ::munmap(aligned + chunk->bytes, tail);
+        ::madvise(aligned, chunk->bytes, MADV_HUGEPAGE);  // advice: a kernel may ignore it
+        chunk->base = aligned;
+        chunks_.push_back(std::move(chunk));
+    }
+    Chunk& c = *chunks_.back();
+    unsigned char* at = c.base + c.used;
+    c.used += need;
+    return at;
+}
 
 int TilePool::allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t stamp) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -28,8 +89,8 @@ int TilePool::allocate(ShaderMap* owner, uint64_t key, bool pinned, uint32_t sta
             // under perf (a pass over memory the fill then writes). The slack, read only by
             // whole-vector loads whose extra lanes are dropped, is zeroed.
             const size_t bytes = kTilesPerBlock * tileBytes_;
-            block->data = std::make_unique_for_overwrite<unsigned char[]>(bytes + kSlackBytes);
-            std::memset(block->data.get() + bytes, 0, kSlackBytes);
+            block->data = blockStorage(bytes + kSlackBytes);
+            std::memset(block->data + bytes, 0, kSlackBytes);
             for (std::atomic<uint32_t>& use : block->lastUse)
                 use.store(0, std::memory_order_relaxed);
             blocks_[blocks] = std::move(block);

@@ -7,6 +7,8 @@
 #include <random>
 #include <set>
 
+#include <cstring>
+
 #include <gtest/gtest.h>
 
 #include "shadermaps/half_float.h"
@@ -736,6 +738,34 @@ TEST(TilePool, MapsShareItAndEvictedSlotsAreReused) {
         EXPECT_EQ(pool->tilesHeld(), 12u);
     }
     EXPECT_EQ(pool->tilesHeld(), 0u);  // destroyed maps give their tiles back
+}
+
+// Slots' storage never overlaps and each block ends in zeroed slack, for tiles small (many
+// blocks a storage chunk) and large (a block bigger than a chunk): every slot's bytes
+// written with its own pattern read back whole after all are written.
+TEST(TilePool, SlotsOwnTheirBytesAcrossBlocksAndChunks) {
+    for (const size_t tileBytes : {size_t{3888}, size_t{200000}}) {
+        TilePool pool(tileBytes);
+        const int slots = tileBytes < 10000 ? 3000 : 100;  // 47 blocks; 2 blocks of 12.8 MB
+        std::vector<int> slot(static_cast<size_t>(slots));
+        for (int k = 0; k < slots; ++k) {
+            slot[static_cast<size_t>(k)] =
+                pool.allocate(nullptr, static_cast<uint64_t>(k), false, 0);
+            std::memset(pool.data(slot[static_cast<size_t>(k)]), k % 251, tileBytes);
+        }
+        for (int k = 0; k < slots; ++k) {
+            const unsigned char* d = pool.data(slot[static_cast<size_t>(k)]);
+            size_t wrong = 0;
+            for (size_t b = 0; b < tileBytes; ++b)
+                wrong += d[b] != static_cast<unsigned char>(k % 251);
+            ASSERT_EQ(wrong, 0u) << "slot " << k << ", tiles of " << tileBytes << " bytes";
+        }
+        // The slack after each block's last tile.
+        for (int k = 63; k < slots; k += 64) {
+            const unsigned char* end = pool.data(slot[static_cast<size_t>(k)]) + tileBytes;
+            for (size_t b = 0; b < TilePool::kSlackBytes; ++b) ASSERT_EQ(end[b], 0) << k;
+        }
+    }
 }
 
 }  // namespace
