@@ -7,7 +7,6 @@
 #include <string>
 
 #include <benchmark/benchmark.h>
-#include <tbb/task_arena.h>
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
 

@@ -7,7 +7,6 @@
 #include <memory>
 
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "phases/worker_threads.h"
 

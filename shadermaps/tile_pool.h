@@ -1,13 +1,15 @@
 // tile_pool.h -- storage for shader-map tiles shared by every map whose tiles have one size:
 // slots in blocks of 64, allocated as needed (the storage never moves), reused once freed.
-// Blocks are carved from 8 MiB regions of address space backed by huge pages where the
-// kernel grants them (pages become resident as tiles are written: at most one 2 MiB page
-// beyond what the blocks hold). A warm run's first frame read its tiles from the store 1.6-
-// 2.9x faster so (a page fault a tile before). Per slot it records which map holds it, under which
-// key, whether it is one of that map's always-resident levels, and when probes last used it, so a
-// cache can keep all the maps under one memory budget by dropping the tiles unused longest
-// (patent col. 10: "the tiles can be stored in and/or removed from a memory using a least
-// recently used (LRU) algorithm").
+// Per slot it records which map holds it, under which key, whether it is one of that map's
+// always-resident levels, and when probes last used it, so a cache can keep all the maps
+// under one memory budget by dropping the tiles unused longest (patent col. 10: "the tiles
+// can be stored in and/or removed from a memory using a least recently used (LRU)
+// algorithm").
+//
+// Blocks are carved from 8 MiB regions of address space the kernel is asked to back with
+// huge pages; pages become resident as tiles are written, at most one 2 MiB page beyond
+// what the blocks hold. A warm run's first frame read its tiles from the store 1.6-2.9x
+// faster so: with 4 KiB pages it took a page fault a tile.
 //
 // Each block ends in kSlackBytes of zeros, so probes may load a texel's channels in whole
 // vectors (8 floats for 5 channels) even at a block's last texel.
