@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "shading/noise_paths.h"
+
 namespace mpshade {
 namespace {
 
@@ -117,137 +119,8 @@ float snoise3(float x, float y, float z) {
 
 namespace {
 
-// Eight lanes at a time in AVX2 registers (GCC vector extensions), each lane computing
-// exactly what snoise3 computes for it, operation for operation, so the values are the
-// same bit for bit. Lanes whose input is not finite or whose lattice cell does not fit an
-// int32 are left to snoise3. Every function passing these vectors is compiled for AVX2
-// (passing them without AVX changes the ABI, which Clang refuses); machines without AVX2
-// take the one-point functions (four lanes in SSE registers had been no faster: the table
-// lookups stay one lane at a time).
-#define MPSHADE_AVX2 [[gnu::always_inline, gnu::target("avx2")]] inline
-using Lanes8 = float __attribute__((vector_size(32)));
-using Ints8 = int32_t __attribute__((vector_size(32)));
-constexpr int kLanes = 8;
-
-// floor(x) for |x| < 2^31 (exact: an integer-valued float) and its low byte.
-MPSHADE_AVX2 void latticeLanes(Lanes8 x, Ints8& cell, Lanes8& frac) {
-    const Ints8 t = __builtin_convertvector(x, Ints8);  // towards zero
-    const Lanes8 tf = __builtin_convertvector(t, Lanes8);
-    const Ints8 below = tf > x;  // -1 where truncation rounded up
-    const Ints8 f = t + below;
-    // x - floor(x) rounded once to float, as snoise3's exact double difference is.
-    frac = x - __builtin_convertvector(f, Lanes8);
-    cell = f & 255;
-}
-
-MPSHADE_AVX2 Lanes8 fadeLanes(Lanes8 t) {
-    return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f);
-}
-
-MPSHADE_AVX2 Lanes8 lerpLanes(Lanes8 t, Lanes8 a, Lanes8 b) {
-    return a + t * (b - a);
-}
-
-// kGradients' row for each lane's hash, as selects.
-MPSHADE_AVX2 Lanes8 gradLanes(Ints8 hash, Lanes8 x, Lanes8 y, Lanes8 z) {
-    const Ints8 h = hash & 15;
-    const Lanes8 one = {1, 1, 1, 1, 1, 1, 1, 1}, zero = {};
-    const Lanes8 su = (h & 1) != 0 ? -one : one, sv = (h & 2) != 0 ? -one : one;
-    const Ints8 vx = (h == 12) | (h == 14);
-    const Lanes8 gx = (h < 8 ? su : zero) + (vx != 0 ? sv : zero);
-    const Lanes8 gy = (h >= 8 ? su : zero) + (h < 4 ? sv : zero);
-    const Lanes8 gz = ((h >= 4) & ~vx) != 0 ? sv : zero;
-    return gx * x + gy * y + gz * z;
-}
-
-MPSHADE_AVX2 Lanes8 snoiseLanes(Lanes8 x, Lanes8 y, Lanes8 z) {
-    Ints8 X, Y, Z;
-    latticeLanes(x, X, x);
-    latticeLanes(y, Y, y);
-    latticeLanes(z, Z, z);
-    const uint8_t* p = kPerm.p.data();
-    // The eight corners' hashes, one lane at a time (table lookups).
-    Ints8 h[8];
-    for (int l = 0; l < kLanes; ++l) {
-        const int A = p[X[l]] + Y[l], AA = p[A] + Z[l], AB = p[A + 1] + Z[l];
-        const int B = p[X[l] + 1] + Y[l], BA = p[B] + Z[l], BB = p[B + 1] + Z[l];
-        h[0][l] = p[AA], h[1][l] = p[BA], h[2][l] = p[AB], h[3][l] = p[BB];
-        h[4][l] = p[AA + 1], h[5][l] = p[BA + 1], h[6][l] = p[AB + 1], h[7][l] = p[BB + 1];
-    }
-    const Lanes8 u = fadeLanes(x), v = fadeLanes(y), w = fadeLanes(z);
-    const Lanes8 x1 = x - 1.0f, y1 = y - 1.0f, z1 = z - 1.0f;
-    const Lanes8 r =
-        lerpLanes(w,
-                  lerpLanes(v, lerpLanes(u, gradLanes(h[0], x, y, z), gradLanes(h[1], x1, y, z)),
-                            lerpLanes(u, gradLanes(h[2], x, y1, z), gradLanes(h[3], x1, y1, z))),
-                  lerpLanes(v, lerpLanes(u, gradLanes(h[4], x, y, z1), gradLanes(h[5], x1, y, z1)),
-                            lerpLanes(u, gradLanes(h[6], x, y1, z1), gradLanes(h[7], x1, y1, z1))));
-    const Lanes8 one = {1, 1, 1, 1, 1, 1, 1, 1};
-    return r < -one ? -one : (r > one ? one : r);
-}
-
-// |x| < 2^30, so floor(x) fits an int32 (false for NaN and infinities): the lanes
-// snoiseLanes computes as snoise3 does.
-MPSHADE_AVX2 Ints8 inLatticeRange(Lanes8 x) {
-    const Ints8 magnitude = (Ints8)x & 0x7fffffff;
-    const Lanes8 limit = {0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f, 0x1p30f};
-    return (Lanes8)magnitude < limit;
-}
-
-enum class NoiseSum { Single, Fbm, Turbulence };
-
-__attribute__((target("avx2"))) void noiseLanesAvx2(const float* x, const float* y, const float* z,
-                                                    int octaves, NoiseSum kind, float* out, int m) {
-    const int n = kind == NoiseSum::Single ? 1 : octaves;
-    for (int first = 0; first < m; first += kLanes) {
-        const int count = std::min(kLanes, m - first);
-        // Whole vectors where eight lanes remain: lanes written one by one into a vector go
-        // through memory, a wider load then waiting on the stores.
-        Lanes8 px = {}, py = {}, pz = {};
-        if (count == kLanes) {
-            std::memcpy(&px, x + first, sizeof px);
-            std::memcpy(&py, y + first, sizeof py);
-            std::memcpy(&pz, z + first, sizeof pz);
-        } else {
-            for (int l = 0; l < count; ++l)
-                px[l] = x[first + l], py[l] = y[first + l], pz[l] = z[first + l];
-        }
-        Lanes8 sum = {};
-        float amp = 1.0f, freq = 1.0f;
-        for (int i = 0; i < n; ++i) {
-            Lanes8 fx = px * freq, fy = py * freq, fz = pz * freq;
-            const Ints8 inside = inLatticeRange(fx) & inLatticeRange(fy) & inLatticeRange(fz);
-            const Lanes8 zero = {};
-            const Lanes8 sx = inside != 0 ? fx : zero, sy = inside != 0 ? fy : zero,
-                         sz = inside != 0 ? fz : zero;
-            Lanes8 value = snoiseLanes(sx, sy, sz);
-            for (int l = 0; l < count; ++l)
-                if (!inside[l]) value[l] = snoise3(fx[l], fy[l], fz[l]);
-            if (kind == NoiseSum::Single) {
-                sum = value;
-                break;
-            }
-            if (kind == NoiseSum::Turbulence) {
-                const Ints8 bits = (Ints8)value & 0x7fffffff;
-                value = (Lanes8)bits;
-            }
-            sum += amp * value;
-            amp *= 0.5f;
-            freq *= 2.0f;
-        }
-        if (count == kLanes)
-            std::memcpy(out + first, &sum, sizeof sum);
-        else
-            for (int l = 0; l < count; ++l) out[first + l] = sum[l];
-    }
-}
-
-#undef MPSHADE_AVX2
-
-void noiseLanes(const float* x, const float* y, const float* z, int octaves, NoiseSum kind,
-                float* out, int m) {
-    static const bool avx2 = __builtin_cpu_supports("avx2");
-    if (avx2) return noiseLanesAvx2(x, y, z, octaves, kind, out, m);
+void noiseLanesPortable(const float* x, const float* y, const float* z, int octaves, NoiseSum kind,
+                        float* out, int m) {
     for (int l = 0; l < m; ++l) {
         switch (kind) {
             case NoiseSum::Single:
@@ -261,6 +134,12 @@ void noiseLanes(const float* x, const float* y, const float* z, int octaves, Noi
                 break;
         }
     }
+}
+
+void noiseLanes(const float* x, const float* y, const float* z, int octaves, NoiseSum kind,
+                float* out, int m) {
+    static const NoisePath path = fastestNoisePath();
+    noiseLanesOn(path, x, y, z, octaves, kind, out, m);
 }
 
 }  // namespace
@@ -310,6 +189,46 @@ float turbulence3(float x, float y, float z, int octaves) {
         freq *= 2.0f;
     }
     return sum;
+}
+
+const uint8_t* noisePermutation() {
+    return kPerm.p.data();
+}
+
+const float* noiseGradients(int axis) {
+    return axis == 0 ? kGradients.x : (axis == 1 ? kGradients.y : kGradients.z);
+}
+
+bool noisePathAvailable(NoisePath path) {
+    switch (path) {
+        case NoisePath::Portable:
+            return true;
+        case NoisePath::Avx2:
+            return __builtin_cpu_supports("avx2");
+        case NoisePath::Avx512Vbmi:
+            return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+                   __builtin_cpu_supports("avx512vbmi") && __builtin_cpu_supports("avx2");
+    }
+    return false;
+}
+
+NoisePath fastestNoisePath() {
+    for (NoisePath path : {NoisePath::Avx512Vbmi, NoisePath::Avx2})
+        if (noisePathAvailable(path)) return path;
+    return NoisePath::Portable;
+}
+
+void noiseLanesOn(NoisePath path, const float* x, const float* y, const float* z, int octaves,
+                  NoiseSum kind, float* out, int m) {
+    switch (path) {
+        case NoisePath::Avx512Vbmi:
+            return noiseLanesAvx512Vbmi(x, y, z, octaves, kind, out, m);
+        case NoisePath::Avx2:
+            return noiseLanesAvx2(x, y, z, octaves, kind, out, m);
+        case NoisePath::Portable:
+            break;
+    }
+    noiseLanesPortable(x, y, z, octaves, kind, out, m);
 }
 
 }  // namespace mpshade

@@ -14,6 +14,7 @@
 #include "shading/lighting.h"
 #include "shading/lighting_avx2.h"
 #include "shading/noise.h"
+#include "shading/noise_paths.h"
 #include "shading/shader_harness.h"
 
 namespace mpshade {
@@ -86,15 +87,20 @@ TEST(Noise, GoldenValuesAreStable) {
 }
 
 TEST(Noise, LanesAreTheOnePointValuesBitForBit) {
-    // The lane functions compute eight points at a time in vector registers; each value must
-    // be the one-point function's, bit for bit, at every scale, on lattice points, at tiny
-    // negatives (whose fraction rounds), beyond the vector path's range (2^30, left to the
-    // one-point function, whose value there is not zero where another coordinate is
-    // fractional) and at non-finite inputs, for run lengths that are not multiples of eight.
+    // The lane functions compute 8 or 16 points at a time in vector registers; each value
+    // must be the one-point function's, bit for bit, at every scale, on lattice points, at
+    // tiny negatives (whose fraction rounds), beyond the vector path's range (2^30, left to
+    // the one-point function, whose value there is not zero where another coordinate is
+    // fractional) and at non-finite inputs, for run lengths that are not multiples of the
+    // lane count -- by every build this processor runs, and by the one the public functions
+    // choose.
     std::mt19937 rng(23);
     constexpr int kMax = 203;
     std::vector<float> x(kMax), y(kMax), z(kMax), out(kMax);
     auto same = [](float a, float b) { return std::memcmp(&a, &b, sizeof(float)) == 0; };
+    std::vector<NoisePath> paths;
+    for (NoisePath path : {NoisePath::Portable, NoisePath::Avx2, NoisePath::Avx512Vbmi})
+        if (noisePathAvailable(path)) paths.push_back(path);
     for (float scale : {1e-30f, 1.0f, 37.0f, 5e4f, 2e9f, 3e38f}) {
         std::uniform_real_distribution<float> uni(-scale, scale);
         for (int i = 0; i < kMax; ++i) {
@@ -106,7 +112,7 @@ TEST(Noise, LanesAreTheOnePointValuesBitForBit) {
             if (i % 23 == 7) z[i] = std::numeric_limits<float>::quiet_NaN();
             if (i % 29 == 9) x[i] = -std::numeric_limits<float>::infinity();
         }
-        for (int m : {1, 8, 13, kMax}) {
+        for (int m : {1, 8, 13, 16, 17, 31, kMax}) {
             snoise3Lanes(x.data(), y.data(), z.data(), out.data(), m);
             for (int i = 0; i < m; ++i)
                 ASSERT_TRUE(same(out[i], snoise3(x[i], y[i], z[i])))
@@ -121,7 +127,48 @@ TEST(Noise, LanesAreTheOnePointValuesBitForBit) {
             for (int i = 0; i < m; ++i)
                 ASSERT_TRUE(same(out[i], turbulence3(x[i], y[i], z[i], 4)))
                     << scale << " lane " << i;
+            for (NoisePath path : paths) {
+                const int p = static_cast<int>(path);
+                noiseLanesOn(path, x.data(), y.data(), z.data(), 1, NoiseSum::Single, out.data(),
+                             m);
+                for (int i = 0; i < m; ++i)
+                    ASSERT_TRUE(same(out[i], snoise3(x[i], y[i], z[i])))
+                        << "path " << p << " scale " << scale << " lane " << i;
+                noiseLanesOn(path, x.data(), y.data(), z.data(), 7, NoiseSum::Fbm, out.data(), m);
+                for (int i = 0; i < m; ++i)
+                    ASSERT_TRUE(same(out[i], fbm3(x[i], y[i], z[i], 7)))
+                        << "path " << p << " scale " << scale << " lane " << i;
+                noiseLanesOn(path, x.data(), y.data(), z.data(), 3, NoiseSum::Turbulence,
+                             out.data(), m);
+                for (int i = 0; i < m; ++i)
+                    ASSERT_TRUE(same(out[i], turbulence3(x[i], y[i], z[i], 3)))
+                        << "path " << p << " scale " << scale << " lane " << i;
+            }
         }
+    }
+}
+
+TEST(Noise, EveryLatticeCellHashesAsTheOnePointFunction) {
+    // Points in each of the 256^3 cells' residues would take long; instead every cell
+    // coordinate 0..255 on each axis in turn (the others swept with it), with fractions
+    // that make all eight corners matter, so a lookup wrong for any index (a table half, a
+    // carry past 255) changes some value.
+    constexpr int kCells = 256 * 3;
+    std::vector<float> x(kCells), y(kCells), z(kCells), out(kCells);
+    for (int i = 0; i < kCells; ++i) {
+        const int c = i % 256, axis = i / 256;
+        const float a = static_cast<float>(c) + 0.31f, b = static_cast<float>(255 - c) + 0.77f;
+        const float d = static_cast<float>((c * 37) % 256) + 0.53f;
+        x[i] = axis == 0 ? a : (axis == 1 ? b : d);
+        y[i] = axis == 0 ? b : (axis == 1 ? d : a);
+        z[i] = axis == 0 ? d : (axis == 1 ? a : b) - 512.0f;  // negative cells wrap too
+    }
+    for (NoisePath path : {NoisePath::Avx2, NoisePath::Avx512Vbmi}) {
+        if (!noisePathAvailable(path)) continue;
+        noiseLanesOn(path, x.data(), y.data(), z.data(), 1, NoiseSum::Single, out.data(), kCells);
+        for (int i = 0; i < kCells; ++i)
+            ASSERT_EQ(out[i], snoise3(x[i], y[i], z[i]))
+                << "path " << static_cast<int>(path) << " cell " << i;
     }
 }
 
