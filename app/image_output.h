@@ -1,6 +1,5 @@
-// image_output.h -- reads images and writes frames with OpenImageIO: linear half-float RGBA
-// OpenEXR, and an sRGB-encoded 8-bit PNG for viewing. Kept apart so only this file pays for OIIO's
-// headers.
+// image_output.h -- reads images (with OpenImageIO, oiio_plugin.h) and writes frames: linear
+// half-float RGBA OpenEXR (exr_file.h) and an sRGB-encoded 8-bit PNG for viewing (png_file.h).
 #pragma once
 
 #include <string>

@@ -1,8 +1,6 @@
-// OpenImageIO bundles fmt with libfmt's include guards: include fmt first (see docs/building.md).
-#include <fmt/format.h>
-
 #include "app/store_export.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -10,8 +8,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 
+#include "app/oiio_loader.h"
 #include "app/output_files.h"
 #include "geometry/error.h"
 #include "shadermaps/half_float.h"
@@ -99,30 +98,33 @@ MapExport exportStoredMap(TileStore& store, const StoredMapSummary& map,
             images.push_back(std::move(image));
         }
         const std::filesystem::path path = dir / fmt::format("chart_{:04d}.exr", chart);
+        // Tiled and mip-mapped by OpenImageIO (oiio_plugin.h).
+        std::vector<std::string> names = info.channelNames;
+        names.emplace_back("filled");
+        std::vector<const char*> channelNames;
+        for (const std::string& name : names) channelNames.push_back(name.c_str());
+        std::vector<int> sizes;
+        std::vector<const float*> levelTexels;
+        for (const auto& level : images) {
+            sizes.push_back(level.size);
+            levelTexels.push_back(level.texels.data());
+        }
+        const char* attributeNames[] = {"mpshade:object", "mpshade:shader"};
+        const char* attributeValues[] = {info.object.c_str(), info.shader.c_str()};
+        const MpshadeMipmappedExr exr{static_cast<int>(levelTexels.size()),
+                                      sizes.data(),
+                                      levelTexels.data(),
+                                      outChannels,
+                                      channelNames.data(),
+                                      std::min(T, images[0].size),
+                                      finest,
+                                      2,
+                                      attributeNames,
+                                      attributeValues};
         writeAtomically(path, [&](const std::string& temporary) {
-            auto out = OIIO::ImageOutput::create("openexr");
-            if (!out) throw std::runtime_error(OIIO::geterror());
-            for (size_t k = 0; k < images.size(); ++k) {
-                OIIO::ImageSpec spec(images[k].size, images[k].size, outChannels,
-                                     OIIO::TypeDesc::FLOAT);
-                spec.channelnames = info.channelNames;
-                spec.channelnames.push_back("filled");
-                spec.alpha_channel = -1;
-                spec.tile_width = spec.tile_height = std::min(T, images[0].size);
-                spec.attribute("compression", "zip");
-                spec.attribute("textureformat", "Plain Texture");
-                spec.attribute("openexr:levelmode", 1);     // MIPMAP_LEVELS
-                spec.attribute("openexr:roundingmode", 0);  // ROUND_DOWN: R / 2^L
-                spec.attribute("mpshade:object", info.object);
-                spec.attribute("mpshade:shader", info.shader);
-                spec.attribute("mpshade:level", finest + static_cast<int>(k));
-                const auto mode =
-                    k == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendMIPLevel;
-                if (!out->open(temporary, spec, mode) ||
-                    !out->write_image(OIIO::TypeDesc::FLOAT, images[k].texels.data()))
-                    throw std::runtime_error(out->geterror());
-            }
-            if (!out->close()) throw std::runtime_error(out->geterror());
+            char error[512] = "";
+            if (!oiioPlugin().writeMipmappedExr(temporary.c_str(), &exr, error, sizeof error))
+                throw std::runtime_error(error);
         });
         ++result.charts;
     }

@@ -6,6 +6,8 @@ find_package(nlohmann_json CONFIG REQUIRED)
 find_package(fmt CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(OpenImageIO CONFIG REQUIRED)
+find_package(OpenEXR CONFIG REQUIRED)
+find_package(PNG REQUIRED)
 
 include(MpshadeImportedLibraries)
 

@@ -4,7 +4,9 @@
 
 # OpenImageIO's exported target names /usr/include/opencv4, which exists only when
 # libopencv-core-dev is installed; drop include directories that do not exist.
-get_target_property(_oiio_inc OpenImageIO::OpenImageIO INTERFACE_INCLUDE_DIRECTORIES)
+if(TARGET OpenImageIO::OpenImageIO)
+  get_target_property(_oiio_inc OpenImageIO::OpenImageIO INTERFACE_INCLUDE_DIRECTORIES)
+endif()
 if(_oiio_inc)
   set(_oiio_kept "")
   foreach(_dir IN LISTS _oiio_inc)

@@ -14,7 +14,8 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 PACKAGES=(
   cmake ninja-build g++ ccache pkg-config
-  libosd-dev libglm-dev libopenimageio-dev openimageio-tools libembree-dev libtbb-dev
+  libosd-dev libglm-dev libopenimageio-dev openimageio-tools libopenexr-dev libpng-dev
+  libembree-dev libtbb-dev
   libgtest-dev googletest libbenchmark-dev libcli11-dev nlohmann-json3-dev libfmt-dev libxxhash-dev
   gnuplot-nox help2man
   slurm-wlm munge

@@ -247,6 +247,14 @@ TEST(Cli, CompareMeasuresAndDrawsTheDifference) {
                   "/no/such/folder/d.png");
     EXPECT_EQ(bad.exitCode, 2);
     EXPECT_NE(bad.output.find("d.png"), std::string::npos) << bad.output;
+    // Images are read by the OpenImageIO module: one that cannot be loaded is an error that
+    // says what to set, exit 2, not a crash.
+    ::setenv("MPSHADE_OIIO_PLUGIN", (dir + "/no_such_module.so").c_str(), 1);
+    bad = mpshade("compare " + dir + "/a.exr " + dir + "/b.exr");
+    ::unsetenv("MPSHADE_OIIO_PLUGIN");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.output.find("MPSHADE_OIIO_PLUGIN"), std::string::npos) << bad.output;
+    EXPECT_NE(bad.output.find("no_such_module.so"), std::string::npos) << bad.output;
 }
 
 TEST(Cli, AFrameThatCannotBeWrittenNamesItsFileAndWhy) {
