@@ -5,6 +5,8 @@
 // facet is visible and their sizes are what dicing to a quarter-pixel flatness or half-pixel
 // edges gives (about one or two facets per pixel).
 //
+// Sample layout: made from nothing, as a run's first frame makes it.
+//
 // Resolve: samples to pixels through the reconstruction filter, with every pixel's samples
 // alike (one shading point a pixel, or one sample a pixel) or not, or every 2x2 block alike
 // (one shading point per 2x2 pixels).
@@ -88,6 +90,21 @@ BENCHMARK_CAPTURE(rasterGrid, cell05_spp1, 1, 0.5f)
     ->UseRealTime();
 BENCHMARK_CAPTURE(rasterGrid, cell4_spp4, 4, 4.0f)
     ->Name("Raster/640x360/4spp/facets_4px")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// A run's sample layout made from nothing, as its first frame makes it: positions, filter
+// taps and the per-pixel and per-block weights, their memory first touched.
+void buildLayout(benchmark::State& state, int width, int height, int spp) {
+    for (auto _ : state) {
+        const SampleLayout layout(width, height, spp, 1u);
+        benchmark::DoNotOptimize(&layout);
+    }
+    state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * width * height * spp);
+}
+
+BENCHMARK_CAPTURE(buildLayout, gallery, 480, 270, 4)
+    ->Name("SampleLayout/480x270/4spp")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -86,6 +86,12 @@ DynamicOptions MultiphaseRenderer::dynamicOptionsFor(const RenderOptions& option
         options.shadingRate.value_or(options_.shadingRate.value_or(scene_.settings.shadingRate));
     if (options.footprintScale > 0.0f) o.footprintScale = options.footprintScale;
     if (!options.reuseStillView) o.reuseBytes = 0;
+    // A camera or a placement animated: the first frame's view does not hold still.
+    bool viewAnimated =
+        scene_.camera.eye.varies() || scene_.camera.target.varies() || scene_.camera.up.varies();
+    for (const SceneObject& object : scene_.objects)
+        viewAnimated = viewAnimated || object.transform.animated();
+    o.keepFirstView = o.keepFirstView && !viewAnimated;
     return o;
 }
 

@@ -339,7 +339,7 @@ void DynamicPhase::compareWithLastView() {
         }
     const bool still = haveLastView_ && key == lastView_;
     reusing_ = options_.reuseBytes > 0 && still && lastViewWhole_;
-    keeping_ = options_.reuseBytes > 0 && (still || !haveLastView_);
+    keeping_ = options_.reuseBytes > 0 && (still || (!haveLastView_ && options_.keepFirstView));
     lastView_ = std::move(key);
     haveLastView_ = true;
     stats_.viewReused = reusing_;

@@ -72,6 +72,12 @@ struct DynamicOptions {
     // them at a frame whose view held still since the last (or at the first), up to this
     // many bytes in all (about 60 a shading point); 0: never.
     size_t reuseBytes = size_t{256} << 20;
+    // Whether a run's first frame keeps its inputs too, for a view expected to hold still;
+    // false: only a frame whose view held still since the last keeps them. A camera that
+    // moves from the first frame would pay for inputs it never replays: keeping them was
+    // 15-30 ms of a warm vase's first frame (its whole sequence 1.29-1.30x its steady
+    // frames against 1.21x, side by side).
+    bool keepFirstView = true;
 };
 
 // A shading point's probe footprint in pixels at `rate` with `spp` samples per pixel, before

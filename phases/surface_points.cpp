@@ -389,11 +389,17 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
         counters.probeSeconds += secondsSince(interpolated);
     }
 
-    runDynamicShader(view, batch.in, n, color, opacity, scratch, counters);
     if (missedCount > 0) {
         missedCount = 0;
         for (size_t i = 0; i < n; ++i) missedCount += missed[i];
     }
+    // Every point waits for a tile (a run's first frame): its results would be thrown away.
+    if (stopAtMissing && missedCount == n && n > 0) {
+        std::fill(color, color + 3 * n, 0.0f);
+        std::fill(opacity, opacity + 3 * n, 0.0f);
+        return missedCount;
+    }
+    runDynamicShader(view, batch.in, n, color, opacity, scratch, counters);
     return missedCount;
 }
 

@@ -189,6 +189,39 @@ TEST(MultiphaseRenderer, DistantLightStoredWhileTheObjectOnlySlides) {
     }
 }
 
+// A run's first frame keeps its shading inputs only where the view can hold still: a
+// camera or a placement animated from the start would pay for inputs it never replays.
+TEST(MultiphaseRenderer, KeepsTheFirstViewOnlyWhenNothingOfTheViewIsAnimated) {
+    Scene still = loadScene(test::sourcePath("examples/vase/scene.json"));
+    const float end = still.settings.duration;
+    for (Keyframes<glm::vec3>* k : {&still.camera.eye, &still.camera.target, &still.camera.up}) {
+        const glm::vec3 v = k->values.empty() ? glm::vec3(0, 1, 0) : k->values.front();
+        k->times = {0.0f};
+        k->values = {v};
+    }
+    const auto holdFirst = [](auto& keys) {
+        if (keys.values.size() > 1) keys = {{0.0f}, {keys.values.front()}};
+    };
+    for (SceneObject& object : still.objects) {
+        holdFirst(object.transform.translate);
+        holdFirst(object.transform.rotate);
+        holdFirst(object.transform.scale);
+    }
+    EXPECT_TRUE(MultiphaseRenderer(still).dynamicOptionsFor({}).keepFirstView);
+    for (int change = 0; change < 4; ++change) {
+        SCOPED_TRACE(change);
+        Scene scene = still;
+        Keyframes<glm::vec3>& moved = change == 0   ? scene.camera.eye
+                                      : change == 1 ? scene.camera.target
+                                      : change == 2 ? scene.camera.up
+                                                    : scene.objects.back().transform.translate;
+        const glm::vec3 from = moved.values.empty() ? glm::vec3(0.0f) : moved.values.front();
+        moved.times = {0.0f, end};
+        moved.values = {from, from + glm::vec3(0.1f, 0.0f, 0.0f)};
+        EXPECT_FALSE(MultiphaseRenderer(scene).dynamicOptionsFor({}).keepFirstView);
+    }
+}
+
 // shadermap_precision "half": the same frame within binary16's rounding, its maps in half
 // the bytes.
 TEST(MultiphaseRenderer, HalfPrecisionMapsMatchFloatOnesInHalfTheBytes) {

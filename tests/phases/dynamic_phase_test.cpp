@@ -319,6 +319,29 @@ TEST(DynamicPhase, AStillViewShadesItsKeptInputsBitForBit) {
     EXPECT_NE(frames[3], frames[4]);
 }
 
+TEST(DynamicPhase, WithoutKeepingTheFirstViewReplaysFromTheThirdStillFrame) {
+    // keepFirstView off (a caller whose camera moves from the start): frame 0 keeps nothing,
+    // frame 1, still since frame 0, shades afresh and keeps, frame 2 replays every point --
+    // the same bits as a phase that keeps nothing.
+    Frame f(test::sourcePath(kLamplight), Representation::ShaderMap, 64, 36);
+    DynamicPhase kept(f.scene), fresh(f.scene);
+    DynamicOptions late = f.options(ShadingRate::Sample);
+    late.keepFirstView = false;
+    DynamicOptions never = f.options(ShadingRate::Sample);
+    never.reuseBytes = 0;
+    const FrameState state = frameStateAt(f.resources, 0, 64, 36, kSpp);
+    for (int t = 0; t < 3; ++t) {
+        SCOPED_TRACE(t);
+        shadeWhole(f, kept, state, late);
+        shadeWhole(f, fresh, state, never);
+        const DynamicFrameStats& s = kept.stats();
+        EXPECT_EQ(s.viewReused, t >= 1);  // the view held still; what replays is below
+        EXPECT_EQ(s.pointsReplayed, t == 2 ? s.shadingPoints : 0u);
+        EXPECT_GT(s.shadingPoints, 1000u);
+        ASSERT_EQ(kept.samples().rgba, fresh.samples().rgba);
+    }
+}
+
 TEST(DynamicPhase, AnyChangeOfTheViewShadesAfresh) {
     // After two still frames, each change the inputs depend on: the camera, an object's
     // placement, a representation built again, the footprint. None replays; each equals a
