@@ -1,5 +1,7 @@
 // mpshade-bench: Google Benchmark harness. items_per_second is the figure to read:
 // samples/s for renderers, lanes/s (shaded points/s) for the interpreter.
+#include <algorithm>
+#include <iterator>
 #include <memory>
 #include <random>
 #include <string>
@@ -12,6 +14,7 @@
 #include "scene/scene_state.h"
 #include "scene/variability.h"
 #include "shading/factoring.h"
+#include "shading/lighting.h"
 #include "shading/shader_compiler.h"
 #include "shading/shading_batch.h"
 
@@ -134,6 +137,137 @@ void factoredPart(benchmark::State& state, const char* shaderName, bool dynamicP
     state.counters["channels"] = f.chosenWidth;
 }
 
+// The factored shader as factoredPart cuts it, over the vase's points, its n-tuple filled
+// by its static part: what the dynamic part reads.
+struct DynamicPart {
+    VasePoints v;
+    FactoredShader f;
+    std::vector<std::vector<float>> tuple;
+    std::vector<const float*> inChannels;
+
+    explicit DynamicPart(const char* shaderName) {
+        FactorOptions cut;
+        cut.storeAboveCost = 0;
+        f = factorShader(*exampleShader(shaderName), v.binding(), cut);
+        tuple.assign(f.staticPart.channelOutputs.size(), std::vector<float>(VasePoints::n));
+        std::vector<float*> outChannels;
+        for (auto& c : tuple) outChannels.push_back(c.data()), inChannels.push_back(c.data());
+        v.out.channels = outChannels.data();
+        std::vector<float> workspace;
+        ShadingCounters counters;
+        ShaderKernel(f.staticPart).run(v.uniforms, v.in, VasePoints::n, v.out, workspace, counters);
+        v.out.channels = nullptr;
+        v.in.channels = inChannels.data();
+    }
+};
+
+// The floor under any kernel that lights the dynamic part's points with the engine's lane
+// formulas (shading/lighting.h): its light operations alone, each over the points in runs
+// of the interpreter's width, arguments read where they lie (V = -I made beforehand, the
+// roughness or exponent its constant). A native kernel of the same shader does this work
+// and more, so Factored/<shader>/dynamic over this bounds from above how far the
+// interpreter is from native code (docs/factoring.md).
+void dynamicLightFloor(benchmark::State& state, const char* shaderName) {
+    DynamicPart d(shaderName);
+    const IrProgram& program = d.f.dynamicPart;
+    std::vector<float> constant(static_cast<size_t>(program.valueCount), 0.0f);
+    for (const Inst& i : program.insts)
+        if (i.op == Op::Const) constant[static_cast<size_t>(i.result)] = i.constant;
+    constexpr size_t n = VasePoints::n;
+    std::vector<float> view(3 * n), rgb(3 * n);
+    for (size_t c = 0; c < 3; ++c)
+        for (size_t i = 0; i < n; ++i) view[c * n + i] = -d.v.in.I[c][i];
+    struct LightOp {
+        Op op;
+        int light;
+        std::vector<float> param;
+    };
+    std::vector<LightOp> ops;
+    for (const Inst& i : program.insts) {
+        if (i.op != Op::Diffuse && i.op != Op::Specular && i.op != Op::Phong) continue;
+        const float param =
+            i.nargs > 9 ? constant[static_cast<size_t>(program.argsOf(i)[9])] : 0.0f;
+        ops.push_back({i.op, i.imm, std::vector<float>(n, param)});
+    }
+    for (auto _ : state) {
+        for (size_t first = 0; first < n; first += ShaderKernel::kLanes) {
+            const int m = static_cast<int>(std::min<size_t>(ShaderKernel::kLanes, n - first));
+            for (const LightOp& l : ops) {
+                const float* args[10] = {d.v.in.P[0] + first,  d.v.in.P[1] + first,
+                                         d.v.in.P[2] + first,  d.v.in.N[0] + first,
+                                         d.v.in.N[1] + first,  d.v.in.N[2] + first,
+                                         &view[first],         &view[n + first],
+                                         &view[2 * n + first], l.param.data() + first};
+                float* out[3] = {&rgb[first], &rgb[n + first], &rgb[2 * n + first]};
+                shadeLight(l.op, d.v.lights[static_cast<size_t>(l.light)], args, out, m);
+            }
+        }
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+    state.counters["light_ops"] = static_cast<double>(ops.size());
+}
+
+// marble.sl's dynamic part written by hand, over one run of up to the interpreter's width
+// from `first`: Ci = the stored n-tuple + Ks specular(N, -I, roughness) by the binding's
+// specular light, Oi = 1. Cloned for AVX2 as the interpreter's batch is, so both run
+// eight lanes at a time.
+__attribute__((target_clones("avx2", "default"))) void marbleRun(const ShadingInputs& in,
+                                                                 const LightSample& light,
+                                                                 size_t first, int m, size_t n,
+                                                                 float* ci, float* oi) {
+    constexpr float kKs = 0.5f, kRoughness = 0.25f;  // marble.sl's defaults
+    constexpr int kLanes = ShaderKernel::kLanes;
+    alignas(64) float view[3][kLanes], spec[3][kLanes], roughness[kLanes];
+    for (int i = 0; i < m; ++i) roughness[i] = kRoughness;
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < m; ++i) view[c][i] = -in.I[c][first + i];
+    const float* args[10] = {in.P[0] + first, in.P[1] + first, in.P[2] + first, in.N[0] + first,
+                             in.N[1] + first, in.N[2] + first, view[0],         view[1],
+                             view[2],         roughness};
+    float* out[3] = {spec[0], spec[1], spec[2]};
+    shadeLight(Op::Specular, light, args, out, m);
+    for (size_t c = 0; c < 3; ++c) {
+        const float* tuple = in.channels[c] + first;
+        float* o = ci + c * n + first;
+        float* a = oi + c * n + first;
+        for (int i = 0; i < m; ++i) o[i] = tuple[i] + kKs * spec[c][i], a[i] = 1.0f;
+    }
+}
+
+// marbleRun over the vase's points, checked against the interpreter's result (the same
+// operations in the same order, so the same bits) before timing.
+void nativeMarbleDynamic(benchmark::State& state) {
+    DynamicPart d("marble");
+    const IrProgram& program = d.f.dynamicPart;
+    int light = -1, specularOps = 0;
+    for (const Inst& i : program.insts)
+        if (i.op == Op::Specular) light = i.imm, ++specularOps;
+    if (specularOps != 1) return state.SkipWithError("marble's dynamic part changed");
+    constexpr size_t n = VasePoints::n, kLanes = ShaderKernel::kLanes;
+    std::vector<float> ci(3 * n), oi(3 * n);
+    const LightSample& specularLight = d.v.lights[static_cast<size_t>(light)];
+    auto run = [&] {
+        for (size_t first = 0; first < n; first += kLanes)
+            marbleRun(d.v.in, specularLight, first, static_cast<int>(std::min(kLanes, n - first)),
+                      n, ci.data(), oi.data());
+    };
+    enableFlushToZero();
+    run();
+    std::vector<float> workspace;
+    ShadingCounters counters;
+    ShaderKernel(program).run(d.v.uniforms, d.v.in, n, d.v.out, workspace, counters);
+    for (size_t c = 0; c < 3; ++c)
+        for (size_t i = 0; i < n; ++i)
+            if (ci[c * n + i] != d.v.out.Ci[c][i] || oi[c * n + i] != d.v.out.Oi[c][i])
+                return state.SkipWithError("the native marble kernel differs from the interpreter");
+    for (auto _ : state) {
+        run();
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * n));
+}
+
 BENCHMARK_CAPTURE(referenceRenderer, vase, "examples/vase/scene.json")
     ->Name("Reference/vase")
     ->Unit(benchmark::kMillisecond)
@@ -161,6 +295,12 @@ BENCHMARK_CAPTURE(interpreter, rust_over_paint, "rust_over_paint")
 BENCHMARK_CAPTURE(interpreter, plastic, "plastic")
     ->Name("Interpreter/plastic")
     ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(interpreter, patina_bronze, "patina_bronze")
+    ->Name("Interpreter/patina_bronze")
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(interpreter, weathered_stone, "weathered_stone")
+    ->Name("Interpreter/weathered_stone")
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace mpshade
@@ -173,13 +313,19 @@ namespace {
         ->Unit(benchmark::kMicrosecond);                         \
     BENCHMARK_CAPTURE(factoredPart, name##_dynamic, #name, true) \
         ->Name("Factored/" #name "/dynamic")                     \
+        ->Unit(benchmark::kMicrosecond);                         \
+    BENCHMARK_CAPTURE(dynamicLightFloor, name, #name)            \
+        ->Name("Factored/" #name "/dynamic_light_floor")         \
         ->Unit(benchmark::kMicrosecond);
 MPSHADE_FACTOR_BENCH(marble)
 MPSHADE_FACTOR_BENCH(wood)
 MPSHADE_FACTOR_BENCH(brick)
 MPSHADE_FACTOR_BENCH(rust_over_paint)
 MPSHADE_FACTOR_BENCH(plastic)
+MPSHADE_FACTOR_BENCH(patina_bronze)
+MPSHADE_FACTOR_BENCH(weathered_stone)
 #undef MPSHADE_FACTOR_BENCH
+BENCHMARK(nativeMarbleDynamic)->Name("Native/marble/dynamic")->Unit(benchmark::kMicrosecond);
 }  // namespace
 }  // namespace mpshade
 
