@@ -14,6 +14,13 @@
 namespace mpshade {
 namespace {
 
+// Room for n elements without shrinking: scratch shrunk for a small batch would be filled
+// with zeros again when the next batch is larger. Elements past n keep whatever they held.
+template <typename T>
+void growTo(std::vector<T>& v, size_t n) {
+    if (v.size() < n) v.resize(n);
+}
+
 // Points come in runs on one facet (the samples of a pixel, the pixels of a facet's row):
 // scratch.runs holds each run's first point, then n. The steps below take a facet's
 // constants once a run and its points four at a time, in vectors whose lanes do exactly
@@ -256,7 +263,7 @@ void chartQueries(const ObjectView& view, const FacetMesh& mesh, const SurfacePo
 size_t probeChannels(const ShaderMap& map, const ProbeOptions& probe, bool stopAtMissing, size_t n,
                      size_t channels, uint8_t* missed, SurfaceShadingScratch& scratch,
                      SurfaceShadingCounters& counters) {
-    scratch.probed.resize(n * channels);
+    growTo(scratch.probed, n * channels);
     scratch.reported.resize(8192);
     ProbeResidency residency;
     residency.missing = scratch.reported.data();
@@ -346,11 +353,11 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
     const size_t channels = shadingChannels(rep);
     ShadingBatch& batch = scratch.batch;
     batch.resize(n, channels);
-    if (useMap) scratch.queries.resize(n);
+    if (useMap) growTo(scratch.queries, n);
     float* rows[ShadingBatch::kInputRows];
     for (int r = 0; r < ShadingBatch::kInputRows; ++r) rows[r] = batch.row(r);
-    scratch.b1.resize(n), scratch.b2.resize(n);
-    if (useMap) scratch.derivatives.resize(4 * n);
+    growTo(scratch.b1, n), growTo(scratch.b2, n);
+    if (useMap) growTo(scratch.derivatives, 4 * n);
     const float* bary1 = scratch.b1.data();
     const float* bary2 = scratch.b2.data();
     const float* px = rows[ShadingBatch::P];

@@ -28,7 +28,8 @@ class ShadingBatch {
         kInputRows = 22
     };
 
-    // Makes room for n points and `channels` n-tuple channels (read or written).
+    // Makes room for n points and `channels` n-tuple channels (read or written); what the
+    // rows held before is left, not cleared.
     void resize(size_t n, size_t channels);
     size_t size() const { return n_; }
 
