@@ -8,7 +8,8 @@ void ShadingBatch::resize(size_t n, size_t channels) {
     n_ = n;
     // Grown only: a vector shrunk for a small batch would zero its tail again when the
     // next batch is larger (4% of a steady frame's shading instructions, the vase).
-    const size_t rowValues = (kInputRows + 6) * n, channelValues = std::max<size_t>(channels, 1) * n;
+    const size_t rowValues = (kInputRows + 6) * n,
+                 channelValues = std::max<size_t>(channels, 1) * n;
     if (rows_.size() < rowValues) rows_.resize(rowValues);
     if (channelData_.size() < channelValues) channelData_.resize(channelValues);
     channels_.resize(channels);
