@@ -124,6 +124,15 @@ struct Prober {
     int tileShift = 0, border = 1;
     size_t rowValues = 0;  // channel values per tile row, borders included
     size_t tileBytes = 0;
+    // lineInTile's tile per level parity: a tap whose 2x2 texels lie in the tile's storage,
+    // borders included, reads it, even where its texel belongs to the next tile: a line that
+    // crosses a tile's edge, and the query after it, no longer look the next tile up and
+    // then this one again. level -1: none.
+    struct TileWindow {
+        int chart = -1, level = -1, ox = 0, oy = 0;
+        const Storage* t = nullptr;
+    };
+    mutable TileWindow window[2];
     // Tiles prefetched lately, by slot (direct-mapped).
     static constexpr unsigned kPrefetchMemory = 256;
     mutable int prefetched[kPrefetchMemory];
@@ -347,8 +356,9 @@ struct Prober {
     // inlined at the call, the rest (lines near a level's edge or across tiles, missing
     // tiles, half storage, recency to report) is out of line: kept apart, the common case
     // compiles to a third of the instructions (callgrind, the vase's steady frame).
-    void lineAccumulate(int chart, int level, float u0, float v0, float du, float dv, int n,
-                        const float* weight, float scale, float* sum) const {
+    [[gnu::always_inline]] void lineAccumulate(int chart, int level, float u0, float v0, float du,
+                                               float dv, int n, const float* weight, float scale,
+                                               float* sum) const {
         if (fast && lineInTile(chart, level, u0, v0, du, dv, n, weight, scale, sum)) return;
         lineAccumulateAnywhere(chart, level, u0, v0, du, dv, n, weight, scale, sum);
     }
@@ -358,8 +368,9 @@ struct Prober {
     // texel lies in (a tile's border holds the next texel), the line's taps mostly one,
     // sometimes two. Returns false, having added nothing, if a tile is not resident or
     // the line is not inside.
-    bool lineInTile(int chart, int level, float u0, float v0, float du, float dv, int n,
-                    const float* weight, float scale, float* sum) const {
+    [[gnu::always_inline]] bool lineInTile(int chart, int level, float u0, float v0, float du,
+                                           float dv, int n, const float* weight, float scale,
+                                           float* sum) const {
         const float fres = levelRes[level];
         const float x0 = u0 * fres - 0.5f, y0 = v0 * fres - 0.5f;
         const float dx = du * fres, dy = dv * fres;
@@ -368,19 +379,28 @@ struct Prober {
         if (!(std::min(x0, xe) >= 0.0f && std::min(y0, ye) >= 0.0f &&
               std::max(x0, xe) < fres - 1.0f && std::max(y0, ye) < fres - 1.0f))
             return false;
-        int tx = -1, ty = -1, ox = 0, oy = 0;
-        const Storage* t = nullptr;
-        return sumLine(n, x0, y0, dx, dy, sum, [&](int i, float x, float y, auto* acc) {
+        TileWindow& w = window[level & 1];
+        if (w.chart != chart || w.level != level) {
+            w.chart = chart, w.level = level;
+            w.ox = w.oy = -(1 << 30);  // no tap fits: the first one looks its tile up
+        }
+        // A tap at texel ix reads ix and ix + 1: both within [ox - border, ox + size +
+        // border - 1], the tile's storage.
+        const unsigned reach = static_cast<unsigned>((1 << tileShift) + 2 * border - 2);
+        const bool whole = sumLine(n, x0, y0, dx, dy, sum, [&](int i, float x, float y, auto* acc) {
             const int ix = static_cast<int>(x), iy = static_cast<int>(y);
-            if ((ix >> tileShift) != tx || (iy >> tileShift) != ty) {
-                tx = ix >> tileShift, ty = iy >> tileShift;
-                ox = tx << tileShift, oy = ty << tileShift;
-                t = tileAt(chart, level, tx, ty);
+            if (static_cast<unsigned>(ix - w.ox + border) > reach ||
+                static_cast<unsigned>(iy - w.oy + border) > reach) {
+                const int tx = ix >> tileShift, ty = iy >> tileShift;
+                w.t = tileAt(chart, level, tx, ty);
+                if (!w.t) return false;
+                w.ox = tx << tileShift, w.oy = ty << tileShift;
             }
-            if (!t) return false;
-            accumulate<true>(t, ox, oy, x, y, weight[i] * scale, acc);
+            accumulate<true>(w.t, w.ox, w.oy, x, y, weight[i] * scale, acc);
             return true;
         });
+        if (!whole) w.level = -1;
+        return whole;
     }
 
     // Sums a line's n taps, from texel coordinates (x, y) by (dx, dy), into sum:
