@@ -261,16 +261,17 @@ void chartQueries(const ObjectView& view, const FacetMesh& mesh, const SurfacePo
 // probes found missing added to scratch.missing, sorted and without repeats. Returns how many
 // probes found a tile missing when stopping at missing ones (those points marked in `missed`).
 size_t probeChannels(const ShaderMap& map, const ProbeOptions& probe, bool stopAtMissing, size_t n,
-                     size_t channels, uint8_t* missed, SurfaceShadingScratch& scratch,
+                     uint8_t* missed, SurfaceShadingScratch& scratch,
                      SurfaceShadingCounters& counters) {
-    growTo(scratch.probed, n * channels);
     scratch.reported.resize(8192);
     ProbeResidency residency;
     residency.missing = scratch.reported.data();
     residency.capacity = scratch.reported.size();
     residency.stopAtMissing = stopAtMissing;
     residency.queryMissed = stopAtMissing ? missed : nullptr;
-    probeShaderMap(map, probe, {scratch.queries.data(), n}, scratch.probed.data(), &residency);
+    // Straight into the batch's channel rows, where the dynamic shader reads them.
+    probeShaderMap(map, probe, {scratch.queries.data(), n},
+                   ProbeOutput{nullptr, scratch.batch.out.channels}, &residency);
     counters.probes += residency.bilinearProbes;
     counters.fallbacks += residency.fallbacks;
     counters.missingProbes += residency.missingProbes;
@@ -285,11 +286,6 @@ size_t probeChannels(const ShaderMap& map, const ProbeOptions& probe, bool stopA
         for (auto it = first; it != end; ++it)
             if (scratch.missing.empty() || !(scratch.missing.back() == *it))
                 scratch.missing.push_back(*it);
-    }
-    ShadingBatch& batch = scratch.batch;
-    for (size_t c = 0; c < channels; ++c) {
-        float* dst = batch.channel(c);
-        for (size_t i = 0; i < n; ++i) dst[i] = scratch.probed[i * channels + c];
     }
     return stopAtMissing ? residency.missingProbes : 0;
 }
@@ -391,8 +387,7 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
     counters.interpolateSeconds += std::chrono::duration<double>(interpolated - began).count();
     size_t missedCount = 0;
     if (useMap && channels > 0) {
-        missedCount =
-            probeChannels(*rep.map, probe, stopAtMissing, n, channels, missed, scratch, counters);
+        missedCount = probeChannels(*rep.map, probe, stopAtMissing, n, missed, scratch, counters);
         counters.probeSeconds += secondsSince(interpolated);
     }
 

@@ -44,7 +44,7 @@ struct SurfacePoints {
 struct SurfaceShadingScratch {
     ShadingBatch batch;
     std::vector<ProbeQuery> queries;
-    std::vector<float> probed, workspace;
+    std::vector<float> workspace;
     std::vector<float> b1, b2;       // per point: barycentric weights
     std::vector<float> derivatives;  // their screen derivatives: 4 rows of n points
     std::vector<uint32_t> runs;      // the first point of each run on one facet, then n

@@ -6,7 +6,8 @@
 namespace mpshade {
 
 void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
-                    std::span<const ProbeQuery> queries, float* out, ProbeResidency* residency) {
+                    std::span<const ProbeQuery> queries, ProbeOutput out,
+                    ProbeResidency* residency) {
     if (!map.options().halfPrecision)
         return probeWith<FloatTexels>(map, options, queries, out, residency);
     // Half storage: the F16C conversions where the processor has them (every x86-64 since
@@ -17,7 +18,7 @@ void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
 }
 
 void probeShaderMapPortable(const ShaderMap& map, const ProbeOptions& options,
-                            std::span<const ProbeQuery> queries, float* out,
+                            std::span<const ProbeQuery> queries, ProbeOutput out,
                             ProbeResidency* residency) {
     if (!map.options().halfPrecision)
         return probeWith<FloatTexels>(map, options, queries, out, residency);

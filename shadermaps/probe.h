@@ -88,9 +88,23 @@ struct ProbeResidency {
         nullptr;  // caller's buffer, one per query: 1 where it found a tile missing
 };
 
-// Writes queries.size() * map.channels() floats to out, query by query.
+// Where a batch of probes writes its n-tuples: interleaved, query k's channels at
+// interleaved + k * channels, or one row per channel, channel c of query k at rows[c][k]
+// (the layout a shading batch reads, with no transposing pass). Exactly one is set.
+struct ProbeOutput {
+    float* interleaved = nullptr;
+    float* const* rows = nullptr;  // map.channels() rows of queries.size() floats
+};
+
 void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
-                    std::span<const ProbeQuery> queries, float* out,
+                    std::span<const ProbeQuery> queries, ProbeOutput out,
                     ProbeResidency* residency = nullptr);
+
+// Writes queries.size() * map.channels() floats to out, query by query.
+inline void probeShaderMap(const ShaderMap& map, const ProbeOptions& options,
+                           std::span<const ProbeQuery> queries, float* out,
+                           ProbeResidency* residency = nullptr) {
+    probeShaderMap(map, options, queries, ProbeOutput{out, nullptr}, residency);
+}
 
 }  // namespace mpshade

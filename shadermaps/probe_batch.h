@@ -89,7 +89,7 @@ inline Float4 queryDerivatives(const ProbeQuery& q) {
 
 template <int C, typename Texels>
 void probeAll(const ShaderMap& map, const ProbeOptions& options,
-              std::span<const ProbeQuery> queries, float* out, ProbeResidency* residency) {
+              std::span<const ProbeQuery> queries, ProbeOutput out, ProbeResidency* residency) {
     const int channels = C > 0 ? C : std::min(map.channels(), kMaxChannels);
     const Prober<C, Texels> p(map, residency, channels, map.levels() - 1);
     const float res0 = static_cast<float>(map.resolution(0));
@@ -198,7 +198,14 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
     uint8_t* queryMissed = residency ? residency->queryMissed : nullptr;
     for (size_t k = 0; k < queries.size(); ++k) {
         p.missed = false;
-        one(queries[k], out + k * static_cast<size_t>(channels));
+        float value[Prober<C, Texels>::kArr];
+        one(queries[k], value);
+        if (out.rows) {
+            for (int c = 0; c < channels; ++c) out.rows[c][k] = value[c];
+        } else {
+            float* o = out.interleaved + k * static_cast<size_t>(channels);
+            for (int c = 0; c < channels; ++c) o[c] = value[c];
+        }
         if (queryMissed) queryMissed[k] = p.missed ? 1 : 0;
     }
     if (residency) residency->bilinearProbes += p.fastProbes;
@@ -207,7 +214,7 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
 // probeShaderMap for Texels, the channel count made a compile-time constant up to 8.
 template <typename Texels>
 void probeWith(const ShaderMap& map, const ProbeOptions& options,
-               std::span<const ProbeQuery> queries, float* out, ProbeResidency* residency) {
+               std::span<const ProbeQuery> queries, ProbeOutput out, ProbeResidency* residency) {
     switch (map.channels()) {
         case 1:
             return probeAll<1, Texels>(map, options, queries, out, residency);

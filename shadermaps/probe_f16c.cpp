@@ -43,7 +43,7 @@ struct HalfTexelsF16C {
 }  // namespace
 
 void probeShaderMapF16C(const ShaderMap& map, const ProbeOptions& options,
-                        std::span<const ProbeQuery> queries, float* out,
+                        std::span<const ProbeQuery> queries, ProbeOutput out,
                         ProbeResidency* residency) {
     probeWith<HalfTexelsF16C>(map, options, queries, out, residency);
 }
@@ -76,7 +76,7 @@ bool probeF16CAvailable() {
     return false;
 }
 void probeShaderMapF16C(const ShaderMap& map, const ProbeOptions& options,
-                        std::span<const ProbeQuery> queries, float* out,
+                        std::span<const ProbeQuery> queries, ProbeOutput out,
                         ProbeResidency* residency) {
     probeShaderMapPortable(map, options, queries, out, residency);
 }

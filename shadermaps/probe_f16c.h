@@ -13,10 +13,11 @@ namespace mpshade {
 bool probeF16CAvailable();
 // probeShaderMap of a half-precision map by F16C. Only where probeF16CAvailable().
 void probeShaderMapF16C(const ShaderMap& map, const ProbeOptions& options,
-                        std::span<const ProbeQuery> queries, float* out, ProbeResidency* residency);
+                        std::span<const ProbeQuery> queries, ProbeOutput out,
+                        ProbeResidency* residency);
 // probeShaderMap in portable code only, whatever the processor.
 void probeShaderMapPortable(const ShaderMap& map, const ProbeOptions& options,
-                            std::span<const ProbeQuery> queries, float* out,
+                            std::span<const ProbeQuery> queries, ProbeOutput out,
                             ProbeResidency* residency);
 
 }  // namespace mpshade

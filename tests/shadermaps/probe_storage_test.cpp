@@ -95,8 +95,8 @@ TEST_P(HalfStorage, F16CAndPortableAgreeBitForBit) {
     const size_t values = qs.size() * static_cast<size_t>(GetParam());
     for (const ProbeOptions& o : everyFilter()) {
         std::vector<float> a(values), b(values);
-        probeShaderMapF16C(*maps.half, o, qs, a.data(), nullptr);
-        probeShaderMapPortable(*maps.half, o, qs, b.data(), nullptr);
+        probeShaderMapF16C(*maps.half, o, qs, ProbeOutput{a.data()}, nullptr);
+        probeShaderMapPortable(*maps.half, o, qs, ProbeOutput{b.data()}, nullptr);
         for (size_t i = 0; i < values; ++i)
             ASSERT_EQ(a[i], b[i]) << "filter " << static_cast<int>(o.filter) << " value " << i;
     }
@@ -125,6 +125,33 @@ TEST_P(HalfStorage, WithinHalfRoundingOfTheFloatMap) {
         // Not identical either: the half map is read, rounded.
         EXPECT_GT(worst, 0.01) << "filter " << static_cast<int>(o.filter);
     }
+}
+
+TEST_P(HalfStorage, RowsPerChannelHoldWhatTheInterleavedLayoutHolds) {
+    // The layout a shading batch reads: channel c of query k at rows[c][k], for float and
+    // half maps and every filter; rows past the last query are not written.
+    const int channels = GetParam();
+    const Maps maps(channels);
+    const std::vector<ProbeQuery> qs = spreadQueries();
+    const size_t n = qs.size();
+    for (const ShaderMap* map : {maps.full.get(), maps.half.get()})
+        for (const ProbeOptions& o : everyFilter()) {
+            std::vector<float> interleaved(n * static_cast<size_t>(channels));
+            probeShaderMap(*map, o, qs, interleaved.data());
+            std::vector<std::vector<float>> rows(static_cast<size_t>(channels),
+                                                 std::vector<float>(n + 1, -7.0f));
+            std::vector<float*> rowPointers;
+            for (auto& r : rows) rowPointers.push_back(r.data());
+            probeShaderMap(*map, o, qs, ProbeOutput{nullptr, rowPointers.data()});
+            for (size_t k = 0; k < n; ++k)
+                for (int c = 0; c < channels; ++c)
+                    ASSERT_EQ(
+                        rows[static_cast<size_t>(c)][k],
+                        interleaved[k * static_cast<size_t>(channels) + static_cast<size_t>(c)])
+                        << "filter " << static_cast<int>(o.filter) << " query " << k << " channel "
+                        << c;
+            for (const auto& r : rows) EXPECT_EQ(r[n], -7.0f);
+        }
 }
 
 INSTANTIATE_TEST_SUITE_P(Channels, HalfStorage, ::testing::Values(3, 5, 9));
