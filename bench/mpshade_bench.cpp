@@ -1,7 +1,6 @@
 // mpshade-bench: Google Benchmark harness. items_per_second is the figure to read:
 // samples/s for renderers, lanes/s (shaded points/s) for the interpreter.
 #include <algorithm>
-#include <iterator>
 #include <memory>
 #include <random>
 #include <string>
@@ -110,56 +109,40 @@ void interpreter(benchmark::State& state, const char* shaderName) {
     runKernelBench(state, *kernel, v);
 }
 
-// The factored shader's two parts over the same points: the static part (per map texel or
-// facet vertex, rarely) and the dynamic part (per sample, every frame). Read the ratio of
-// the dynamic part's time to the unfactored shader's (Interpreter/<shader>). The cut as the
-// minimum cut makes it, every static value stored (storeAboveCost 0): the plastic's static
-// part is then its diffuse light, the figure that sets FactorOptions::storeAboveCost.
-void factoredPart(benchmark::State& state, const char* shaderName, bool dynamicPart) {
-    VasePoints v;
-    FactorOptions cut;
-    cut.storeAboveCost = 0;
-    const FactoredShader f = factorShader(*exampleShader(shaderName), v.binding(), cut);
-    const ShaderKernel staticKernel(f.staticPart), dynamicKernel(f.dynamicPart);
-    std::vector<std::vector<float>> tuple(f.staticPart.channelOutputs.size(),
-                                          std::vector<float>(VasePoints::n));
-    std::vector<float*> outChannels;
-    std::vector<const float*> inChannels;
-    for (auto& c : tuple) outChannels.push_back(c.data()), inChannels.push_back(c.data());
-    v.out.channels = outChannels.data();
-    v.in.channels = inChannels.data();
-    if (dynamicPart) {
-        std::vector<float> workspace;
-        ShadingCounters counters;
-        staticKernel.run(v.uniforms, v.in, VasePoints::n, v.out, workspace, counters);
-    }
-    runKernelBench(state, dynamicPart ? dynamicKernel : staticKernel, v);
-    state.counters["channels"] = f.chosenWidth;
-}
-
-// The factored shader as factoredPart cuts it, over the vase's points, its n-tuple filled
-// by its static part: what the dynamic part reads.
-struct DynamicPart {
+// An example shader factored as the minimum cut makes it, every static value stored
+// (storeAboveCost 0), over the vase's points: its n-tuple (read and written in place)
+// filled by its static part, as the dynamic part reads it.
+struct FactoredVasePoints {
     VasePoints v;
     FactoredShader f;
     std::vector<std::vector<float>> tuple;
+    std::vector<float*> outChannels;
     std::vector<const float*> inChannels;
 
-    explicit DynamicPart(const char* shaderName) {
+    explicit FactoredVasePoints(const char* shaderName) {
         FactorOptions cut;
         cut.storeAboveCost = 0;
         f = factorShader(*exampleShader(shaderName), v.binding(), cut);
         tuple.assign(f.staticPart.channelOutputs.size(), std::vector<float>(VasePoints::n));
-        std::vector<float*> outChannels;
         for (auto& c : tuple) outChannels.push_back(c.data()), inChannels.push_back(c.data());
         v.out.channels = outChannels.data();
+        v.in.channels = inChannels.data();
         std::vector<float> workspace;
         ShadingCounters counters;
         ShaderKernel(f.staticPart).run(v.uniforms, v.in, VasePoints::n, v.out, workspace, counters);
-        v.out.channels = nullptr;
-        v.in.channels = inChannels.data();
     }
 };
+
+// The factored shader's two parts over the same points: the static part (per map texel or
+// facet vertex, rarely) and the dynamic part (per sample, every frame). Read the ratio of
+// the dynamic part's time to the unfactored shader's (Interpreter/<shader>). With every
+// static value stored, the plastic's static part is its diffuse light, the figure that sets
+// FactorOptions::storeAboveCost.
+void factoredPart(benchmark::State& state, const char* shaderName, bool dynamicPart) {
+    FactoredVasePoints d(shaderName);
+    runKernelBench(state, ShaderKernel(dynamicPart ? d.f.dynamicPart : d.f.staticPart), d.v);
+    state.counters["channels"] = d.f.chosenWidth;
+}
 
 // The floor under any kernel that lights the dynamic part's points with the engine's lane
 // formulas (shading/lighting.h): its light operations alone, each over the points in runs
@@ -168,7 +151,7 @@ struct DynamicPart {
 // and more, so Factored/<shader>/dynamic over this bounds from above how far the
 // interpreter is from native code (docs/factoring.md).
 void dynamicLightFloor(benchmark::State& state, const char* shaderName) {
-    DynamicPart d(shaderName);
+    FactoredVasePoints d(shaderName);
     const IrProgram& program = d.f.dynamicPart;
     std::vector<float> constant(static_cast<size_t>(program.valueCount), 0.0f);
     for (const Inst& i : program.insts)
@@ -238,7 +221,7 @@ __attribute__((target_clones("avx2", "default"))) void marbleRun(const ShadingIn
 // marbleRun over the vase's points, checked against the interpreter's result (the same
 // operations in the same order, so the same bits) before timing.
 void nativeMarbleDynamic(benchmark::State& state) {
-    DynamicPart d("marble");
+    FactoredVasePoints d("marble");
     const IrProgram& program = d.f.dynamicPart;
     int light = -1, specularOps = 0;
     for (const Inst& i : program.insts)
