@@ -9,6 +9,7 @@
 #include <cstring>
 #include <span>
 
+#include "shadermaps/feline_lanes.h"
 #include "shadermaps/prober.h"
 
 namespace mpshade {
@@ -77,31 +78,13 @@ Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy
     return f;
 }
 
-// A query's footprint (dudx, dvdx, dudy, dvdy) as one vector.
-inline Float4 queryDerivatives(const ProbeQuery& q) {
-    static_assert(offsetof(ProbeQuery, dvdx) == offsetof(ProbeQuery, dudx) + sizeof(float) &&
-                  offsetof(ProbeQuery, dudy) == offsetof(ProbeQuery, dudx) + 2 * sizeof(float) &&
-                  offsetof(ProbeQuery, dvdy) == offsetof(ProbeQuery, dudx) + 3 * sizeof(float));
-    Float4 v;
-    std::memcpy(&v, reinterpret_cast<const char*>(&q) + offsetof(ProbeQuery, dudx), sizeof v);
-    return v;
-}
-
 template <int C, typename Texels>
 void probeAll(const ShaderMap& map, const ProbeOptions& options,
               std::span<const ProbeQuery> queries, ProbeOutput out, ProbeResidency* residency) {
     const int channels = C > 0 ? C : std::min(map.channels(), kMaxChannels);
     const Prober<C, Texels> p(map, residency, channels, map.levels() - 1);
     const float res0 = static_cast<float>(map.resolution(0));
-    // The last Feline setup, for queries with the same footprint.
-    struct FelineSetup {
-        int chart = -1;
-        Float4 derivatives = {};  // dudx, dvdx, dudy, dvdy
-        float tolerance = -1.0f;  // no query shares the setup before the first
-        int n = 1, l0 = 0, l1 = 0;
-        float blend = 0.0f, offsetU = 0.0f, offsetV = 0.0f, du = 0.0f, dv = 0.0f;
-        float weights[kMaxTaps] = {};
-    } setup;
+    FelineSetup setup;  // the last one, for the queries after it with the same footprint
     auto one = [&](ProbeQuery q, float* o) {
         if (!std::isfinite(q.u)) q.u = 0.0f;
         if (!std::isfinite(q.v)) q.v = 0.0f;
@@ -111,11 +94,7 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
         // reference renderer within 0.02 dB either way (docs/shader-maps.md). The four
         // differences are compared at once: |d| <= tolerance is -tolerance <= d <= tolerance,
         // false for a NaN either way.
-        const Float4 derivatives = queryDerivatives(q);
-        const Float4 change = derivatives - setup.derivatives;
-        const auto within = (change <= setup.tolerance) & (change >= -setup.tolerance);
-        const bool sameFeline = options.filter == ProbeFilter::Feline && q.chart == setup.chart &&
-                                (within[0] & within[1] & within[2] & within[3]) != 0;
+        const bool sameFeline = options.filter == ProbeFilter::Feline && sharesSetup(setup, q);
         const Footprint f = sameFeline ? Footprint{}
                                        : footprintOf(q, res0,
                                                      options.filter == ProbeFilter::Trilinear
@@ -152,7 +131,7 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
         // samples of a pixel on one facet) mostly share it, so it is kept from the last.
         if (!sameFeline) {
             setup.chart = q.chart;
-            setup.derivatives = derivatives;
+            setup.derivatives = queryDerivatives(q);
             setup.tolerance = (1.0f / 16.0f) * std::max({std::fabs(q.dudx), std::fabs(q.dvdx),
                                                          std::fabs(q.dudy), std::fabs(q.dvdy)});
             const float minor = std::max(f.minor, 1e-30f);
@@ -196,17 +175,52 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
         for (int c = 0; c < channels; ++c) o[c] = sum[c];
     };
     uint8_t* queryMissed = residency ? residency->queryMissed : nullptr;
-    for (size_t k = 0; k < queries.size(); ++k) {
-        p.missed = false;
-        float value[Prober<C, Texels>::kArr];
-        one(queries[k], value);
+    auto write = [&](size_t k, const float* value) {
         if (out.rows) {
             for (int c = 0; c < channels; ++c) out.rows[c][k] = value[c];
         } else {
             float* o = out.interleaved + k * static_cast<size_t>(channels);
             for (int c = 0; c < channels; ++c) o[c] = value[c];
         }
+    };
+    constexpr int kVectors = Prober<C, Texels>::kVectors;
+    const bool lanes = kVectors > 0 && options.filter == ProbeFilter::Feline && p.fast;
+    // After lanes that probed nothing the next tries wait 1, 2, 4, then kLanes queries: where
+    // tiles are missing (a first pass) every try would fail.
+    size_t retry = 0, wait = 1;
+    for (size_t k = 0; k < queries.size();) {
+        // Up to kLanes at once where they share the setup (feline_lanes.h); else one, which
+        // makes the setup the next ones may share.
+        if constexpr (kVectors > 0) {
+            Float4 block[kLanes][kVectors > 0 ? kVectors : 1];
+            const int m =
+                lanes && k >= retry
+                    ? felineLanes(p, setup, queries.data() + k,
+                                  static_cast<int>(std::min<size_t>(kLanes, queries.size() - k)),
+                                  block)
+                    : 0;
+            if (m > 0) {
+                for (int j = 0; j < m; ++j) {
+                    float value[4 * (kVectors > 0 ? kVectors : 1)];
+                    for (int c = 0; c < kVectors; ++c) storeFloat4(value + 4 * c, block[j][c]);
+                    write(k + static_cast<size_t>(j), value);
+                }
+                if (queryMissed) std::fill(queryMissed + k, queryMissed + k + m, uint8_t{0});
+                k += static_cast<size_t>(m);
+                wait = 1;
+                continue;
+            }
+            if (lanes && k >= retry) {
+                retry = k + wait;
+                wait = std::min<size_t>(2 * wait, kLanes);
+            }
+        }
+        p.missed = false;
+        float value[Prober<C, Texels>::kArr];
+        one(queries[k], value);
+        write(k, value);
         if (queryMissed) queryMissed[k] = p.missed ? 1 : 0;
+        ++k;
     }
     if (residency) residency->bilinearProbes += p.fastProbes;
 }

@@ -1,7 +1,7 @@
 // prober.h -- the inner loops of shader-map probes (probe.h), for the files that build them
-// for one way of reading texels each: probe.cpp (float, and binary16 converted in
-// portable code) and probe_f16c.cpp (binary16 by the F16C conversion instructions, chosen
-// at run time). Everything here has internal linkage, so each file's copies are compiled
+// for one instruction set each: probe.cpp (portable: float, and binary16 converted in
+// portable code) and probe_avx2.cpp (AVX2, binary16 by the F16C conversion instructions,
+// chosen at run time). Everything here has internal linkage, so each file's copies are compiled
 // for its own instruction set and none replaces another's at link time.
 //
 // Texels, a policy type: Storage (float or uint16_t), kHalf (the map stores binary16),

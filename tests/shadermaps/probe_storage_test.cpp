@@ -1,7 +1,7 @@
-// Probes of half-precision shader maps: the F16C build and the portable one give the same
-// bits (both convert exactly), and both stay within binary16's rounding of the float map's
-// probes, on every filter and on the channel counts that take each path (3: one vector a
-// texel, 5: two, 9: channel by channel).
+// Probes of half-precision shader maps: the AVX2 build (F16C conversions) and the portable
+// one give the same bits (both convert exactly), and both stay within binary16's rounding of the
+// float map's probes, on every filter and on the channel counts that take each path (3: one vector
+// a texel, 5: two, 9: channel by channel).
 #include <cmath>
 #include <memory>
 #include <random>
@@ -10,46 +10,12 @@
 
 #include <gtest/gtest.h>
 
+#include "shadermaps/noise_maps.h"
 #include "shadermaps/probe.h"
-#include "shadermaps/probe_f16c.h"
-#include "shading/factoring.h"
-#include "shading/shader_compiler.h"
+#include "shadermaps/probe_avx2.h"
 
 namespace mpshade {
 namespace {
-
-// A shader whose static part is `channels` noise values (stored, not repeated), over a
-// 4 x 4 plane: a map in float and one in half, every level filled.
-struct Maps {
-    Surface surface = Plane{4.0f, 4.0f};
-    FactoredShader factored;
-    std::unique_ptr<ShaderKernel> kernel;
-    std::unique_ptr<ShaderMap> full, half;
-
-    explicit Maps(int channels) {
-        std::string body;
-        for (int c = 0; c < channels; ++c)
-            body += "  float a" + std::to_string(c) + " = noise(P * " + std::to_string(3 + c) +
-                    ") * " + std::to_string(1 + c) + ";\n";
-        std::string sum = "a0";
-        for (int c = 1; c < channels; ++c) sum += " * (1 + time) + a" + std::to_string(c);
-        const std::string source =
-            "surface s() {\n" + body + "  Ci = color(" + sum + " * (1 + time));\n}\n";
-        auto ast = compileShaderText("storage.sl", source);
-        FactorOptions store;
-        store.storeAboveCost = 0;
-        factored = factorShader(*ast, {}, store);
-        kernel = std::make_unique<ShaderKernel>(factored.staticPart);
-        ShaderMapOptions options;
-        options.resolution = 128;
-        full = std::make_unique<ShaderMap>(surface, *kernel, ShadingUniforms{}, options);
-        options.halfPrecision = true;
-        half = std::make_unique<ShaderMap>(surface, *kernel, ShadingUniforms{}, options);
-        full->fillLevels(0, full->levels() - 1);
-        half->fillLevels(0, half->levels() - 1);
-        EXPECT_EQ(full->channels(), channels);
-    }
-};
 
 // Queries spread over the chart with footprints from a tenth of a texel to most of the
 // chart, isotropic and up to 30:1 in any direction, plus exact level sizes.
@@ -88,14 +54,14 @@ std::vector<ProbeOptions> everyFilter() {
 
 class HalfStorage : public ::testing::TestWithParam<int> {};
 
-TEST_P(HalfStorage, F16CAndPortableAgreeBitForBit) {
-    if (!probeF16CAvailable()) GTEST_SKIP() << "no F16C on this processor";
-    const Maps maps(GetParam());
+TEST_P(HalfStorage, Avx2AndPortableAgreeBitForBit) {
+    if (!probeAvx2Available()) GTEST_SKIP() << "no AVX2 and F16C on this processor";
+    const NoiseMaps maps(GetParam());
     const std::vector<ProbeQuery> qs = spreadQueries();
     const size_t values = qs.size() * static_cast<size_t>(GetParam());
     for (const ProbeOptions& o : everyFilter()) {
         std::vector<float> a(values), b(values);
-        probeShaderMapF16C(*maps.half, o, qs, ProbeOutput{a.data()}, nullptr);
+        probeShaderMapAvx2(*maps.half, o, qs, ProbeOutput{a.data()}, nullptr);
         probeShaderMapPortable(*maps.half, o, qs, ProbeOutput{b.data()}, nullptr);
         for (size_t i = 0; i < values; ++i)
             ASSERT_EQ(a[i], b[i]) << "filter " << static_cast<int>(o.filter) << " value " << i;
@@ -107,7 +73,7 @@ TEST_P(HalfStorage, WithinHalfRoundingOfTheFloatMap) {
     // convex combination of texels, so its error is at most 2^-11 times the largest
     // texel magnitude it read -- bounded here by the channel's scale, (1 + c).
     const int channels = GetParam();
-    const Maps maps(channels);
+    const NoiseMaps maps(channels);
     const std::vector<ProbeQuery> qs = spreadQueries();
     for (const ProbeOptions& o : everyFilter()) {
         std::vector<float> x(qs.size() * static_cast<size_t>(channels)), y(x.size());
@@ -131,7 +97,7 @@ TEST_P(HalfStorage, RowsPerChannelHoldWhatTheInterleavedLayoutHolds) {
     // The layout a shading batch reads: channel c of query k at rows[c][k], for float and
     // half maps and every filter; rows past the last query are not written.
     const int channels = GetParam();
-    const Maps maps(channels);
+    const NoiseMaps maps(channels);
     const std::vector<ProbeQuery> qs = spreadQueries();
     const size_t n = qs.size();
     for (const ShaderMap* map : {maps.full.get(), maps.half.get()})

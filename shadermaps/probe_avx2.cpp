@@ -1,9 +1,9 @@
-#include "shadermaps/probe_f16c.h"
+#include "shadermaps/probe_avx2.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 
 // Every header the probe code uses comes in before the target switch, so only the code
-// below is built for F16C (and the AVX it implies): inline functions of those headers,
+// below is built for AVX2 and F16C: inline functions of those headers,
 // which the linker may merge with other files' copies, stay baseline.
 #include <cpuid.h>
 #include <immintrin.h>
@@ -19,12 +19,14 @@
 #include "shadermaps/shader_map.h"
 
 #if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("f16c"))), apply_to = function)
+#pragma clang attribute push(__attribute__((target("avx2,f16c"))), apply_to = function)
 #else
 #pragma GCC push_options
-#pragma GCC target("f16c")
+#pragma GCC target("avx2,f16c")
 #endif
 
+// Eight queries a vector (feline_lanes.h): GCC does not define __AVX2__ for a target pragma.
+#define MPSHADE_PROBE_LANES 8
 #include "shadermaps/probe_batch.h"
 
 namespace mpshade {
@@ -42,9 +44,11 @@ struct HalfTexelsF16C {
 
 }  // namespace
 
-void probeShaderMapF16C(const ShaderMap& map, const ProbeOptions& options,
+void probeShaderMapAvx2(const ShaderMap& map, const ProbeOptions& options,
                         std::span<const ProbeQuery> queries, ProbeOutput out,
                         ProbeResidency* residency) {
+    if (!map.options().halfPrecision)
+        return probeWith<FloatTexels>(map, options, queries, out, residency);
     probeWith<HalfTexelsF16C>(map, options, queries, out, residency);
 }
 
@@ -58,12 +62,12 @@ void probeShaderMapF16C(const ShaderMap& map, const ProbeOptions& options,
 
 namespace mpshade {
 
-bool probeF16CAvailable() {
+bool probeAvx2Available() {
     // F16C is CPUID leaf 1, ECX bit 29 (not every compiler's __builtin_cpu_supports knows
-    // it); AVX's check includes the system saving the vector state.
+    // it); AVX2's check includes the system saving the vector state.
     unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
     if (!__get_cpuid(1, &eax, &ebx, &ecx, &edx)) return false;
-    return (ecx & (1u << 29)) != 0 && __builtin_cpu_supports("avx");
+    return (ecx & (1u << 29)) != 0 && __builtin_cpu_supports("avx2");
 }
 
 }  // namespace mpshade
@@ -72,10 +76,10 @@ bool probeF16CAvailable() {
 
 namespace mpshade {
 
-bool probeF16CAvailable() {
+bool probeAvx2Available() {
     return false;
 }
-void probeShaderMapF16C(const ShaderMap& map, const ProbeOptions& options,
+void probeShaderMapAvx2(const ShaderMap& map, const ProbeOptions& options,
                         std::span<const ProbeQuery> queries, ProbeOutput out,
                         ProbeResidency* residency) {
     probeShaderMapPortable(map, options, queries, out, residency);
