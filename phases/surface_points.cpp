@@ -300,23 +300,7 @@ void runDynamicShader(const ObjectView& view, const ShadingInputs& in, size_t n,
     ShadingCounters shading;
     view.rep->dynamicKernel->run(*view.uniforms, in, n, batch.out, scratch.workspace, shading);
     counters.instructions += shading.instructions;
-    // sanitizeShade (compositing.h) without a branch, so the loop vectorizes: x - x is 0
-    // for a finite x and NaN otherwise, and a sum with a NaN is not 0.
-    const float *c0 = batch.out.Ci[0], *c1 = batch.out.Ci[1], *c2 = batch.out.Ci[2];
-    const float *o0 = batch.out.Oi[0], *o1 = batch.out.Oi[1], *o2 = batch.out.Oi[2];
-    uint64_t nonFinite = 0;
-    for (size_t i = 0; i < n; ++i) {
-        const float check = (c0[i] - c0[i]) + (c1[i] - c1[i]) + (c2[i] - c2[i]) + (o0[i] - o0[i]) +
-                            (o1[i] - o1[i]) + (o2[i] - o2[i]);
-        const bool finite = check == 0.0f;
-        nonFinite += finite ? 0 : 1;
-        color[3 * i] = finite ? c0[i] : 0.0f;
-        color[3 * i + 1] = finite ? c1[i] : 0.0f;
-        color[3 * i + 2] = finite ? c2[i] : 0.0f;
-        opacity[3 * i] = finite ? std::clamp(o0[i], 0.0f, 1.0f) : 1.0f;
-        opacity[3 * i + 1] = finite ? std::clamp(o1[i], 0.0f, 1.0f) : 1.0f;
-        opacity[3 * i + 2] = finite ? std::clamp(o2[i], 0.0f, 1.0f) : 1.0f;
-    }
+    const uint64_t nonFinite = sanitizeShadeRows(n, batch.out.Ci, batch.out.Oi, color, opacity);
     counters.nonFinite += nonFinite;
     counters.kernelSeconds += secondsSince(began);
 }

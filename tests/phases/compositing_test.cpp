@@ -1,0 +1,61 @@
+// The NaN policy over rows of results (sanitizeShadeRows) against the one-result policy
+// (sanitizeShade), which says it with std::isfinite and std::clamp: the same bits and the
+// same count, for every batch length's vector part and tail, with NaN, infinities,
+// negative and above-one opacities, -0 and denormals in any component.
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "phases/compositing.h"
+
+namespace mpshade {
+namespace {
+
+TEST(Compositing, RowsAreSanitizedAsEachResultAlone) {
+    std::mt19937 rng(5);
+    const float specials[] = {std::numeric_limits<float>::quiet_NaN(),
+                              std::numeric_limits<float>::infinity(),
+                              -std::numeric_limits<float>::infinity(),
+                              -0.0f,
+                              1e-40f,
+                              -2.5f,
+                              1.0f,
+                              0.0f,
+                              7.0f};
+    std::uniform_real_distribution<float> value(-0.5f, 1.5f);
+    std::uniform_int_distribution<int> pick(0, 19);
+    for (size_t n = 0; n <= 13; ++n)
+        for (int trial = 0; trial < 40; ++trial) {
+            std::vector<float> rows(6 * n);
+            for (float& x : rows) {
+                const int p = pick(rng);
+                x = p < 9 ? specials[p] : value(rng);
+            }
+            const float* ci[3] = {&rows[0], &rows[n], &rows[2 * n]};
+            const float* oi[3] = {&rows[3 * n], &rows[4 * n], &rows[5 * n]};
+            std::vector<float> color(3 * n + 1, 42.0f), opacity(3 * n + 1, 42.0f);
+            const size_t bad = sanitizeShadeRows(n, ci, oi, color.data(), opacity.data());
+            size_t expectBad = 0;
+            for (size_t i = 0; i < n; ++i) {
+                float c[3] = {ci[0][i], ci[1][i], ci[2][i]}, o[3] = {oi[0][i], oi[1][i], oi[2][i]};
+                if (!sanitizeShade(c, o)) ++expectBad;
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_EQ(0, std::memcmp(&color[3 * i + k], &c[k], sizeof(float)))
+                        << "n " << n << " result " << i << " colour " << k;
+                    ASSERT_EQ(0, std::memcmp(&opacity[3 * i + k], &o[k], sizeof(float)))
+                        << "n " << n << " result " << i << " opacity " << k;
+                }
+            }
+            EXPECT_EQ(bad, expectBad) << "n " << n;
+            // Nothing written past the last result.
+            EXPECT_EQ(color[3 * n], 42.0f);
+            EXPECT_EQ(opacity[3 * n], 42.0f);
+        }
+}
+
+}  // namespace
+}  // namespace mpshade
