@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <span>
 #include <type_traits>
 
 #include <glm/geometric.hpp>
@@ -28,9 +29,9 @@ void growTo(std::vector<T>& v, size_t n) {
 // get the same bits as they would in a lane.
 // Without a branch: runs of a few points ended in a mispredicted one each (6% of this
 // file's time on the courtyard's frame).
-void findRuns(const SurfacePoints& points, std::vector<uint32_t>& runs) {
+std::span<const uint32_t> findRuns(const SurfacePoints& points, std::vector<uint32_t>& runs) {
     const size_t n = points.n;
-    runs.resize(n + 1);
+    growTo(runs, n + 1);
     uint32_t* out = runs.data();
     size_t count = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -38,7 +39,7 @@ void findRuns(const SurfacePoints& points, std::vector<uint32_t>& runs) {
         count += (i == 0 || points.facet[i] != points.facet[i - 1]) ? 1 : 0;
     }
     out[count++] = static_cast<uint32_t>(n);
-    runs.resize(count);
+    return {out, count};
 }
 
 // One facet's constants for step 1, broadcast: a lane type T is float or Float4.
@@ -114,7 +115,7 @@ RayHit<T> hitFacet(const FacetRay<T>& f, T x, T y) {
 // Step 1: where each point's ray meets its facet: the barycentric weights (and, for a probe,
 // their screen derivatives, 4 rows of n) and P.
 void intersectFacets(const ObjectView& view, const FacetMesh& mesh, const SurfacePoints& points,
-                     const std::vector<uint32_t>& runs, float* __restrict bary1,
+                     std::span<const uint32_t> runs, float* __restrict bary1,
                      float* __restrict bary2, float* __restrict px, float* __restrict py,
                      float* __restrict pz, float* __restrict derivatives) {
     const size_t n = points.n;
@@ -161,33 +162,38 @@ void viewDirections(const ObjectView& view, const SurfacePoints& points, const f
     const float ex = view.eye.x, ey = view.eye.y, ez = view.eye.z;
     const Float4 zero = splatFloat4(0.0f), one = splatFloat4(1.0f);
     const Float4 ex4 = splatFloat4(ex), ey4 = splatFloat4(ey), ez4 = splatFloat4(ez);
+    // A direction that came out zero or not finite: the ray's own.
+    auto rayDirection = [&](size_t k) {
+        const glm::vec3 I = glm::normalize(view.d0 + points.x[k] * view.dx + points.y[k] * view.dy);
+        ix[k] = I.x, iy[k] = I.y, iz[k] = I.z;
+    };
     size_t i = 0;
     for (; i + 4 <= n; i += 4) {
         const Float4 tx = loadFloat4(px + i) - ex4, ty = loadFloat4(py + i) - ey4,
                      tz = loadFloat4(pz + i) - ez4;
         const Float4 len2 = tx * tx + ty * ty + tz * tz;
         const Float4 inv = one / sqrtFloat4(len2 > zero ? len2 : one);
-        storeFloat4(ix + i, tx * inv);
-        storeFloat4(iy + i, ty * inv);
-        storeFloat4(iz + i, tz * inv);
+        const Float4 x = tx * inv, y = ty * inv, z = tz * inv;
+        storeFloat4(ix + i, x);
+        storeFloat4(iy + i, y);
+        storeFloat4(iz + i, z);
+        const auto good = x * x + y * y + z * z > zero;
+        if (!(good[0] & good[1] & good[2] & good[3]))
+            for (size_t k = i; k < i + 4; ++k)
+                if (!good[k - i]) rayDirection(k);
     }
     for (; i < n; ++i) {
         const float tx = px[i] - ex, ty = py[i] - ey, tz = pz[i] - ez;
         const float len2 = tx * tx + ty * ty + tz * tz;
         const float inv = 1.0f / std::sqrt(len2 > 0.0f ? len2 : 1.0f);
         ix[i] = tx * inv, iy[i] = ty * inv, iz[i] = tz * inv;
+        if (!(ix[i] * ix[i] + iy[i] * iy[i] + iz[i] * iz[i] > 0.0f)) rayDirection(i);
     }
-    for (size_t k = 0; k < n; ++k)
-        if (!(ix[k] * ix[k] + iy[k] * iy[k] + iz[k] * iz[k] > 0.0f)) {
-            const glm::vec3 I =
-                glm::normalize(view.d0 + points.x[k] * view.dx + points.y[k] * view.dy);
-            ix[k] = I.x, iy[k] = I.y, iz[k] = I.z;
-        }
 }
 
 // Step 3: a vertex attribute row at each point's weights.
 void interpolateRow(const uint32_t* __restrict attributeIndex, const SurfacePoints& points,
-                    const std::vector<uint32_t>& runs, const float* __restrict bary1,
+                    std::span<const uint32_t> runs, const float* __restrict bary1,
                     const float* __restrict bary2, const float* __restrict r,
                     float* __restrict out) {
     const Float4 one4 = splatFloat4(1.0f);
@@ -230,7 +236,7 @@ void normalizeRows(size_t n, float* __restrict nx, float* __restrict ny, float* 
 // Step 4, with a shader map: each point's chart point and its footprint (the weights'
 // screen derivatives carried to the chart, times footprintScale).
 void chartQueries(const ObjectView& view, const FacetMesh& mesh, const SurfacePoints& points,
-                  const std::vector<uint32_t>& runs, const float* __restrict bary1,
+                  std::span<const uint32_t> runs, const float* __restrict bary1,
                   const float* __restrict bary2, const float* __restrict dd, ProbeQuery* queries) {
     const float s = view.footprintScale;
     const size_t n = points.n;
@@ -344,26 +350,26 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
     const float* py = rows[ShadingBatch::P + 1];
     const float* pz = rows[ShadingBatch::P + 2];
 
-    findRuns(points, scratch.runs);
-    intersectFacets(view, mesh, points, scratch.runs, scratch.b1.data(), scratch.b2.data(),
+    const std::span<const uint32_t> runs = findRuns(points, scratch.runs);
+    intersectFacets(view, mesh, points, runs, scratch.b1.data(), scratch.b2.data(),
                     rows[ShadingBatch::P], rows[ShadingBatch::P + 1], rows[ShadingBatch::P + 2],
                     useMap ? scratch.derivatives.data() : nullptr);
     viewDirections(view, points, px, py, pz, rows[ShadingBatch::I], rows[ShadingBatch::I + 1],
                    rows[ShadingBatch::I + 2]);
     const uint32_t* const attributeIndex = mesh.attributeIndex.data();
     for (int row : rep.geometryRows)
-        interpolateRow(attributeIndex, points, scratch.runs, bary1, bary2,
+        interpolateRow(attributeIndex, points, runs, bary1, bary2,
                        attr.rows[static_cast<size_t>(row)].data(),
                        rows[row < VertexAttributes::U ? row : row + 3]);
     if (!attr.rows[VertexAttributes::Nx].empty())
         normalizeRows(n, rows[ShadingBatch::N], rows[ShadingBatch::N + 1],
                       rows[ShadingBatch::N + 2]);
     if (useMap) {
-        chartQueries(view, mesh, points, scratch.runs, bary1, bary2, scratch.derivatives.data(),
+        chartQueries(view, mesh, points, runs, bary1, bary2, scratch.derivatives.data(),
                      scratch.queries.data());
     } else {
         for (size_t c = 0; c < channels; ++c)
-            interpolateRow(attributeIndex, points, scratch.runs, bary1, bary2,
+            interpolateRow(attributeIndex, points, runs, bary1, bary2,
                            attr.rows[VertexAttributes::kGeometryRows + c].data(), batch.channel(c));
     }
     if (stopAtMissing && missed) std::fill(missed, missed + n, uint8_t{0});

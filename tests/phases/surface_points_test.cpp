@@ -253,5 +253,41 @@ TEST(SurfacePoints, RunsOfAnyLengthGiveEachPointTheBitsItGetsAlone) {
     }
 }
 
+// A point that lies at the eye (the eye on one of its facet's corners) has no direction
+// from the eye (it would be 0); it takes its ray's. In a batch's vector part and its tail
+// alike, beside points of another facet.
+TEST(SurfacePoints, APointAtTheEyeTakesItsRaysDirection) {
+    BallView b;
+    const std::vector<uint32_t> facets = facingFacets(b, 2);
+    ASSERT_GE(facets.size(), 2u);
+    const uint32_t i0 = b.mesh().positionIndex[3 * facets[0]];
+    b.view.eye = b.mesh().format.dequantize(b.mesh().qx[i0], b.mesh().qy[i0], b.mesh().qz[i0]);
+    for (size_t n = 1; n <= 11; ++n) {
+        std::vector<uint32_t> facet;
+        std::vector<float> x, y;
+        for (size_t i = 0; i < n; ++i) {
+            facet.push_back(facets[i % 3 == 2 ? 1 : 0]);
+            x.push_back(10.0f + 3.0f * static_cast<float>(i));
+            y.push_back(20.0f + 1.5f * static_cast<float>(i));
+        }
+        SurfaceShadingScratch scratch;
+        SurfaceShadingCounters counters;
+        std::vector<float> color(3 * n), opacity(3 * n);
+        std::vector<uint8_t> missed(n);
+        shadeSurfacePoints(b.view, DynamicOptions{}.probe, false,
+                           {facet.data(), x.data(), y.data(), n}, color.data(), opacity.data(),
+                           missed.data(), scratch, counters);
+        for (size_t i = 0; i < n; ++i) {
+            SCOPED_TRACE(testing::Message() << n << " points, point " << i);
+            float I[3];
+            for (int k = 0; k < 3; ++k) I[k] = scratch.batch.row(ShadingBatch::I + k)[i];
+            const DVec ray = b.ray(x[i], y[i]);
+            const double len = std::sqrt(ray[0] * ray[0] + ray[1] * ray[1] + ray[2] * ray[2]);
+            // Points of the other facet lie on their rays too, so theirs is the same.
+            for (int k = 0; k < 3; ++k) EXPECT_NEAR(I[k], ray[k] / len, 1e-5);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace mpshade
