@@ -35,8 +35,9 @@ TEST(Compositing, RowsAreSanitizedAsEachResultAlone) {
                 const int p = pick(rng);
                 x = p < 9 ? specials[p] : value(rng);
             }
-            const float* ci[3] = {&rows[0], &rows[n], &rows[2 * n]};
-            const float* oi[3] = {&rows[3 * n], &rows[4 * n], &rows[5 * n]};
+            const float* r = rows.data();
+            const float* ci[3] = {r, r + n, r + 2 * n};
+            const float* oi[3] = {r + 3 * n, r + 4 * n, r + 5 * n};
             std::vector<float> color(3 * n + 1, 42.0f), opacity(3 * n + 1, 42.0f);
             const size_t bad = sanitizeShadeRows(n, ci, oi, color.data(), opacity.data());
             size_t expectBad = 0;
