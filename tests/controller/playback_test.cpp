@@ -165,7 +165,7 @@ namespace {
 
 // A camera panning from one ball to another that is out of view at first.
 std::string writePanScene() {
-    const std::string path = ::testing::TempDir() + "mpshade_pan_scene.json";
+    const std::string path = test::testFolder("mpshade_playback") + "pan_scene.json";
     std::ofstream f(path);
     f << R"({
   "settings": {"width": 64, "height": 48, "fps": 10, "duration": 2.0, "samples_per_pixel": 1},

@@ -95,7 +95,7 @@ namespace {
 // A ball whose baked colour follows an animated parameter (k: 0 at t = 0 to 1 at t = 1),
 // and one whose animated parameter stays dynamic (not baked); the camera stands still.
 std::string writeBakedInputScene() {
-    const std::string dir = ::testing::TempDir();
+    const std::string dir = test::testFolder("mpshade_rerun");
     {
         std::ofstream sl(dir + "mpshade_baked_k.sl");
         sl << "surface baked_k(float k = 0.0) {\n"

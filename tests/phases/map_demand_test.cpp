@@ -10,6 +10,7 @@
 
 #include "phases/map_demand.h"
 #include "scene/scene.h"
+#include "test_support.h"
 
 namespace mpshade {
 namespace {
@@ -21,8 +22,7 @@ namespace {
 // `occluder`: a second square in front hiding x < 0 of the first, as the eye sees it.
 Scene squareScene(const std::string& name, double lod, bool occluder) {
     const double distance = std::exp2(lod) * 960.0 / double(1 << 20);
-    const std::string dir = ::testing::TempDir() + "mpshade_map_demand/";
-    std::filesystem::create_directories(dir);
+    const std::string dir = test::testFolder("mpshade_map_demand");
     std::ofstream(dir + "s.sl") << "surface s() { Ci = color(noise(P * 40)); }";
     std::string objects =
         R"({"name": "square", "geometry": {"type": "plane", "size": [2, 2]}, "shader": "s",
@@ -87,8 +87,7 @@ TEST(MapDemand, AFloorSeenFromCloseByAtAGrazingAngleCoversHalfTheImage) {
     // 1/20 of a pixel under the horizon). Its near cells are hundreds of pixels wide and
     // straddle the image's edge, so they are split until each is a few pixels: counted by
     // their centres alone, the lower half came out a twelfth of itself.
-    const std::string dir = ::testing::TempDir() + "mpshade_map_demand/";
-    std::filesystem::create_directories(dir);
+    const std::string dir = test::testFolder("mpshade_map_demand");
     std::ofstream(dir + "s.sl") << "surface s() { Ci = color(noise(P * 40)); }";
     std::ofstream(dir + "floor.json") << R"({"settings": {"width": 640, "height": 480,
       "fps": 10, "duration": 0.1, "samples_per_pixel": 4},
