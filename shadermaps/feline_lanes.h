@@ -112,16 +112,15 @@ int felineLanes(const Prober<C, Texels>& p, const FelineSetup& setup, const Prob
     const LaneFloats u0 = u + setup.offsetU, v0 = v + setup.offsetV;
 
     struct Line {
-        int level;
-        float scale, fres, dx, dy;
-        int tx0, ty0;             // the tile of the first query's first tap
-        const Storage* tiles[9];  // tiles tx0 - 1 .. tx0 + 1 by ty0 - 1 .. ty0 + 1
+        int level = 0;
+        float scale = 0.0f, fres = 0.0f, dx = 0.0f, dy = 0.0f;
+        int tx0 = 0, ty0 = 0;          // the tile of the first query's first tap
+        const Storage* tiles[9] = {};  // tiles tx0 - 1 .. tx0 + 1 by ty0 - 1 .. ty0 + 1
     };
     Line lines[2];
     int count = 0;
-    if (setup.blend < 1.0f)
-        lines[count++].level = setup.l0, lines[count - 1].scale = 1.0f - setup.blend;
-    if (setup.blend > 0.0f) lines[count++].level = setup.l1, lines[count - 1].scale = setup.blend;
+    if (setup.blend < 1.0f) lines[count++] = {setup.l0, 1.0f - setup.blend};
+    if (setup.blend > 0.0f) lines[count++] = {setup.l1, setup.blend};
     const int n = setup.n;
     const int shift = p.tileShift;
     for (int l = 0; l < count; ++l) {
@@ -196,15 +195,8 @@ int felineLanes(const Prober<C, Texels>& p, const FelineSetup& setup, const Prob
             const LaneInts slot = (ty - line.ty0 + 1) * 3 + (tx - line.tx0 + 1);
             const LaneInts at =
                 (iy - (ty << shift) + border) * rowValues + (ix - (tx << shift) + border) * C;
-            for (int j = 0; j < lanes; ++j) {
-                const Storage* t00 = line.tiles[slot[j]] + at[j];
-                const Storage* t01 = t00 + rowValues;
-                for (int k = 0; k < kVectors; ++k)
-                    acc[j][k] += w00[j] * Texels::load4(t00 + 4 * k) +
-                                 w10[j] * Texels::load4(t00 + C + 4 * k) +
-                                 w01[j] * Texels::load4(t01 + 4 * k) +
-                                 w11[j] * Texels::load4(t01 + C + 4 * k);
-            }
+            for (int j = 0; j < lanes; ++j)
+                p.addTexels(line.tiles[slot[j]] + at[j], w00[j], w10[j], w01[j], w11[j], acc[j]);
         }
         for (int j = 0; j < lanes; ++j)
             for (int k = 0; k < kVectors; ++k) sum[j][k] += acc[j][k];

@@ -228,8 +228,15 @@ struct Prober {
         const float wy0 = w * (1.0f - fy), wy1 = w * fy;
         const float w00 = wy0 * (1.0f - fx), w10 = wy0 * fx, w01 = wy1 * (1.0f - fx),
                     w11 = wy1 * fx;
-        const Storage* t00 = t + static_cast<size_t>(lj) * rowValues +
-                             static_cast<size_t>(li) * static_cast<size_t>(kChannels);
+        addTexels(t + static_cast<size_t>(lj) * rowValues +
+                      static_cast<size_t>(li) * static_cast<size_t>(kChannels),
+                  w00, w10, w01, w11, acc);
+    }
+
+    // Adds the 2x2 texels from t00 (t00's row and the next), weighted, to acc: the sum every
+    // vector path of a tap makes (feline_lanes.h too), in one order so they agree bit for bit.
+    void addTexels(const Storage* t00, float w00, float w10, float w01, float w11,
+                   Float4* acc) const {
         const Storage* t01 = t00 + rowValues;
         for (int k = 0; k < kVectors; ++k)
             acc[k] +=
