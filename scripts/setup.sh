@@ -47,6 +47,29 @@ build() {
   cmake --build "$dir" -j "$(nproc)"
 }
 
+# The sanitized suite. LeakSanitizer's own stop-the-world tracer now and then crashes as a
+# process exits ("Tracer caught signal 11", then "LeakSanitizer has encountered a fatal
+# error"), after the test has passed and before any leak is looked for: a known fault of the
+# sanitizer runtime (google/sanitizers issues 1170 and 1353), not of the code under test.
+# When every failed test shows that signature, those tests alone run once more; any other
+# failure fails at once.
+sanitized_tests() {
+  local log=build-sanitize/Testing/ctest-sanitize.log
+  mkdir -p build-sanitize/Testing
+  if ctest --test-dir build-sanitize --output-on-failure -j "$(nproc)" 2>&1 | tee "$log"; then
+    return 0
+  fi
+  local failed crashes
+  failed=$(grep -c . build-sanitize/Testing/Temporary/LastTestsFailed.log || true)
+  crashes=$(grep -c "LeakSanitizer has encountered a fatal error" "$log" || true)
+  if [ "$failed" -eq 0 ] || [ "$crashes" -lt "$failed" ]; then
+    echo "sanitized tests: $failed failed, $crashes with the LeakSanitizer tracer's crash" >&2
+    return 1
+  fi
+  echo "sanitized tests: the $failed failed test(s) all ended in LeakSanitizer's tracer crash; running them once more" >&2
+  ctest --test-dir build-sanitize --output-on-failure --rerun-failed
+}
+
 job="${1:-}"
 case "$job" in
   demo)
@@ -63,8 +86,8 @@ case "$job" in
   sanitize)
     install_packages
     build build-sanitize -DMPSHADE_WERROR=ON -DMPSHADE_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMPSHADE_BUILD_BENCH=OFF
-    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-      ctest --test-dir build-sanitize --output-on-failure -j "$(nproc)"
+    export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+    sanitized_tests
     ;;
   fuzz)
     install_packages "${FUZZ_PACKAGES[@]}"
