@@ -12,6 +12,8 @@
 
 #include "geometry/error.h"
 #include "geometry/float4.h"
+#include "phases/resolve_avx512.h"
+#include "phases/resolve_rows.h"
 
 namespace mpshade {
 namespace {
@@ -273,61 +275,9 @@ void SampleLayout::prepareInverseSums() {
     });
 }
 
-namespace {
-
-// The resolve's writes: out-pixel rows [py0, py1] of the `pixels` image (width wide, RGBA),
-// each getting weights (its row of `w`, `stride` apart and offset by the first row's
-// distance `row0` from the source) times a color, over `columns` pixels from column x.
-template <int columns>
-[[gnu::always_inline]] inline void addWeighted(float* pixels, int width, int x, int py0, int py1,
-                                               int row0, const float* w, int stride,
-                                               const Float4& c) {
-    for (int py = py0; py <= py1; ++py) {
-        const float* wr = w + stride * (py - row0);
-        float* o = pixels + (static_cast<size_t>(py) * width + x) * 4;
-        for (int k = 0; k < columns; ++k) storeFloat4(o + 4 * k, loadFloat4(o + 4 * k) + wr[k] * c);
-    }
-}
-
-// A pixel's samples [first, last) with a filter reaching one pixel around, summed in
-// registers first, so each pixel in reach is read and written once per pixel rather than
-// once per sample.
-[[gnu::always_inline]] inline void addSamples3x3(float* pixels, int width, int qx, int qy, int py0,
-                                                 int py1, const float* rgba, const float* weights,
-                                                 size_t first, size_t last) {
-    Float4 sum[3][3];
-    for (auto& row : sum)
-        for (Float4& v : row) v = splatFloat4(0.0f);
-    for (size_t s = first; s < last; ++s) {
-        const float* w = weights + s * 6;
-        const Float4 c = loadFloat4(rgba + 4 * s);
-        const Float4 c0 = w[0] * c, c1 = w[1] * c, c2 = w[2] * c;
-        for (int r = 0; r < 3; ++r) {
-            sum[r][0] += w[3 + r] * c0;
-            sum[r][1] += w[3 + r] * c1;
-            sum[r][2] += w[3 + r] * c2;
-        }
-    }
-    for (int py = py0; py <= py1; ++py) {
-        const Float4* add = sum[py - qy + 1];
-        float* o = pixels + (static_cast<size_t>(py) * width + qx - 1) * 4;
-        storeFloat4(o, loadFloat4(o) + add[0]);
-        storeFloat4(o + 4, loadFloat4(o + 4) + add[1]);
-        storeFloat4(o + 8, loadFloat4(o + 8) + add[2]);
-    }
-}
-
-}  // namespace
-
-void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out,
-                           bool quads) const {
+void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out, bool quads,
+                           ResolveBuild build) const {
     if (out.width != width_ || out.height != height_) out = Image(width_, height_);
-    const size_t taps = static_cast<size_t>(taps_), spp = static_cast<size_t>(spp_);
-    const float* weights = weights_.data();
-    const float* pixelWeights = pixelWeights_.data();
-    const float* inverseSum = inverseSum_.data();
-    float* pixels = out.rgba.data();
-    const int width = width_, height = height_, reach = reach_;
     // Bands of output rows in parallel. Within a band, every sample of the rows in reach is
     // read once and added to the pixels it reaches in the band: its y weight towards the
     // row times its x weight towards the column. A pixel whose samples all hold the same
@@ -340,83 +290,25 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
     // goes in one step: 16 pixels reached, against 36 for four pixels (1.3x faster
     // resolves at one sample a pixel; looking for such blocks in frames shaded otherwise
     // costs more than it finds).
-    const bool blocks = quads && uniform && reach == 1 && !blockWeights_.empty();
-    const int blocksX = width / 2;
-    const float* blockWeights = blockWeights_.data();
-    auto blockAlike = [&](int bx, int by) {
-        const size_t p = static_cast<size_t>(2 * by) * width + 2 * bx;
-        if (!(uniform[p] && uniform[p + 1] && uniform[p + width] && uniform[p + width + 1]))
-            return false;
-        // Bit for bit, as the dynamic phase marks alike pixels.
-        uint64_t first[2];
-        std::memcpy(first, rgba + 4 * p * spp, 16);
-        auto same = [&](size_t q) {
-            uint64_t other[2];
-            std::memcpy(other, rgba + 4 * q * spp, 16);
-            return ((first[0] ^ other[0]) | (first[1] ^ other[1])) == 0;
-        };
-        return same(p + 1) && same(p + width) && same(p + width + 1);
-    };
+    ResolveFrame f;
+    f.rgba = rgba;
+    f.uniform = uniform;
+    f.pixels = out.rgba.data();
+    f.weights = weights_.data();
+    f.pixelWeights = pixelWeights_.data();
+    f.blockWeights = blockWeights_.data();
+    f.inverseSum = inverseSum_.data();
+    f.width = width_, f.height = height_, f.reach = reach_;
+    f.taps = static_cast<size_t>(taps_), f.spp = static_cast<size_t>(spp_);
+    f.blocks = quads && uniform && reach_ == 1 && !blockWeights_.empty();
+    const bool avx512 = build == ResolveBuild::Fastest && resolveAvx512Available();
     constexpr int kBand = 8;
-    tbb::parallel_for(0, (height + kBand - 1) / kBand, [&](int band) {
-        const int r0 = band * kBand, r1 = std::min(height, r0 + kBand);
-        std::fill(pixels + static_cast<size_t>(r0) * width * 4,
-                  pixels + static_cast<size_t>(r1) * width * 4, 0.0f);
-        // With blocks, from an even row, so every 2x2 block in reach is met at its top row.
-        const int firstRow = std::max(0, r0 - reach) & (blocks ? ~1 : ~0);
-        for (int qy = firstRow; qy < std::min(height, r1 + reach); ++qy) {
-            const int py0 = std::max(r0, qy - reach), py1 = std::min(r1 - 1, qy + reach);
-            const int by = qy / 2;
-            const bool blockRow = blocks && by >= 1 && 2 * by + 2 < height;
-            bool alike = false;  // the current block's, found at its left column
-            for (int qx = 0; qx < width; ++qx) {
-                if (qx % 2 == 0)
-                    alike = blockRow && qx >= 2 && qx + 3 < width && blockAlike(qx / 2, by);
-                if (alike) {
-                    // A 2x2 block shaded once (at one shading point per 2x2 pixels): its one
-                    // color to the 4 x 4 pixels it reaches, from its top row, for both.
-                    if (qy % 2 == 0 && qx % 2 == 0)
-                        addWeighted<4>(
-                            pixels, width, qx - 1, std::max(r0, qy - 1), std::min(r1 - 1, qy + 2),
-                            qy - 1,
-                            blockWeights + (static_cast<size_t>(by) * blocksX + qx / 2) * 16, 4,
-                            loadFloat4(rgba + 4 * (static_cast<size_t>(qy) * width + qx) * spp));
-                    continue;
-                }
-                if (py0 > py1) continue;  // a row read for the blocks it starts
-                const size_t pixel = static_cast<size_t>(qy) * width + qx;
-                const size_t first = pixel * spp;
-                const bool same = uniform && uniform[pixel];
-                const size_t last = same ? first + 1 : first + spp;
-                if (reach == 1 && qx > 0 && qx + 1 < width) {
-                    if (same)  // one color, its samples' weights summed
-                        addWeighted<3>(pixels, width, qx - 1, py0, py1, qy - 1,
-                                       pixelWeights + pixel * 9, 3, loadFloat4(rgba + 4 * first));
-                    else
-                        addSamples3x3(pixels, width, qx, qy, py0, py1, rgba, weights, first, last);
-                    continue;
-                }
-                // The general case: a wider filter, or a pixel at the image's edge.
-                const int px0 = std::max(0, qx - reach), px1 = std::min(width - 1, qx + reach);
-                for (size_t s = first; s < last; ++s) {
-                    const float* w =
-                        same ? pixelWeights + pixel * taps * taps : weights + s * 2 * taps;
-                    const Float4 c = loadFloat4(rgba + 4 * s);
-                    for (int py = py0; py <= py1; ++py) {
-                        const size_t oy = static_cast<size_t>(py - qy + reach);
-                        float* row = pixels + static_cast<size_t>(py) * width * 4;
-                        for (int px = px0; px <= px1; ++px) {
-                            const size_t ox = static_cast<size_t>(px - qx + reach);
-                            const float f = same ? w[oy * taps + ox] : w[taps + oy] * w[ox];
-                            float* o = row + 4 * static_cast<size_t>(px);
-                            storeFloat4(o, loadFloat4(o) + f * c);
-                        }
-                    }
-                }
-            }
-        }
-        for (size_t p = static_cast<size_t>(r0) * width; p < static_cast<size_t>(r1) * width; ++p)
-            storeFloat4(pixels + 4 * p, loadFloat4(pixels + 4 * p) * inverseSum[p]);
+    tbb::parallel_for(0, (height_ + kBand - 1) / kBand, [&](int band) {
+        const int r0 = band * kBand, r1 = std::min(height_, r0 + kBand);
+        if (avx512)
+            resolveRowsAvx512(f, r0, r1);
+        else
+            resolveRowsOf(f, r0, r1);
     });
 }
 

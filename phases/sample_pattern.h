@@ -18,6 +18,9 @@ namespace mpshade {
 // (seed, px, py, k). Returns image coordinates in pixels (continuous, y down).
 void samplePosition(uint32_t seed, int px, int py, int k, int spp, float& x, float& y);
 
+// Which build of the resolve runs (SampleLayout::resolve).
+enum class ResolveBuild { Fastest, Portable };
+
 // The pixel reconstruction filter: a truncated Gaussian (pbrt-v4's GaussianFilter),
 // f(d) = max(0, exp(-d^2 / (2 sigma^2)) - exp(-r^2 / (2 sigma^2))) separably in x and y.
 struct PixelFilter {
@@ -71,8 +74,10 @@ class SampleLayout {
     // RGBA as its first, which is then read once. `quads`: the frame was shaded once per
     // 2x2 pixels, so whole 2x2 blocks of uniform pixels holding one RGBA are looked for and
     // read once (with `uniform` only). `out` keeps its storage when its size is the
-    // layout's.
-    void resolve(const float* rgba, const uint8_t* uniform, Image& out, bool quads = false) const;
+    // layout's. `build`: the fastest the processor runs (AVX-512 where it has it), or the
+    // baseline's; the same bits either way.
+    void resolve(const float* rgba, const uint8_t* uniform, Image& out, bool quads = false,
+                 ResolveBuild build = ResolveBuild::Fastest) const;
 
   private:
     // Resizing leaves the elements unset: every one is written before it is read, and

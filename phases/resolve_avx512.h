@@ -1,0 +1,14 @@
+// resolve_avx512.h -- SampleLayout::resolve's bands (resolve_rows.h) built for AVX-512,
+// chosen at run time where the processor has it: the same bits as the baseline build.
+#pragma once
+
+#include "phases/resolve_frame.h"
+
+namespace mpshade {
+
+// True where this build has the AVX-512 resolve and the processor runs it.
+bool resolveAvx512Available();
+// Output rows [r0, r1) of `frame` (resolve_rows.h). Only where resolveAvx512Available().
+void resolveRowsAvx512(const ResolveFrame& frame, int r0, int r1);
+
+}  // namespace mpshade
