@@ -265,8 +265,9 @@ void buildBandPoints(const SampleLayout& layout, const VisibilityBuffer& vis,
         blocks.sortByObject(objects);
     }
     const size_t points = pts.object.size();
-    pts.color.resize(3 * points);
-    pts.opacity.resize(3 * points);
+    // One float beyond the last point's: the composite reads a point's three as four.
+    pts.color.resize(3 * points + 1);
+    pts.opacity.resize(3 * points + 1);
     pts.pending.clear();
     pts.fresh = true;
     pts.built = true;

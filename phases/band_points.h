@@ -46,7 +46,7 @@ struct BandPoints {
     // point is every sample's only fragment (its samples' fragmentPoint then unset);
     // otherwise kNoPoint. Empty when shaded per sample.
     std::vector<uint32_t> pixelPoint;
-    std::vector<float> color, opacity;  // 3 per shading point
+    std::vector<float> color, opacity;  // 3 per shading point, and one float more
     // Points are grouped by object: object o's are [objectStart[o], objectStart[o + 1]).
     std::vector<uint32_t> objectStart;
     bool fresh = false;             // no point shaded yet: every point is pending

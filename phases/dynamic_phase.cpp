@@ -246,35 +246,44 @@ inline void compositePixel(const BandPoints& pts, const BandRange& r, const Visi
     // Whether the pixel's samples came out alike is decided on the values in registers:
     // reading the samples back from rgbaOut waited on their stores (the whole band's
     // composite took a fifth of the shading time of a one-sphere scene).
-    float firstRgba[4];
+    const Float4 background4 = {background.x, background.y, background.z, 0.0f};
+    const Float4 zero = {}, one = splatFloat4(1.0f);
+    Float4 firstRgba = zero;
     bool same = true;
     for (size_t smp = first; smp < first + spp; ++smp) {
-        float rgba[4];
+        Float4 rgba;
         if (vis.count[smp] == 1) {
             // One surface (most samples): SampleComposite's arithmetic written out for one
-            // layer, the same bits without its loops over layers and channels.
+            // layer in one vector, the same bits without its loops over layers and channels.
+            // A point's three floats are read as four (BandPoints pads its rows by one).
             const uint32_t p = pts.fragmentPoint[smp * layers - r.firstSlot];
-            const float* ci = &pts.color[3 * p];
-            const float* oi = &pts.opacity[3 * p];
-            float t[3];
-            for (int k = 0; k < 3; ++k) {
-                t[k] = 1.0f - oi[k];
-                rgba[k] = (0.0f + oi[k] * ci[k]) + t[k] * background[k];
-            }
+            const Float4 ci = loadFloat4(&pts.color[3 * p]);
+            const Float4 oi = loadFloat4(&pts.opacity[3 * p]);
+            const Float4 t = one - oi;
+            rgba = (zero + oi * ci) + t * background4;
             rgba[3] = 1.0f - (t[0] + t[1] + t[2]) / 3.0f;
+        } else if (vis.count[smp] == 0) {
+            // The background alone: SampleComposite's finish with nothing over it.
+            rgba = zero + one * background4;
+            rgba[3] = 1.0f - (1.0f + 1.0f + 1.0f) / 3.0f;
         } else {
             SampleComposite c;
             for (int l = 0; l < vis.count[smp]; ++l) {
                 const uint32_t p = pts.fragmentPoint[smp * layers + l - r.firstSlot];
                 c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
             }
-            c.finish(background, rgba);
+            float out[4];
+            c.finish(background, out);
+            rgba = loadFloat4(out);
         }
-        std::memcpy(&rgbaOut[4 * smp], rgba, sizeof rgba);
+        storeFloat4(&rgbaOut[4 * smp], rgba);
+        // Bit for bit, as the resolve compares alike blocks.
+        using Bits = int32_t __attribute__((vector_size(16)));
+        const Bits differ = reinterpret_cast<Bits>(rgba) ^ reinterpret_cast<Bits>(firstRgba);
         if (smp == first)
-            std::memcpy(firstRgba, rgba, sizeof rgba);
+            firstRgba = rgba;
         else
-            same = same && std::memcmp(rgba, firstRgba, sizeof rgba) == 0;
+            same = same && (differ[0] | differ[1] | differ[2] | differ[3]) == 0;
     }
     uniform[pixel] = same ? 1 : 0;
 }
