@@ -391,27 +391,35 @@ class TileRasterizer {
               const std::vector<uint8_t>& objectOpaque) {
         Setup su;
         setUp(tri, ox_, oy_, su);
-        // The edges at the tile's corners: all inside, the tile is covered whole; one wholly
-        // outside, nothing to do.
-        bool whole = true, outside = false;
-        for (int i = 0; i < 3; ++i) {
-            double lo = 1e300, hi = -1e300;
-            for (double cy : cornerY_)
-                for (double cx : cornerX_) {
-                    const double edge = su.c[i] + su.a[i] * cx + su.b[i] * cy;
-                    lo = std::min(lo, edge);
-                    hi = std::max(hi, edge);
-                }
-            whole = whole && lo > 0.0;
-            outside = outside || hi <= 0.0;
-        }
-        if (outside) return;
-        ++s_.facetsBinned;
-        s_.tilesCoveredWhole += whole;
         const int32_t minX = std::min({tri.x[0], tri.x[1], tri.x[2]}),
                       maxX = std::max({tri.x[0], tri.x[1], tri.x[2]});
         const int32_t minY = std::min({tri.y[0], tri.y[1], tri.y[2]}),
                       maxY = std::max({tri.y[0], tri.y[1], tri.y[2]});
+        // The edges at the tile's corners: all inside, the tile is covered whole; one wholly
+        // outside, nothing to do. A facet whose box leaves out a corner of the tile covers
+        // neither, and its box within the tile is what the samples are tested in anyway: the
+        // twelve edge evaluations are for facets as large as the tile (most facets are a
+        // pixel or two across).
+        bool whole = false, outside = false;
+        const int64_t tileX1 = ox_ + static_cast<int64_t>(cornerX_[1]),
+                      tileY1 = oy_ + static_cast<int64_t>(cornerY_[1]);
+        if (minX <= ox_ && minY <= oy_ && maxX >= tileX1 && maxY >= tileY1) {
+            whole = true;
+            for (int i = 0; i < 3; ++i) {
+                double lo = 1e300, hi = -1e300;
+                for (double cy : cornerY_)
+                    for (double cx : cornerX_) {
+                        const double edge = su.c[i] + su.a[i] * cx + su.b[i] * cy;
+                        lo = std::min(lo, edge);
+                        hi = std::max(hi, edge);
+                    }
+                whole = whole && lo > 0.0;
+                outside = outside || hi <= 0.0;
+            }
+        }
+        if (outside) return;
+        ++s_.facetsBinned;
+        s_.tilesCoveredWhole += whole;
         const int bx0 = std::max(tx0_, minX >> kSub), by0 = std::max(ty0_, minY >> kSub);
         const int bx1 = std::min(tx1_, maxX >> kSub), by1 = std::min(ty1_, maxY >> kSub);
         const int spp = grid_.spp;
