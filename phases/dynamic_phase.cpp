@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 #include <glm/geometric.hpp>
 
+#include "geometry/ray_scene.h"
 #include "phases/band_points.h"
 #include "phases/compositing.h"
 #include "phases/view_reuse.h"
@@ -487,6 +488,10 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
     WorkDeadline deadline(options_.deadline);
     tbb::parallel_for(size_t{0}, bandDone_.size(), [&](size_t b) {
         if (bandDone_[b] || deadline.passed()) return;
+        // Denormals flushed on every thread that shades, as on those that fill tiles and
+        // trace the reference: a thread's mode otherwise depended on whether a static fill
+        // had run on it, and a denormal result with it (frames' bits on scheduling).
+        enableFlushToZero();
         const ScopedSpan task(options_.trace, "band", PhaseKind::Dynamic, SpanLevel::Task, -1,
                               frame_->index);
         shadeBand(b, acceptFallbacks, missing.local());
@@ -629,6 +634,7 @@ RefineCounts DynamicPhase::refine(std::span<const PixelRect> tiles, const Refine
     tbb::enumerable_thread_specific<std::vector<TileRequest>> found;
     const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
     tbb::parallel_for(0, workers, [&](int) {
+        enableFlushToZero();  // as shade() does
         Band::Scratch& s = scratch_->refine.local();
         if (s.costs.size() != objects) s.costs.assign(objects, ObjectFrameCost{});
         s.batchMissed.resize(kBatch);
