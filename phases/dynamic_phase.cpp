@@ -488,9 +488,10 @@ std::vector<TileRequest> DynamicPhase::shade(bool acceptFallbacks) {
     WorkDeadline deadline(options_.deadline);
     tbb::parallel_for(size_t{0}, bandDone_.size(), [&](size_t b) {
         if (bandDone_[b] || deadline.passed()) return;
-        // Denormals flushed on every thread that shades, as on those that fill tiles and
-        // trace the reference: a thread's mode otherwise depended on whether a static fill
-        // had run on it, and a denormal result with it (frames' bits on scheduling).
+        // Denormals flushed in every task that shades, as in those that fill tiles and
+        // trace the reference. TBB runs a task in the float mode of the thread that started
+        // it, and whether that one's was flushed depended on whether a static fill's task
+        // had run on it before: a denormal result, and a frame's bits, with it.
         enableFlushToZero();
         const ScopedSpan task(options_.trace, "band", PhaseKind::Dynamic, SpanLevel::Task, -1,
                               frame_->index);

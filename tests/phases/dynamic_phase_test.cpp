@@ -6,6 +6,7 @@
 // a change of view, never from coarser levels, within its budget.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -14,6 +15,9 @@
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 #include "phases/dynamic_frame.h"
 #include "phases/dynamic_phase.h"
@@ -163,6 +167,43 @@ TEST(DynamicPhase, OpacityOutsideZeroToOneIsClampedAndANonFiniteResultIsOpaqueBl
             }
         }
     }
+}
+
+TEST(DynamicPhase, DenormalsAreFlushedWhateverTheCallersFloatMode) {
+    // The dynamic shader takes its result through a denormal and back: flushed, the plane
+    // is black; kept, about (1 + |I.x|) / 4. Each task the dynamic phase and the resolve
+    // run flushes denormals (as the static fills and the reference's tracing do), so the
+    // frame is the same bits whichever mode the caller had (TBB gives its tasks the mode of
+    // the thread that started them, and a static fill can leave that thread's flushed).
+#if !defined(__SSE__)
+    GTEST_SKIP() << "the float mode is set through SSE's control register";
+#else
+    Frame f(writePlaneScene("float_mode",
+                            "surface plane() { float x = (1 + abs(I[0])) * 1e-30; "
+                            "x = x * 1e-10; x = x * 1e30; Ci = color(x * 2.5e9); }"),
+            Representation::Facets);
+    constexpr unsigned kFlushAndDenormalsZero = 0x8040;
+    std::vector<float> samples[2];
+    Image images[2];
+    for (int flushed = 0; flushed < 2; ++flushed) {
+        const unsigned saved = _mm_getcsr();
+        _mm_setcsr(flushed ? (saved | kFlushAndDenormalsZero) : (saved & ~kFlushAndDenormalsZero));
+        DynamicPhase phase(f.scene);
+        phase.begin(f.state, f.drawn, f.layout, f.options(ShadingRate::Sample));
+        EXPECT_TRUE(phase.shade().empty());
+        samples[flushed] = phase.samples().rgba;
+        phase.resolve(images[flushed]);
+        _mm_setcsr(saved);
+    }
+    // Flushed: the plane black and opaque over the background.
+    EXPECT_EQ(samples[1][0], 0.0f);
+    ASSERT_EQ(samples[0].size(), samples[1].size());
+    EXPECT_EQ(0,
+              std::memcmp(samples[0].data(), samples[1].data(), samples[0].size() * sizeof(float)));
+    ASSERT_EQ(images[0].rgba.size(), images[1].rgba.size());
+    EXPECT_EQ(0, std::memcmp(images[0].rgba.data(), images[1].rgba.data(),
+                             images[0].rgba.size() * sizeof(float)));
+#endif
 }
 
 TEST(DynamicPhase, OneShadingPointPerSamplePixelOrBlockAndSurface) {
