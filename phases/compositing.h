@@ -54,7 +54,12 @@ inline size_t sanitizeShadeRows(size_t n, const float* const ci[3], const float*
             check += (c[k] - c[k]) + (o[k] - o[k]);
         }
         const auto finite = check == zero;
+#if defined(__SSE__)
+        nonFinite += static_cast<size_t>(
+            __builtin_popcount(~_mm_movemask_ps(reinterpret_cast<__m128>(finite)) & 0xF));
+#else
         for (int k = 0; k < 4; ++k) nonFinite += finite[k] ? 0 : 1;
+#endif
         for (int k = 0; k < 3; ++k) {
             c[k] = finite ? c[k] : zero;
             // std::clamp(o, 0, 1): o < 0 ? 0 : (1 < o ? 1 : o).
