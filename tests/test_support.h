@@ -5,6 +5,9 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#if defined(__SSE__)
+#include <xmmintrin.h>
+#endif
 
 namespace mpshade::test {
 
@@ -22,5 +25,32 @@ inline std::string testFolder(const std::string& prefix) {
     std::filesystem::create_directories(dir);
     return dir;
 }
+
+// The calling thread's float mode set for a scope, denormals flushed to zero (and read as
+// zero) or kept, and restored after. A static fill's tasks flush them (enableFlushToZero)
+// and TBB hands a thread's mode on to the tasks it starts, so a test before another in the
+// same process may have left it either way. Without SSE the mode is left as it is.
+class FloatMode {
+  public:
+    explicit FloatMode(bool flush) {
+#if defined(__SSE__)
+        constexpr unsigned kFlushAndDenormalsZero = 0x8040;  // MXCSR's FTZ and DAZ bits
+        saved_ = _mm_getcsr();
+        _mm_setcsr(flush ? (saved_ | kFlushAndDenormalsZero) : (saved_ & ~kFlushAndDenormalsZero));
+#else
+        (void)flush;
+#endif
+    }
+    ~FloatMode() {
+#if defined(__SSE__)
+        _mm_setcsr(saved_);
+#endif
+    }
+    FloatMode(const FloatMode&) = delete;
+    FloatMode& operator=(const FloatMode&) = delete;
+
+  private:
+    unsigned saved_ = 0;
+};
 
 }  // namespace mpshade::test

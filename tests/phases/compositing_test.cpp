@@ -9,11 +9,9 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#if defined(__SSE__)
-#include <xmmintrin.h>
-#endif
 
 #include "phases/compositing.h"
+#include "test_support.h"
 
 namespace mpshade {
 namespace {
@@ -26,36 +24,12 @@ bool sameResult(float a, float b, bool flushing) {
            std::fabs(b) < std::numeric_limits<float>::min();
 }
 
-// The renderer's worker threads may run with denormals flushed (a static fill turns that on
-// for Embree; enableFlushToZero), and a test before this one in the same process may have
-// left it on: the policy is checked in both modes, the process's mode restored after.
-class FloatMode {
-  public:
-    explicit FloatMode(bool flush) {
-#if defined(__SSE__)
-        constexpr unsigned kFlushAndDenormalsZero = 0x8040;
-        saved_ = _mm_getcsr();
-        _mm_setcsr(flush ? (saved_ | kFlushAndDenormalsZero) : (saved_ & ~kFlushAndDenormalsZero));
-#else
-        (void)flush;
-#endif
-    }
-    ~FloatMode() {
-#if defined(__SSE__)
-        _mm_setcsr(saved_);
-#endif
-    }
-    FloatMode(const FloatMode&) = delete;
-    FloatMode& operator=(const FloatMode&) = delete;
-
-  private:
-    unsigned saved_ = 0;
-};
-
+// The policy is checked with denormals kept and flushed (test::FloatMode): the renderer's
+// shading tasks flush them, and a test run before this one may have left either mode.
 TEST(Compositing, RowsAreSanitizedAsEachResultAlone) {
     for (const bool flushing : {false, true}) {
         SCOPED_TRACE(flushing ? "denormals flushed" : "IEEE denormals");
-        const FloatMode mode(flushing);
+        const test::FloatMode mode(flushing);
         std::mt19937 rng(5);
         const float specials[] = {std::numeric_limits<float>::quiet_NaN(),
                                   std::numeric_limits<float>::infinity(),

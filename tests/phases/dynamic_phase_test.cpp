@@ -15,9 +15,6 @@
 
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
-#if defined(__SSE__)
-#include <xmmintrin.h>
-#endif
 
 #include "phases/dynamic_frame.h"
 #include "phases/dynamic_phase.h"
@@ -171,10 +168,10 @@ TEST(DynamicPhase, OpacityOutsideZeroToOneIsClampedAndANonFiniteResultIsOpaqueBl
 
 TEST(DynamicPhase, DenormalsAreFlushedWhateverTheCallersFloatMode) {
     // The dynamic shader takes its result through a denormal and back: flushed, the plane
-    // is black; kept, about (1 + |I.x|) / 4. Each task the dynamic phase and the resolve
-    // run flushes denormals (as the static fills and the reference's tracing do), so the
-    // frame is the same bits whichever mode the caller had (TBB gives its tasks the mode of
-    // the thread that started them, and a static fill can leave that thread's flushed).
+    // is black; kept, about (1 + |I.x|) / 4. Each task the dynamic phase runs flushes
+    // denormals (as the static fills and the reference's tracing do), so the frame is the
+    // same bits whichever mode the caller had (TBB gives its tasks the mode of the thread
+    // that started them, and a static fill can leave that thread's flushed).
 #if !defined(__SSE__)
     GTEST_SKIP() << "the float mode is set through SSE's control register";
 #else
@@ -182,18 +179,15 @@ TEST(DynamicPhase, DenormalsAreFlushedWhateverTheCallersFloatMode) {
                             "surface plane() { float x = (1 + abs(I[0])) * 1e-30; "
                             "x = x * 1e-10; x = x * 1e30; Ci = color(x * 2.5e9); }"),
             Representation::Facets);
-    constexpr unsigned kFlushAndDenormalsZero = 0x8040;
     std::vector<float> samples[2];
     Image images[2];
     for (int flushed = 0; flushed < 2; ++flushed) {
-        const unsigned saved = _mm_getcsr();
-        _mm_setcsr(flushed ? (saved | kFlushAndDenormalsZero) : (saved & ~kFlushAndDenormalsZero));
+        const test::FloatMode mode(flushed == 1);
         DynamicPhase phase(f.scene);
         phase.begin(f.state, f.drawn, f.layout, f.options(ShadingRate::Sample));
         EXPECT_TRUE(phase.shade().empty());
         samples[flushed] = phase.samples().rgba;
         phase.resolve(images[flushed]);
-        _mm_setcsr(saved);
     }
     // Flushed: the plane black and opaque over the background.
     EXPECT_EQ(samples[1][0], 0.0f);
