@@ -264,9 +264,10 @@ inline void compositePixel(const BandPoints& pts, const BandRange& r, const Visi
             rgba = (zero + oi * ci) + t * background4;
             rgba[3] = 1.0f - (t[0] + t[1] + t[2]) / 3.0f;
         } else if (vis.count[smp] == 0) {
-            // The background alone: SampleComposite's finish with nothing over it.
+            // The background alone: SampleComposite's finish with nothing over it (C 0, T 1;
+            // 0 + 1 bg rather than bg, so a -0 comes out +0 as there), coverage 0.
             rgba = zero + one * background4;
-            rgba[3] = 1.0f - (1.0f + 1.0f + 1.0f) / 3.0f;
+            rgba[3] = 0.0f;
         } else {
             SampleComposite c;
             for (int l = 0; l < vis.count[smp]; ++l) {
