@@ -49,11 +49,15 @@ inline Float4 queryDerivatives(const ProbeQuery& q) {
     return v;
 }
 
+using Int4 = int32_t __attribute__((vector_size(16)));
+
 // Whether a query's footprint shares `setup` (|change| <= tolerance in all four, false for a
 // NaN either way).
 inline bool sharesSetup(const FelineSetup& setup, const ProbeQuery& q) {
     const Float4 change = queryDerivatives(q) - setup.derivatives;
-    const auto within = (change <= setup.tolerance) & (change >= -setup.tolerance);
+    // |change| by clearing the sign bits; NaN stays NaN, and compares false.
+    const Float4 size = reinterpret_cast<Float4>(reinterpret_cast<Int4>(change) & 0x7fffffff);
+    const auto within = size <= setup.tolerance;
 #if defined(__SSE__)
     const bool all = _mm_movemask_ps(reinterpret_cast<__m128>(within)) == 0xF;
 #else
@@ -112,16 +116,20 @@ int felineLanes(const Prober<C, Texels>& p, const FelineSetup& setup, const Prob
     v = reinterpret_cast<LaneFloats>(reinterpret_cast<LaneInts>(v) & (v - v == zero));
     const LaneFloats u0 = u + setup.offsetU, v0 = v + setup.offsetV;
 
+    // No member has a default initializer: a zeroed Line was a string store a call (five of
+    // them with the sums below), each tens of cycles to start for a few hundred bytes.
     struct Line {
-        int level = 0;
-        float scale = 0.0f, fres = 0.0f, dx = 0.0f, dy = 0.0f;
-        int tx0 = 0, ty0 = 0;          // the tile of the first query's first tap
-        const Storage* tiles[9] = {};  // tiles tx0 - 1 .. tx0 + 1 by ty0 - 1 .. ty0 + 1
+        int level;
+        float scale, fres, dx, dy;
+        int tx0, ty0;             // the tile of the first query's first tap
+        const Storage* tiles[9];  // tiles tx0 - 1 .. tx0 + 1 by ty0 - 1 .. ty0 + 1: only
+                                  // those a probed lane reads are set
     };
     Line lines[2];
     int count = 0;
-    if (setup.blend < 1.0f) lines[count++] = {setup.l0, 1.0f - setup.blend};
-    if (setup.blend > 0.0f) lines[count++] = {setup.l1, setup.blend};
+    if (setup.blend < 1.0f)
+        lines[count].level = setup.l0, lines[count++].scale = 1.0f - setup.blend;
+    if (setup.blend > 0.0f) lines[count].level = setup.l1, lines[count++].scale = setup.blend;
     const int n = setup.n;
     const int shift = p.tileShift;
     for (int l = 0; l < count; ++l) {
@@ -158,8 +166,8 @@ int felineLanes(const Prober<C, Texels>& p, const FelineSetup& setup, const Prob
         unsigned missing = 0;
         for (unsigned bits = wanted; bits != 0; bits &= bits - 1) {
             const int slot = std::countr_zero(bits);
-            line.tiles[slot] = p.tileAt(setup.chart, line.level, line.tx0 + slot % 3 - 1,
-                                        line.ty0 + slot / 3 - 1);
+            line.tiles[slot] =
+                p.tileAt(setup.chart, line.level, line.tx0 + slot % 3 - 1, line.ty0 + slot / 3 - 1);
             if (!line.tiles[slot]) missing |= 1u << slot;
         }
         if (missing != 0) {
@@ -170,32 +178,51 @@ int felineLanes(const Prober<C, Texels>& p, const FelineSetup& setup, const Prob
         if (lanes == 0) return 0;
     }
 
-    // Texel offsets and bilinear weights in lanes, then each query's texels.
-    Float4 sum[kLanes][kVectors] = {};
+    // Texel offsets and bilinear weights in lanes, tap by tap, then each query's texels with
+    // its sums in registers: lane j's line l adds its taps in order into acc, and acc into the
+    // line sum, as lineInTile does.
+    constexpr int kTapsAtOnce = 4;  // taps a pass keeps in lanes (n is nearly always 1-3)
+    struct Tap {
+        LaneInts slot, at;
+        LaneFloats w00, w10, w01, w11;
+    };
+    Float4 sum[kLanes][kVectors];
     const int rowValues = static_cast<int>(p.rowValues);
     const int border = p.border;
     for (int l = 0; l < count; ++l) {
         const Line& line = lines[l];
-        Float4 acc[kLanes][kVectors] = {};
         LaneFloats x = u0 * line.fres - 0.5f, y = v0 * line.fres - 0.5f;
-        for (int i = 0; i < n; ++i, x += line.dx, y += line.dy) {
-            const LaneInts ix = __builtin_convertvector(x, LaneInts),
-                           iy = __builtin_convertvector(y, LaneInts);
-            const LaneFloats fx = x - __builtin_convertvector(ix, LaneFloats);
-            const LaneFloats fy = y - __builtin_convertvector(iy, LaneFloats);
-            const float wi = setup.weights[i] * line.scale;
-            const LaneFloats wy0 = wi * (1.0f - fy), wy1 = wi * fy;
-            const LaneFloats w00 = wy0 * (1.0f - fx), w10 = wy0 * fx, w01 = wy1 * (1.0f - fx),
-                             w11 = wy1 * fx;
-            const LaneInts tx = ix >> shift, ty = iy >> shift;
-            const LaneInts slot = (ty - line.ty0 + 1) * 3 + (tx - line.tx0 + 1);
-            const LaneInts at =
-                (iy - (ty << shift) + border) * rowValues + (ix - (tx << shift) + border) * C;
-            for (int j = 0; j < lanes; ++j)
-                p.addTexels(line.tiles[slot[j]] + at[j], w00[j], w10[j], w01[j], w11[j], acc[j]);
+        Float4 acc[kLanes][kVectors];
+        for (int i0 = 0; i0 < n; i0 += kTapsAtOnce) {
+            const int taps = std::min(kTapsAtOnce, n - i0);
+            Tap tap[kTapsAtOnce];
+            for (int t = 0; t < taps; ++t, x += line.dx, y += line.dy) {
+                const LaneInts ix = __builtin_convertvector(x, LaneInts),
+                               iy = __builtin_convertvector(y, LaneInts);
+                const LaneFloats fx = x - __builtin_convertvector(ix, LaneFloats);
+                const LaneFloats fy = y - __builtin_convertvector(iy, LaneFloats);
+                const float wi = setup.weights[i0 + t] * line.scale;
+                const LaneFloats wy0 = wi * (1.0f - fy), wy1 = wi * fy;
+                tap[t].w00 = wy0 * (1.0f - fx), tap[t].w10 = wy0 * fx;
+                tap[t].w01 = wy1 * (1.0f - fx), tap[t].w11 = wy1 * fx;
+                const LaneInts tx = ix >> shift, ty = iy >> shift;
+                tap[t].slot = (ty - line.ty0 + 1) * 3 + (tx - line.tx0 + 1);
+                tap[t].at =
+                    (iy - (ty << shift) + border) * rowValues + (ix - (tx << shift) + border) * C;
+            }
+            for (int j = 0; j < lanes; ++j) {
+                Float4 a[kVectors];
+                for (int k = 0; k < kVectors; ++k) a[k] = i0 == 0 ? Float4{} : acc[j][k];
+                for (int t = 0; t < taps; ++t)
+                    p.addTexels(line.tiles[tap[t].slot[j]] + tap[t].at[j], tap[t].w00[j],
+                                tap[t].w10[j], tap[t].w01[j], tap[t].w11[j], a);
+                for (int k = 0; k < kVectors; ++k) acc[j][k] = a[k];
+            }
         }
+        // 0 + acc is acc (a sum from +0 is never -0): the first line's is stored as it is.
         for (int j = 0; j < lanes; ++j)
-            for (int k = 0; k < kVectors; ++k) sum[j][k] += acc[j][k];
+            for (int k = 0; k < kVectors; ++k)
+                sum[j][k] = l == 0 ? acc[j][k] : sum[j][k] + acc[j][k];
     }
     p.fastProbes +=
         static_cast<uint64_t>(count) * static_cast<uint64_t>(n) * static_cast<uint64_t>(lanes);

@@ -78,6 +78,18 @@ Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy
     return f;
 }
 
+// r[i] = lane i of a, b, c, d.
+inline void transpose4(Float4 a, Float4 b, Float4 c, Float4 d, Float4* r) {
+    const Float4 ab0 = __builtin_shufflevector(a, b, 0, 4, 1, 5);
+    const Float4 ab1 = __builtin_shufflevector(a, b, 2, 6, 3, 7);
+    const Float4 cd0 = __builtin_shufflevector(c, d, 0, 4, 1, 5);
+    const Float4 cd1 = __builtin_shufflevector(c, d, 2, 6, 3, 7);
+    r[0] = __builtin_shufflevector(ab0, cd0, 0, 1, 4, 5);
+    r[1] = __builtin_shufflevector(ab0, cd0, 2, 3, 6, 7);
+    r[2] = __builtin_shufflevector(ab1, cd1, 0, 1, 4, 5);
+    r[3] = __builtin_shufflevector(ab1, cd1, 2, 3, 6, 7);
+}
+
 template <int C, typename Texels>
 void probeAll(const ShaderMap& map, const ProbeOptions& options,
               std::span<const ProbeQuery> queries, ProbeOutput out, ProbeResidency* residency) {
@@ -200,7 +212,19 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
                                   block)
                     : 0;
             if (m > 0) {
-                for (int j = 0; j < m; ++j) {
+                int j = 0;
+                // Four queries' channels at once into the rows (a 4x4 transpose a vector): the
+                // rows then take four stores a channel instead of one a query and channel.
+                if (out.rows)
+                    for (; j + 4 <= m; j += 4)
+                        for (int c = 0; c < kVectors; ++c) {
+                            Float4 r[4];
+                            transpose4(block[j][c], block[j + 1][c], block[j + 2][c],
+                                       block[j + 3][c], r);
+                            for (int i = 0; i < 4 && 4 * c + i < channels; ++i)
+                                storeFloat4(out.rows[4 * c + i] + k + static_cast<size_t>(j), r[i]);
+                        }
+                for (; j < m; ++j) {
                     float value[4 * (kVectors > 0 ? kVectors : 1)];
                     for (int c = 0; c < kVectors; ++c) storeFloat4(value + 4 * c, block[j][c]);
                     write(k + static_cast<size_t>(j), value);

@@ -101,6 +101,31 @@ TEST_P(ProbeLanes, Avx2AndPortableAgreeOnRows) {
         }
 }
 
+// Results written into channel rows (the lanes' go four queries at a time by a transpose)
+// are the ones written query by query, in either build.
+TEST_P(ProbeLanes, RowsHoldWhatInterleavedHolds) {
+    const NoiseMaps maps(GetParam());
+    const size_t channels = static_cast<size_t>(GetParam());
+    using Probe = void (*)(const ShaderMap&, const ProbeOptions&, std::span<const ProbeQuery>,
+                           ProbeOutput, ProbeResidency*);
+    std::vector<Probe> builds = {probeShaderMapPortable};
+    if (probeAvx2Available()) builds.push_back(probeShaderMapAvx2);
+    for (Probe probe : builds)
+        for (const ProbeOptions& o : felineOptions())
+            for (const std::vector<ProbeQuery>& qs : rows()) {
+                std::vector<float> interleaved(qs.size() * channels);
+                std::vector<std::vector<float>> rowData(channels, std::vector<float>(qs.size()));
+                std::vector<float*> rowPointers;
+                for (std::vector<float>& r : rowData) rowPointers.push_back(r.data());
+                probe(*maps.full, o, qs, ProbeOutput{interleaved.data()}, nullptr);
+                probe(*maps.full, o, qs, ProbeOutput{nullptr, rowPointers.data()}, nullptr);
+                for (size_t k = 0; k < qs.size(); ++k)
+                    for (size_t c = 0; c < channels; ++c)
+                        ASSERT_EQ(rowData[c][k], interleaved[k * channels + c])
+                            << "query " << k << " channel " << c;
+            }
+}
+
 // A map with most of its fine tiles missing: the lanes leave a query whose tiles are
 // missing to the one-at-a-time path, so the answers (coarser levels' values), the counts
 // and the queries marked as missing are what each query alone gives.
