@@ -124,9 +124,11 @@ void intersectFacets(const ObjectView& view, const FacetMesh& mesh, const Surfac
         const size_t first = runs[r], end = runs[r + 1];
         const uint32_t facet = points.facet[first];
         size_t i = first;
-        if (end - first >= 4) {
+        // Two points or more go four at a time, the last four past the run's end while
+        // inside the batch: the next run writes its own points' results over those lanes.
+        if (end - first >= 2) {
             const FacetRay<Float4> f = facetRay<Float4>(view, mesh, facet);
-            for (; i + 4 <= end; i += 4) {
+            for (; i < end && i + 4 <= n; i += 4) {
                 const RayHit<Float4> h =
                     hitFacet(f, loadFloat4(points.x + i), loadFloat4(points.y + i));
                 storeFloat4(bary1 + i, h.b1), storeFloat4(bary2 + i, h.b2);
@@ -139,7 +141,7 @@ void intersectFacets(const ObjectView& view, const FacetMesh& mesh, const Surfac
                 }
             }
         }
-        if (i == end) continue;
+        if (i >= end) continue;
         const FacetRay<float> f = facetRay<float>(view, mesh, facet);
         for (; i < end; ++i) {
             const RayHit<float> h = hitFacet(f, points.x[i], points.y[i]);
@@ -197,13 +199,15 @@ void interpolateRow(const uint32_t* __restrict attributeIndex, const SurfacePoin
                     const float* __restrict bary2, const float* __restrict r,
                     float* __restrict out) {
     const Float4 one4 = splatFloat4(1.0f);
+    const size_t n = points.n;
     for (size_t k = 0; k + 1 < runs.size(); ++k) {
         const size_t first = runs[k], end = runs[k + 1];
         const uint32_t* a = &attributeIndex[3 * static_cast<size_t>(points.facet[first])];
         const float r0 = r[a[0]], r1 = r[a[1]], r2 = r[a[2]];
         size_t i = first;
         const Float4 r04 = splatFloat4(r0), r14 = splatFloat4(r1), r24 = splatFloat4(r2);
-        for (; i + 4 <= end; i += 4) {
+        // As in intersectFacets, past the run's end while inside the batch.
+        for (; i < end && i + 4 <= n; i += 4) {
             const Float4 b1 = loadFloat4(bary1 + i), b2 = loadFloat4(bary2 + i);
             storeFloat4(out + i, (one4 - b1 - b2) * r04 + b1 * r14 + b2 * r24);
         }
