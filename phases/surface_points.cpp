@@ -25,8 +25,8 @@ void growTo(std::vector<T>& v, size_t n) {
 // Points come in runs on one facet (the samples of a pixel, the pixels of a facet's row):
 // scratch.runs holds each run's first point, then n. The steps below take a facet's
 // constants once a run and its points four at a time, in vectors whose lanes do exactly
-// the scalar arithmetic, in the same order: the last points of a run, done one by one,
-// get the same bits as they would in a lane.
+// the scalar arithmetic, in the same order: a point gets the same bits in a lane or done
+// alone (a one-point run, or the last of the batch).
 // Without a branch: runs of a few points ended in a mispredicted one each (6% of this
 // file's time on the courtyard's frame).
 std::span<const uint32_t> findRuns(const SurfacePoints& points, std::vector<uint32_t>& runs) {
