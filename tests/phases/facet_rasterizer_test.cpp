@@ -114,9 +114,10 @@ TEST(FacetRasterizer, SharedEdgesAreWatertight) {
 }
 
 TEST(FacetRasterizer, OpaqueDepthTestCoversTheSameSamples) {
-    // The opaque path (one layer, the vectorized depth test, whole tiles skipping the edge
-    // tests) must cover exactly the samples the k-buffer path does, and keep the nearest
-    // facet: here depth falls with x, so the facet with the largest 1/depth wins.
+    // The opaque path (one layer, the vectorized depth test -- by hand in AVX-512 where the
+    // processor has it --, whole tiles skipping the edge tests) must cover exactly the
+    // samples the k-buffer path does, at the same depth bits, and keep the nearest facet:
+    // here depth falls with x, so the facet with the largest 1/depth wins.
     GridFixture g;
     VisibilityBuffer layered, opaque;
     RasterStats a, b;
@@ -129,6 +130,8 @@ TEST(FacetRasterizer, OpaqueDepthTestCoversTheSameSamples) {
         ASSERT_EQ(opaque.count[s], layered.count[s]) << s;
         if (opaque.count[s]) {
             ASSERT_EQ(opaque.facet[s], layered.facet[s * layered.layers]);
+            // The same depth plane, evaluated alike (unfused) in the vector sample test.
+            ASSERT_EQ(opaque.invDepth[s], layered.invDepth[s * layered.layers]) << s;
         }
     }
     // Surfaces beyond the far plane are not seen: 1 / depth here is 0.2 .. 0.211.
@@ -166,6 +169,7 @@ TEST(FacetRasterizer, SubPixelFacetsCoverEverySampleOnce) {
             ASSERT_EQ(opaque.count[s], layered.count[s]) << spp << " spp, sample " << s;
             if (opaque.count[s]) {
                 ASSERT_EQ(opaque.facet[s], layered.facet[s * layered.layers]);
+                ASSERT_EQ(opaque.invDepth[s], layered.invDepth[s * layered.layers]);
             }
         }
         EXPECT_GT(interior, 700 * spp);
