@@ -159,7 +159,9 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) uint32_t boxDepthTe
 // same bits. (GCC 12's conversion intrinsics start from an undefined vector, which
 // -Wmaybe-uninitialized reports inside the header.)
 #pragma GCC diagnostic push
+#if !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 __attribute__((target("avx512f,avx512vl"))) uint32_t boxDepthTestAvx512(
     const int32_t* fx, const int32_t* fy, size_t rows, size_t n, size_t stride, int32_t ox,
     int32_t oy, const Setup& s, bool edges, float* inv, uint32_t* object, uint32_t* facet,
