@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 
 #if defined(__SSE__)
@@ -13,6 +14,8 @@
 namespace mpshade {
 
 using Float4 = float __attribute__((vector_size(16)));
+// Four 32-bit integers: a Float4's comparison masks, and its lanes' bits.
+using Int4 = int32_t __attribute__((vector_size(16)));
 
 inline Float4 loadFloat4(const float* p) {
     Float4 v;

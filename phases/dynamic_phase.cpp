@@ -280,8 +280,7 @@ inline void compositePixel(const BandPoints& pts, const BandRange& r, const Visi
         }
         storeFloat4(&rgbaOut[4 * smp], rgba);
         // Bit for bit, as the resolve compares alike blocks.
-        using Bits = int32_t __attribute__((vector_size(16)));
-        const Bits differ = reinterpret_cast<Bits>(rgba) ^ reinterpret_cast<Bits>(firstRgba);
+        const Int4 differ = reinterpret_cast<Int4>(rgba) ^ reinterpret_cast<Int4>(firstRgba);
         if (smp == first)
             firstRgba = rgba;
         else

@@ -49,8 +49,6 @@ inline Float4 queryDerivatives(const ProbeQuery& q) {
     return v;
 }
 
-using Int4 = int32_t __attribute__((vector_size(16)));
-
 // Whether a query's footprint shares `setup` (|change| <= tolerance in all four, false for a
 // NaN either way).
 inline bool sharesSetup(const FelineSetup& setup, const ProbeQuery& q) {
