@@ -28,6 +28,55 @@ void sizePoints(BandPoints& pts, size_t objects) {
     pts.x.resize(points), pts.y.resize(points);
 }
 
+// samplePoints with one layer (every object opaque): a sample holds at most one fragment,
+// its slot the sample itself. The counts and cursors are kept in registers over each run of
+// one object's samples: incremented in memory sample after sample, each waited on the last
+// one's store (the counting sort's chain), most of the time this took.
+void samplePointsOneLayer(const SampleLayout& layout, const VisibilityBuffer& vis,
+                          const BandRange& r, size_t objects, BandPoints& pts,
+                          BandPointScratch& s) {
+    const uint8_t* count = vis.count.data();
+    const uint32_t* object = vis.object.data();
+    const uint32_t* facet = vis.facet.data();
+    pts.pixelPoint.clear();
+    uint32_t current = 0;
+    uint32_t run = 0;
+    for (int py = r.row0; py < r.row1; ++py)
+        for (size_t smp = layout.index(r.col0, py, 0); smp < layout.index(r.col1, py, 0); ++smp) {
+            if (!count[smp]) continue;
+            const uint32_t o = object[smp];
+            if (o != current) {
+                pts.objectStart[current + 1] += run;
+                current = o, run = 0;
+            }
+            ++run;
+        }
+    pts.objectStart[current + 1] += run;
+    sizePoints(pts, objects);
+    s.cursor.assign(pts.objectStart.begin(), pts.objectStart.end() - 1);
+    uint32_t* const pointObject = pts.object.data();
+    uint32_t* const pointFacet = pts.facet.data();
+    float* const px = pts.x.data();
+    float* const py = pts.y.data();
+    uint32_t* const fragmentPoint = pts.fragmentPoint.data() - r.firstSlot;
+    current = 0;
+    uint32_t at = s.cursor[0];
+    for (int row = r.row0; row < r.row1; ++row)
+        for (size_t smp = layout.index(r.col0, row, 0); smp < layout.index(r.col1, row, 0); ++smp) {
+            if (!count[smp]) continue;
+            const uint32_t o = object[smp];
+            if (o != current) {
+                s.cursor[current] = at;
+                current = o, at = s.cursor[o];
+            }
+            pointObject[at] = o;
+            pointFacet[at] = facet[smp];
+            px[at] = layout.x(smp);
+            py[at] = layout.y(smp);
+            fragmentPoint[smp] = at++;
+        }
+}
+
 // Per sample: a point per fragment, placed by object as it is made (a counting sort).
 void samplePoints(const SampleLayout& layout, const VisibilityBuffer& vis, const BandRange& r,
                   size_t objects, BandPoints& pts, BandPointScratch& s) {
@@ -248,7 +297,10 @@ void buildBandPoints(const SampleLayout& layout, const VisibilityBuffer& vis,
                              static_cast<size_t>(vis.layers));
     pts.objectStart.assign(objects + 1, 0);
     if (options.rate == ShadingRate::Sample) {
-        samplePoints(layout, vis, range, objects, pts, scratch);
+        if (vis.layers == 1)
+            samplePointsOneLayer(layout, vis, range, objects, pts, scratch);
+        else
+            samplePoints(layout, vis, range, objects, pts, scratch);
     } else {
         const int block = options.rate == ShadingRate::Quad ? 2 : 1;
         BlockPoints blocks(layout, vis, range, block, pts, scratch);
