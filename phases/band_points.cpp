@@ -39,41 +39,43 @@ void samplePointsOneLayer(const SampleLayout& layout, const VisibilityBuffer& vi
     const uint32_t* object = vis.object.data();
     const uint32_t* facet = vis.facet.data();
     pts.pixelPoint.clear();
-    uint32_t current = 0;
+    // No object yet (a band may have none, and a frame no objects at all).
+    constexpr uint32_t kNone = ~uint32_t{0};
+    uint32_t current = kNone;
     uint32_t run = 0;
     for (int py = r.row0; py < r.row1; ++py)
         for (size_t smp = layout.index(r.col0, py, 0); smp < layout.index(r.col1, py, 0); ++smp) {
             if (!count[smp]) continue;
             const uint32_t o = object[smp];
             if (o != current) {
-                pts.objectStart[current + 1] += run;
+                if (current != kNone) pts.objectStart[current + 1] += run;
                 current = o, run = 0;
             }
             ++run;
         }
-    pts.objectStart[current + 1] += run;
+    if (current != kNone) pts.objectStart[current + 1] += run;
     sizePoints(pts, objects);
     s.cursor.assign(pts.objectStart.begin(), pts.objectStart.end() - 1);
     uint32_t* const pointObject = pts.object.data();
     uint32_t* const pointFacet = pts.facet.data();
     float* const px = pts.x.data();
     float* const py = pts.y.data();
-    uint32_t* const fragmentPoint = pts.fragmentPoint.data() - r.firstSlot;
-    current = 0;
-    uint32_t at = s.cursor[0];
+    uint32_t* const fragmentPoint = pts.fragmentPoint.data();
+    current = kNone;
+    uint32_t at = 0;
     for (int row = r.row0; row < r.row1; ++row)
         for (size_t smp = layout.index(r.col0, row, 0); smp < layout.index(r.col1, row, 0); ++smp) {
             if (!count[smp]) continue;
             const uint32_t o = object[smp];
             if (o != current) {
-                s.cursor[current] = at;
+                if (current != kNone) s.cursor[current] = at;
                 current = o, at = s.cursor[o];
             }
             pointObject[at] = o;
             pointFacet[at] = facet[smp];
             px[at] = layout.x(smp);
             py[at] = layout.y(smp);
-            fragmentPoint[smp] = at++;
+            fragmentPoint[smp - r.firstSlot] = at++;
         }
 }
 

@@ -2,6 +2,7 @@
 // worked out here sample by sample: one point per fragment, grouped by object, in sample
 // order within an object, each fragment pointing at its own point. One layer (every object
 // opaque, the path that keeps its counts in registers) and several.
+#include <algorithm>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -112,6 +113,23 @@ TEST(BandPoints, PerSampleEveryFragmentIsAPointGroupedByObjectInSampleOrder) {
                 buildBandPoints(layout, vis, tile, objects, BandPointOptions{}, pts, scratch);
                 expectPoints(layout, vis, tile, objects, pts);
             }
+}
+
+// A frame that draws no object: no points, and nothing written outside the arrays (ASan).
+TEST(BandPoints, NoObjectsNoPoints) {
+    for (const int layers : {1, 2}) {
+        const SampleLayout layout(9, 5, 4, 1u);
+        VisibilityBuffer vis;
+        vis.resize(9, 5, 4, layers);
+        std::fill(vis.count.begin(), vis.count.end(), uint8_t{0});
+        BandPoints pts;
+        BandPointScratch scratch;
+        const BandRange range(layout, layers, 0, 5);
+        buildBandPoints(layout, vis, range, 0, BandPointOptions{}, pts, scratch);
+        EXPECT_TRUE(pts.object.empty());
+        ASSERT_EQ(pts.objectStart.size(), 1u);
+        EXPECT_EQ(pts.objectStart[0], 0u);
+    }
 }
 
 }  // namespace
