@@ -28,6 +28,15 @@ void sizePoints(BandPoints& pts, size_t objects) {
     pts.x.resize(points), pts.y.resize(points);
 }
 
+// Calls f(sample) for every sample of the range's rows and columns that holds a fragment.
+template <typename F>
+void forEachCoveredSample(const SampleLayout& layout, const BandRange& r, const uint8_t* count,
+                          F&& f) {
+    for (int py = r.row0; py < r.row1; ++py)
+        for (size_t smp = layout.index(r.col0, py, 0); smp < layout.index(r.col1, py, 0); ++smp)
+            if (count[smp]) f(smp);
+}
+
 // samplePoints with one layer (every object opaque): a sample holds at most one fragment,
 // its slot the sample itself. The counts and cursors are kept in registers over each run of
 // one object's samples: incremented in memory sample after sample, each waited on the last
@@ -43,40 +52,34 @@ void samplePointsOneLayer(const SampleLayout& layout, const VisibilityBuffer& vi
     constexpr uint32_t kNone = ~uint32_t{0};
     uint32_t current = kNone;
     uint32_t run = 0;
-    for (int py = r.row0; py < r.row1; ++py)
-        for (size_t smp = layout.index(r.col0, py, 0); smp < layout.index(r.col1, py, 0); ++smp) {
-            if (!count[smp]) continue;
-            const uint32_t o = object[smp];
-            if (o != current) {
-                if (current != kNone) pts.objectStart[current + 1] += run;
-                current = o, run = 0;
-            }
-            ++run;
+    forEachCoveredSample(layout, r, count, [&](size_t smp) {
+        if (object[smp] != current) {
+            if (current != kNone) pts.objectStart[current + 1] += run;
+            current = object[smp], run = 0;
         }
+        ++run;
+    });
     if (current != kNone) pts.objectStart[current + 1] += run;
     sizePoints(pts, objects);
     s.cursor.assign(pts.objectStart.begin(), pts.objectStart.end() - 1);
     uint32_t* const pointObject = pts.object.data();
     uint32_t* const pointFacet = pts.facet.data();
-    float* const px = pts.x.data();
-    float* const py = pts.y.data();
+    float* const pointX = pts.x.data();
+    float* const pointY = pts.y.data();
     uint32_t* const fragmentPoint = pts.fragmentPoint.data();
     current = kNone;
     uint32_t at = 0;
-    for (int row = r.row0; row < r.row1; ++row)
-        for (size_t smp = layout.index(r.col0, row, 0); smp < layout.index(r.col1, row, 0); ++smp) {
-            if (!count[smp]) continue;
-            const uint32_t o = object[smp];
-            if (o != current) {
-                if (current != kNone) s.cursor[current] = at;
-                current = o, at = s.cursor[o];
-            }
-            pointObject[at] = o;
-            pointFacet[at] = facet[smp];
-            px[at] = layout.x(smp);
-            py[at] = layout.y(smp);
-            fragmentPoint[smp - r.firstSlot] = at++;
+    forEachCoveredSample(layout, r, count, [&](size_t smp) {
+        if (object[smp] != current) {
+            if (current != kNone) s.cursor[current] = at;
+            current = object[smp], at = s.cursor[current];
         }
+        pointObject[at] = current;
+        pointFacet[at] = facet[smp];
+        pointX[at] = layout.x(smp);
+        pointY[at] = layout.y(smp);
+        fragmentPoint[smp - r.firstSlot] = at++;
+    });
 }
 
 // Per sample: a point per fragment, placed by object as it is made (a counting sort).
