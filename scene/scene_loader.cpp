@@ -85,7 +85,9 @@ double lengthOf(const JsonNode& n) {
 glm::vec3 colorOf(const JsonNode& n) {
     glm::vec3 c = n.vec3();
     if (c.x < 0 || c.y < 0 || c.z < 0) n.fail("color components must be non-negative");
-    return c;
+    // -0 as +0: a light's terms are then never -0, which the shaders' light sums rely on
+    // to start from their first light (shading/lower.cpp).
+    return c + glm::vec3(0.0f);
 }
 glm::vec3 directionOf(const JsonNode& n) {
     glm::vec3 d = n.vec3();

@@ -315,14 +315,21 @@ class Lowerer {
         sum.type = ValueType::Color;
         const int zero = b_.constant(0.0f);
         for (int k = 0; k < 3; ++k) sum.c[k] = zero;
+        bool first = true;
         for (size_t l = 0; l < binding_.lights.size(); ++l) {
             if (binding_.lights[l].kind == LightKind::Ambient) continue;
             // A distant light does not depend on P: do not make it look as if it did.
             std::vector<int> lightArgs = args;
             if (binding_.lights[l].kind == LightKind::Distant)
                 lightArgs[0] = lightArgs[1] = lightArgs[2] = zero;
-            const int first = b_.emit(op, lightArgs, 3, static_cast<int>(l));
-            for (int k = 0; k < 3; ++k) sum.c[k] = b_.emit(Op::Add, {sum.c[k], first + k});
+            const int light = b_.emit(op, lightArgs, 3, static_cast<int>(l));
+            // The first light is the sum so far: 0 + x is x but for x = -0 (a light's terms
+            // are clamped at +0 and scene colours load -0 as +0; only a colour an animation
+            // curve took below 0 can give it, and then a zero either way), and each add cost
+            // the dynamic kernel a pass over its lanes.
+            for (int k = 0; k < 3; ++k)
+                sum.c[k] = first ? light + k : b_.emit(Op::Add, {sum.c[k], light + k});
+            first = false;
         }
         return sum;
     }

@@ -289,7 +289,7 @@ TEST(MultiphaseRenderer, DirectIsRefusedToShadersThatTraceOcclusionRays) {
 }
 
 TEST(MultiphaseRenderer, StaticPartNotWorthStoringLeavesGeometryOnly) {
-    // The teapot's plastic under a moving light: the fixed lights' diffuse (33 units) is not
+    // The teapot's plastic under a moving light: the fixed light's diffuse (30 units) is not
     // worth a probe, so nothing is stored: no map, facets to the geometric tolerance, the
     // whole shader per sample -- and the frame is as close to the reference as with the
     // diffuse light stored in a map (storeAboveCost 0).
@@ -303,7 +303,7 @@ TEST(MultiphaseRenderer, StaticPartNotWorthStoringLeavesGeometryOnly) {
     const Image ref = reference.renderFrame(3, options, rs);
     const Image got = multi.renderFrame(3, options, ms);
     EXPECT_EQ(multi.factored(teapot).chosenWidth, 0);
-    EXPECT_EQ(multi.factored(teapot).recomputedStaticCost, 33);
+    EXPECT_EQ(multi.factored(teapot).recomputedStaticCost, 30);
     const ObjectRepresentation* rep = multi.representation(teapot);
     ASSERT_NE(rep, nullptr);
     EXPECT_EQ(rep->kind, Representation::ShaderMap);  // diced for the geometric tolerance

@@ -1,5 +1,6 @@
 // The scene file: golden errors for a corpus of bad scenes, keys, the evolving scene at
 // time t, and which inputs of each object vary.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -397,6 +398,29 @@ TEST(SceneState, LightsInObjectSpaceKeepWorldFalloff) {
     EXPECT_NEAR(lights[0].color.x / glm::dot(lights[0].position, lights[0].position),
                 worldIrradiance, 1e-4f);
     EXPECT_NEAR(glm::length(lights[1].toLight - glm::vec3(1, 0, 0)), 0.0f, 1e-5f);
+}
+
+TEST(SceneLoader, NegativeZeroColoursLoadAsPositiveZero) {
+    // The shaders' light sums start from their first light (shading/lower.cpp), exact only
+    // while no light's term is -0: a colour of -0 loads as +0, and -0.0001 is still an error.
+    const auto scene = [](const std::string& color) {
+        return writeScene("zero_color.json", R"({
+      "camera": { "eye": [0, 0, 5], "target": [0, 0, 0] },
+      "lights": [ { "type": "distant", "direction": [0, -1, 0], "color": )" +
+                                                 color + R"( } ],
+      "shaders": { "s": "s.sl" },
+      "objects": [ { "name": "o", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s" } ]
+    })");
+    };
+    const Scene s = loadScene(scene("[-0.0, 1, -0]"));
+    const CameraState cam = cameraAt(s, 0, 64, 64);
+    std::vector<LightSample> lights;
+    lightsAt(s, objectAt(s.objects[0], 0, cam), 0, lights);
+    ASSERT_EQ(lights.size(), 1u);
+    EXPECT_FALSE(std::signbit(lights[0].color.x));
+    EXPECT_FALSE(std::signbit(lights[0].color.z));
+    EXPECT_EQ(lights[0].color.y, 1.0f);
+    EXPECT_THROW(loadScene(scene("[-0.0001, 1, 0]")), InputError);
 }
 
 }  // namespace
