@@ -29,6 +29,18 @@ template <Op OP>
     for (int l = 0; l < m; ++l) o[l] = scalar::ternary(OP, a[l], b[l], c[l]);
 }
 
+template <MulFusion F>
+[[gnu::always_inline]] inline void fusedLoop(float* o, const float* a, const float* b,
+                                             const float* c, int m) {
+    for (int l = 0; l < m; ++l) {
+        const float t = a[l] * b[l];
+        if constexpr (F == MulFusion::ProductPlus) o[l] = t + c[l];
+        if constexpr (F == MulFusion::PlusProduct) o[l] = c[l] + t;
+        if constexpr (F == MulFusion::ProductMinus) o[l] = t - c[l];
+        if constexpr (F == MulFusion::MinusProduct) o[l] = c[l] - t;
+    }
+}
+
 constexpr float kNoOperand[ShaderKernel::kLanes] = {};
 
 // One batch of m lanes (from `start`) through the whole program. Cloned for AVX2 and the
@@ -46,6 +58,22 @@ __attribute__((target_clones("avx2", "default"))) void runBatch(
         const float* b = e.nin > 1 ? S[e.in[1]] : kNoOperand;
         const float* c = e.nin > 2 ? S[e.in[2]] : kNoOperand;
         for (int k = 0; k < e.nout; ++k) S[e.out[k]] = R(e.out[k]);
+        switch (e.fusion) {
+            case MulFusion::None:
+                break;
+            case MulFusion::ProductPlus:
+                fusedLoop<MulFusion::ProductPlus>(o, a, b, c, m);
+                continue;
+            case MulFusion::PlusProduct:
+                fusedLoop<MulFusion::PlusProduct>(o, a, b, c, m);
+                continue;
+            case MulFusion::ProductMinus:
+                fusedLoop<MulFusion::ProductMinus>(o, a, b, c, m);
+                continue;
+            case MulFusion::MinusProduct:
+                fusedLoop<MulFusion::MinusProduct>(o, a, b, c, m);
+                continue;
+        }
         switch (e.op) {
             case Op::Global: {
                 const auto id = static_cast<GlobalId>(e.imm);
@@ -212,6 +240,32 @@ __attribute__((target_clones("avx2", "default"))) void runBatch(
     }
 }
 
+// For each instruction, the index of the addition or subtraction its product is fused
+// into (MulFusion), else -1: a one-result Mul whose value only that instruction reads, once,
+// and that no output keeps (lastUse past the program).
+std::vector<int> findMulFusions(const IrProgram& program, const std::vector<int>& lastUse) {
+    const size_t count = program.insts.size();
+    std::vector<int> uses(static_cast<size_t>(program.valueCount), 0);
+    for (const Inst& inst : program.insts)
+        for (int a = 0; a < inst.nargs; ++a) ++uses[static_cast<size_t>(program.argsOf(inst)[a])];
+    std::vector<int> fusedInto(count, -1);
+    std::vector<char> absorbs(count, 0);
+    for (size_t k = 0; k < count; ++k) {
+        const Inst& mul = program.insts[k];
+        if (mul.op != Op::Mul || mul.nout != 1 || mul.nargs != 2) continue;
+        const auto v = static_cast<size_t>(mul.result);
+        const int reader = lastUse[v];
+        if (uses[v] != 1 || reader < 0 || reader >= static_cast<int>(count)) continue;
+        const Inst& add = program.insts[static_cast<size_t>(reader)];
+        if ((add.op != Op::Add && add.op != Op::Sub) || add.nargs != 2 || add.nout != 1 ||
+            absorbs[static_cast<size_t>(reader)])
+            continue;
+        fusedInto[k] = reader;
+        absorbs[static_cast<size_t>(reader)] = 1;
+    }
+    return fusedInto;
+}
+
 }  // namespace
 
 ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
@@ -228,6 +282,7 @@ ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
     for (int v : program.ci) keepToTheEnd(v);
     for (int v : program.oi) keepToTheEnd(v);
     for (int v : program.channelOutputs) keepToTheEnd(v);
+    const std::vector<int> fusedInto = findMulFusions(program, lastUse);
 
     std::vector<int32_t> reg(static_cast<size_t>(program.valueCount), -1);
     std::vector<char> constantReg;
@@ -249,9 +304,23 @@ ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
         constantReg[static_cast<size_t>(r)] = 1;
         constants_.emplace_back(r, inst.constant);
     }
+    // Where a fused product's arguments are read: where its reader is.
+    for (size_t k = 0; k < program.insts.size(); ++k) {
+        if (fusedInto[k] < 0) continue;
+        const Inst& mul = program.insts[k];
+        for (int a = 0; a < mul.nargs; ++a) {
+            int& last = lastUse[static_cast<size_t>(program.argsOf(mul)[a])];
+            last = std::max(last, fusedInto[k]);
+        }
+    }
+    std::vector<int> fusedFrom(program.insts.size(), -1);
+    for (size_t k = 0; k < program.insts.size(); ++k)
+        if (fusedInto[k] >= 0) fusedFrom[static_cast<size_t>(fusedInto[k])] = static_cast<int>(k);
     for (size_t k = 0; k < program.insts.size(); ++k) {
         const Inst& inst = program.insts[k];
         if (inst.op == Op::Const) continue;
+        ++instructions_;
+        if (fusedInto[k] >= 0) continue;  // emitted with its reader
         ExecInst e;
         e.op = inst.op;
         e.nin = inst.nargs;
@@ -259,13 +328,44 @@ ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
         e.imm = inst.imm;
         const int32_t* args = program.argsOf(inst);
         for (int a = 0; a < inst.nargs; ++a) e.in[a] = reg[static_cast<size_t>(args[a])];
+        if (fusedFrom[k] >= 0) {
+            const Inst& mul = program.insts[static_cast<size_t>(fusedFrom[k])];
+            const int32_t* margs = program.argsOf(mul);
+            const bool productFirst = args[0] == mul.result;
+            const int32_t other = e.in[productFirst ? 1 : 0];
+            e.op = Op::Mul;
+            e.fusion = inst.op == Op::Add
+                           ? (productFirst ? MulFusion::ProductPlus : MulFusion::PlusProduct)
+                           : (productFirst ? MulFusion::ProductMinus : MulFusion::MinusProduct);
+            e.nin = 3;
+            e.in[0] = reg[static_cast<size_t>(margs[0])];
+            e.in[1] = reg[static_cast<size_t>(margs[1])];
+            e.in[2] = other;
+        }
         // Outputs never share a register with this instruction's own inputs.
         for (int o = 0; o < inst.nout; ++o)
             e.out[o] = reg[static_cast<size_t>(inst.result + o)] = allocate();
+        // The fused product's arguments are read here too (their lastUse moved here).
+        if (fusedFrom[k] >= 0) {
+            const Inst& mul = program.insts[static_cast<size_t>(fusedFrom[k])];
+            for (int a = 0; a < mul.nargs; ++a) {
+                const int32_t v = program.argsOf(mul)[a];
+                int& last = lastUse[static_cast<size_t>(v)];
+                const int32_t r = reg[static_cast<size_t>(v)];
+                if (last == static_cast<int>(k) && !constantReg[static_cast<size_t>(r)]) {
+                    freeRegs.push_back(r);
+                    last = -2;
+                }
+            }
+        }
         for (int a = 0; a < inst.nargs; ++a) {
+            if (fusedFrom[k] >= 0 &&
+                args[a] == program.insts[static_cast<size_t>(fusedFrom[k])].result)
+                continue;  // the product: never in a register
             int& last = lastUse[static_cast<size_t>(args[a])];
-            if (last == static_cast<int>(k) && !constantReg[static_cast<size_t>(e.in[a])]) {
-                freeRegs.push_back(e.in[a]);
+            const int32_t r = reg[static_cast<size_t>(args[a])];
+            if (last == static_cast<int>(k) && !constantReg[static_cast<size_t>(r)]) {
+                freeRegs.push_back(r);
                 last = -2;  // freed; a repeated argument is not freed twice
             }
         }
@@ -308,7 +408,7 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
         }
         for (size_t k = 0; k < channelRegs_.size(); ++k)
             std::memcpy(out.channels[k] + start, S[channelRegs_[k]], bytes);
-        counters.instructions += code_.size() * static_cast<uint64_t>(m);
+        counters.instructions += instructions_ * static_cast<uint64_t>(m);
     }
     counters.points += n;
     return true;

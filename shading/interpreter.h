@@ -69,8 +69,21 @@ struct ShadingCounters {
     uint64_t occlusionRays = 0;
 };
 
+// A multiplication fused into the addition or subtraction that is its only reader: one
+// pass over the lanes for the two (the kernel is bound by its passes through L1), each
+// lane rounding the product and then the sum as the two instructions did. With op Mul,
+// in[0] * in[1] is t and in[2] the other operand.
+enum class MulFusion : uint8_t {
+    None,
+    ProductPlus,   // t + in[2]
+    PlusProduct,   // in[2] + t
+    ProductMinus,  // t - in[2]
+    MinusProduct,  // in[2] - t
+};
+
 struct ExecInst {
     Op op;
+    MulFusion fusion = MulFusion::None;
     uint8_t nin = 0, nout = 0;
     int32_t imm = 0;
     int32_t in[10] = {};
@@ -85,7 +98,10 @@ class ShaderKernel {
 
     const IrProgram& program() const { return program_; }
     int registerCount() const { return registerCount_; }
-    size_t instructionCount() const { return code_.size(); }
+    // The program's instructions but constants (a fused pair counts two).
+    size_t instructionCount() const { return instructions_; }
+    // The passes over a batch's lanes: instructions, a fused pair (MulFusion) one.
+    size_t passCount() const { return code_.size(); }
 
     // Runs the program on n points. `workspace` is scratch owned by the caller (one per
     // thread); it is sized on first use and then reused without allocation. `stop` (may
@@ -100,6 +116,7 @@ class ShaderKernel {
     std::vector<ExecInst> code_;
     std::vector<std::pair<int32_t, float>> constants_;  // register, value
     int registerCount_ = 0;
+    size_t instructions_ = 0;
     int ci_[3] = {-1, -1, -1}, oi_[3] = {-1, -1, -1};
     std::vector<int32_t> channelRegs_;
 };

@@ -159,5 +159,41 @@ TEST(Interpreter, CountsInstructionsPerLane) {
     EXPECT_EQ(r.counters.points, 10u);
 }
 
+TEST(Interpreter, ProductsFusedIntoTheirSumsRoundTwice) {
+    // Products read once, by a sum, in every order and sign: each fused into its sum (one
+    // pass, not two) and rounded before the sum as the two instructions round. With
+    // u = v = 1 + 2^-12 and s = -(1 + 2^-11), u v rounds to 1 + 2^-11 (the 2^-24 is a tie
+    // to even), so u v + s is exactly 0; a fused multiply-add would give 2^-24.
+    const float u = 1.0f + 0x1p-12f;
+    ShadingPoint p;
+    p.u = p.v = u, p.s = -(1.0f + 0x1p-11f), p.t = 0.375f;
+    std::vector<ShadingPoint> points(3, p);
+    points[1].u = 0.1f, points[1].v = 0.3f, points[1].s = 0.7f;  // none exact
+    points[2].u = -3.0f, points[2].v = 1e-8f, points[2].s = 1e30f;
+    const std::string source =
+        "surface f() { Ci = color(u * v + s, s + u * t, v * t - s);\n"
+        "  Oi = color(s - u * s, (v * s - t) * t, 1); }";
+    auto ast = compileShaderText("fused.sl", source);
+    const ShaderKernel kernel(lowerShader(*ast, {}));
+    // Five products, each fused into the one sum that reads it.
+    EXPECT_EQ(kernel.passCount() + 5, kernel.instructionCount());
+    const auto r = test::runKernel(kernel, points);
+    auto times = [](float a, float b) {
+        const volatile float product = a * b;  // rounded on its own
+        return static_cast<float>(product);
+    };
+    for (size_t i = 0; i < points.size(); ++i) {
+        const ShadingPoint& q = points[i];
+        EXPECT_EQ(r.Ci[i].x, times(q.u, q.v) + q.s) << i;
+        EXPECT_EQ(r.Ci[i].y, q.s + times(q.u, q.t)) << i;
+        EXPECT_EQ(r.Ci[i].z, times(q.v, q.t) - q.s) << i;
+        EXPECT_EQ(r.Oi[i].x, q.s - times(q.u, q.s)) << i;
+        EXPECT_EQ(r.Oi[i].y, (times(q.v, q.s) - q.t) * q.t) << i;
+    }
+    EXPECT_EQ(r.Ci[0].x, 0.0f);
+    // Counted as the program's instructions, fused or not.
+    EXPECT_EQ(r.counters.instructions, kernel.instructionCount() * points.size());
+}
+
 }  // namespace
 }  // namespace mpshade
