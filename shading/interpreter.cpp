@@ -223,7 +223,7 @@ __attribute__((target_clones("avx2", "default"))) void runBatch(
                 const float* arg[10];
                 for (int k = 0; k < e.nin; ++k) arg[k] = S[e.in[k]];
                 float* rgb[3] = {R(e.out[0]), R(e.out[1]), R(e.out[2])};
-                shadeLight(e.op, light, arg, rgb, m);
+                shadeLight(e.op, light, arg, rgb, m, e.negatedView);
                 break;
             }
             case Op::Occlusion: {
@@ -238,6 +238,61 @@ __attribute__((target_clones("avx2", "default"))) void runBatch(
                 break;
         }
     }
+}
+
+// A specular(N, -I, r) reads its view through three negations, a pass over the lanes
+// each: where every reader of a negation is a Specular's view, those Speculars read the
+// negation's argument instead (negatedView) and the negation is no longer run. Rewrites
+// `program`'s arguments; marks the Speculars and the negations left unread.
+void readNegatedViews(IrProgram& program, std::vector<char>& negatedView,
+                      std::vector<char>& unread) {
+    const size_t count = program.insts.size();
+    negatedView.assign(count, 0);
+    unread.assign(count, 0);
+    std::vector<int> producer(static_cast<size_t>(program.valueCount), -1);
+    for (size_t k = 0; k < count; ++k)
+        for (int o = 0; o < program.insts[k].nout; ++o)
+            producer[static_cast<size_t>(program.insts[k].result + o)] = static_cast<int>(k);
+    // Values kept as results, or read other than as a Specular's view, keep their negation.
+    std::vector<char> otherUse(static_cast<size_t>(program.valueCount), 0);
+    for (const int v : program.ci)
+        if (v >= 0) otherUse[static_cast<size_t>(v)] = 1;
+    for (const int v : program.oi)
+        if (v >= 0) otherUse[static_cast<size_t>(v)] = 1;
+    for (const int v : program.channelOutputs) otherUse[static_cast<size_t>(v)] = 1;
+    for (const Inst& inst : program.insts)
+        for (int a = 0; a < inst.nargs; ++a)
+            if (!(inst.op == Op::Specular && a >= 6 && a <= 8))
+                otherUse[static_cast<size_t>(program.argsOf(inst)[a])] = 1;
+    auto negation = [&](int32_t v) {
+        const int k = producer[static_cast<size_t>(v)];
+        return k >= 0 && program.insts[static_cast<size_t>(k)].op == Op::Neg &&
+               program.insts[static_cast<size_t>(k)].nargs == 1 &&
+               !otherUse[static_cast<size_t>(v)];
+    };
+    std::vector<char> negationRead(count, 0);
+    for (size_t k = 0; k < count; ++k) {
+        const Inst& inst = program.insts[k];
+        if (inst.op != Op::Specular || inst.nargs < 9) continue;
+        int32_t* args = program.args.data() + inst.firstArg;
+        if (!(negation(args[6]) && negation(args[7]) && negation(args[8]))) {
+            for (int a = 6; a <= 8; ++a) {
+                const int p = producer[static_cast<size_t>(args[a])];
+                if (p >= 0) negationRead[static_cast<size_t>(p)] = 1;
+            }
+            continue;
+        }
+        negatedView[k] = 1;
+        for (int a = 6; a <= 8; ++a) {
+            const Inst& neg =
+                program.insts[static_cast<size_t>(producer[static_cast<size_t>(args[a])])];
+            args[a] = program.argsOf(neg)[0];
+        }
+    }
+    for (size_t k = 0; k < count; ++k)
+        if (program.insts[k].op == Op::Neg && !negationRead[k] &&
+            !otherUse[static_cast<size_t>(program.insts[k].result)])
+            unread[k] = 1;
 }
 
 // For each instruction, the index of the addition or subtraction its product is fused
@@ -268,7 +323,10 @@ std::vector<int> findMulFusions(const IrProgram& program, const std::vector<int>
 
 }  // namespace
 
-ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
+ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
+    IrProgram program = source;
+    std::vector<char> negatedView, unread;
+    readNegatedViews(program, negatedView, unread);
     // Last instruction reading each value; outputs live to the end.
     std::vector<int> lastUse(static_cast<size_t>(program.valueCount), -1);
     for (size_t k = 0; k < program.insts.size(); ++k) {
@@ -320,12 +378,13 @@ ShaderKernel::ShaderKernel(const IrProgram& program) : program_(program) {
         const Inst& inst = program.insts[k];
         if (inst.op == Op::Const) continue;
         ++instructions_;
-        if (fusedInto[k] >= 0) continue;  // emitted with its reader
+        if (fusedInto[k] >= 0 || unread[k]) continue;  // emitted with its reader, or not needed
         ExecInst e;
         e.op = inst.op;
         e.nin = inst.nargs;
         e.nout = inst.nout;
         e.imm = inst.imm;
+        e.negatedView = negatedView[k] != 0;
         const int32_t* args = program.argsOf(inst);
         for (int a = 0; a < inst.nargs; ++a) e.in[a] = reg[static_cast<size_t>(args[a])];
         if (fusedFrom[k] >= 0) {

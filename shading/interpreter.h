@@ -84,6 +84,7 @@ enum class MulFusion : uint8_t {
 struct ExecInst {
     Op op;
     MulFusion fusion = MulFusion::None;
+    bool negatedView = false;  // Specular: in[6..8] hold -V (shadeLight)
     uint8_t nin = 0, nout = 0;
     int32_t imm = 0;
     int32_t in[10] = {};

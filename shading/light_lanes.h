@@ -49,7 +49,9 @@ inline Float4 root(Float4 x) {
 // Lanes [l, l + width of V) of one light, with the light's kind and the operation fixed:
 // branch-free (selects, and divisions by safe denominators). The formulas are
 // shadeLightOne's; max(0, x) is a select that is 0 for NaN, as std::fmax(0, x) is.
-template <Op kOp, bool kPoint, typename V>
+// kNegV (Specular): args 6-8 hold -V, so L + V is L - args, the very bits a pass negating
+// them first would give (x + -y is x - y in IEEE arithmetic; only a NaN's sign may differ).
+template <Op kOp, bool kPoint, typename V, bool kNegV = false>
 inline void shadeLightLanes(const LightSample& light, const float* const* args, float* const* rgb,
                             int l) {
     const V zero = splat(0.0f, V{}), one = splat(1.0f, V{});
@@ -79,8 +81,14 @@ inline void shadeLightLanes(const LightSample& light, const float* const* args, 
     if constexpr (kOp == Op::Diffuse) {
         f = ndl;
     } else if constexpr (kOp == Op::Specular) {
-        const V hx = Lx + load(args[6] + l, V{}), hy = Ly + load(args[7] + l, V{}),
-                hz = Lz + load(args[8] + l, V{});
+        V hx, hy, hz;
+        if constexpr (kNegV) {
+            hx = Lx - load(args[6] + l, V{}), hy = Ly - load(args[7] + l, V{}),
+            hz = Lz - load(args[8] + l, V{});
+        } else {
+            hx = Lx + load(args[6] + l, V{}), hy = Ly + load(args[7] + l, V{}),
+            hz = Lz + load(args[8] + l, V{});
+        }
         const V hl = root(hx * hx + hy * hy + hz * hz);
         const auto ok = (hl > zero) & (ndl > zero);
         const V ndh = positive((nx * hx + ny * hy + nz * hz) / (ok ? hl : one));

@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "geometry/error.h"
 #include "geometry/float4.h"
 #include "geometry/point_cloud.h"
 #include "geometry/ray_scene.h"
@@ -74,46 +75,51 @@ namespace {
 // One light over m lanes: four at a time in vector registers (the compiler did not
 // vectorize the one-lane loop) for diffuse and specular, the rest one at a time. Phong's
 // power is a library call: one lane at a time.
-template <Op kOp, bool kPoint>
+template <Op kOp, bool kPoint, bool kNegV>
 void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
     int l = 0;
     if constexpr (kOp != Op::Phong)
-        for (; l + 4 <= m; l += 4) shadeLightLanes<kOp, kPoint, Float4>(light, args, rgb, l);
-    for (; l < m; ++l) shadeLightLanes<kOp, kPoint, float>(light, args, rgb, l);
+        for (; l + 4 <= m; l += 4) shadeLightLanes<kOp, kPoint, Float4, kNegV>(light, args, rgb, l);
+    for (; l < m; ++l) shadeLightLanes<kOp, kPoint, float, kNegV>(light, args, rgb, l);
 }
 
-template <Op kOp>
+template <Op kOp, bool kNegV = false>
 void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m,
                 bool baseline = false) {
     static const bool avx2 = shadeLightAvx2Available();
-    if (kOp != Op::Phong && avx2 && !baseline) return shadeLightAvx2(kOp, light, args, rgb, m);
+    if (kOp != Op::Phong && avx2 && !baseline)
+        return shadeLightAvx2(kOp, light, args, rgb, m, kNegV);
     if (light.kind == LightKind::Point)
-        shadeLanes<kOp, true>(light, args, rgb, m);
+        shadeLanes<kOp, true, kNegV>(light, args, rgb, m);
     else
-        shadeLanes<kOp, false>(light, args, rgb, m);
+        shadeLanes<kOp, false, kNegV>(light, args, rgb, m);
 }
 
 }  // namespace
 
-void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb,
-                int m) {
+void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb, int m,
+                bool negatedView) {
+    MPSHADE_CHECK(!negatedView || op == Op::Specular);
     switch (op) {
         case Op::Diffuse:
             return shadeLanes<Op::Diffuse>(light, args, rgb, m);
         case Op::Specular:
-            return shadeLanes<Op::Specular>(light, args, rgb, m);
+            return negatedView ? shadeLanes<Op::Specular, true>(light, args, rgb, m)
+                               : shadeLanes<Op::Specular>(light, args, rgb, m);
         default:
             return shadeLanes<Op::Phong>(light, args, rgb, m);
     }
 }
 
 void shadeLightBaseline(Op op, const LightSample& light, const float* const* args,
-                        float* const* rgb, int m) {
+                        float* const* rgb, int m, bool negatedView) {
+    MPSHADE_CHECK(!negatedView || op == Op::Specular);
     switch (op) {
         case Op::Diffuse:
             return shadeLanes<Op::Diffuse>(light, args, rgb, m, true);
         case Op::Specular:
-            return shadeLanes<Op::Specular>(light, args, rgb, m, true);
+            return negatedView ? shadeLanes<Op::Specular, true>(light, args, rgb, m, true)
+                               : shadeLanes<Op::Specular>(light, args, rgb, m, true);
         default:
             return shadeLanes<Op::Phong>(light, args, rgb, m, true);
     }

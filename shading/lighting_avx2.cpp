@@ -51,28 +51,30 @@ inline Lanes8 root(Lanes8 x) {
 namespace mpshade {
 namespace {
 
-template <Op kOp, bool kPoint>
+template <Op kOp, bool kPoint, bool kNegV>
 void lanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
     int l = 0;
-    for (; l + 8 <= m; l += 8) shadeLightLanes<kOp, kPoint, Lanes8>(light, args, rgb, l);
-    for (; l + 4 <= m; l += 4) shadeLightLanes<kOp, kPoint, Float4>(light, args, rgb, l);
-    for (; l < m; ++l) shadeLightLanes<kOp, kPoint, float>(light, args, rgb, l);
+    for (; l + 8 <= m; l += 8) shadeLightLanes<kOp, kPoint, Lanes8, kNegV>(light, args, rgb, l);
+    for (; l + 4 <= m; l += 4) shadeLightLanes<kOp, kPoint, Float4, kNegV>(light, args, rgb, l);
+    for (; l < m; ++l) shadeLightLanes<kOp, kPoint, float, kNegV>(light, args, rgb, l);
 }
 
-template <Op kOp>
+template <Op kOp, bool kNegV = false>
 void lanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
     if (light.kind == LightKind::Point)
-        lanes<kOp, true>(light, args, rgb, m);
+        lanes<kOp, true, kNegV>(light, args, rgb, m);
     else
-        lanes<kOp, false>(light, args, rgb, m);
+        lanes<kOp, false, kNegV>(light, args, rgb, m);
 }
 
 }  // namespace
 
 void shadeLightAvx2(Op op, const LightSample& light, const float* const* args, float* const* rgb,
-                    int m) {
+                    int m, bool negatedView) {
     if (op == Op::Diffuse)
         lanes<Op::Diffuse>(light, args, rgb, m);
+    else if (negatedView)
+        lanes<Op::Specular, true>(light, args, rgb, m);
     else
         lanes<Op::Specular>(light, args, rgb, m);
 }
@@ -101,7 +103,7 @@ namespace mpshade {
 bool shadeLightAvx2Available() {
     return false;
 }
-void shadeLightAvx2(Op, const LightSample&, const float* const*, float* const*, int) {}
+void shadeLightAvx2(Op, const LightSample&, const float* const*, float* const*, int, bool) {}
 
 }  // namespace mpshade
 

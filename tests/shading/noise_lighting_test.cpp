@@ -1,5 +1,6 @@
 // Noise is deterministic with documented ranges; lighting and occlusion match their
 // formulas and simple analytic cases.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -13,6 +14,7 @@
 #include "geometry/ray_scene.h"
 #include "shading/lighting.h"
 #include "shading/lighting_avx2.h"
+#include "shading/lower.h"
 #include "shading/noise.h"
 #include "shading/noise_paths.h"
 #include "shading/shader_harness.h"
@@ -385,6 +387,77 @@ TEST(Lighting, EightLanesInAvx2AreTheBaselineBitForBit) {
                     << "lane " << i % m << " channel " << i / m << " op " << static_cast<int>(op)
                     << " " << wide[i] << " against " << base[i];
         }
+}
+
+TEST(Lighting, ANegatedViewIsTheNegatedArgumentsBitForBit) {
+    // specular(N, -I, r) reads I and subtracts it (negatedView) instead of a pass negating
+    // it first: the same bits in the baseline and AVX2 paths, edge inputs included (a zero
+    // and a -0 view component, a point at the light, a zero normal).
+    std::mt19937 rng(41);
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    constexpr int m = 37;
+    const auto [point, distant] = pointAndDistantLights();
+    std::vector<float> in(10 * m), negated(3 * m);
+    for (float& x : in) x = uni(rng);
+    for (int l = 0; l < m; ++l) in[9 * m + l] = 0.5f + 0.5f * uni(rng);
+    for (int k = 0; k < 3; ++k) in[k * m + 3] = point.position[k];
+    for (int k = 0; k < 3; ++k) in[(3 + k) * m + 17] = 0.0f;
+    in[6 * m + 5] = 0.0f, in[7 * m + 5] = -0.0f, in[8 * m + 36] = -0.0f;
+    for (int i = 0; i < 3 * m; ++i) negated[i] = -in[6 * m + i];
+    const float* args[10];
+    for (int k = 0; k < 10; ++k) args[k] = &in[static_cast<size_t>(k) * m];
+    const float* negatedArgs[10];
+    std::copy(args, args + 10, negatedArgs);
+    for (int k = 0; k < 3; ++k) negatedArgs[6 + k] = &negated[static_cast<size_t>(k) * m];
+    for (const bool baseline : {true, false})
+        for (const LightSample& light : {point, distant}) {
+            std::vector<float> want(3 * m, -1.0f), got(3 * m, -2.0f);
+            float* w[3] = {&want[0], &want[m], &want[2 * m]};
+            float* g[3] = {&got[0], &got[m], &got[2 * m]};
+            if (baseline) {
+                shadeLightBaseline(Op::Specular, light, args, w, m);
+                shadeLightBaseline(Op::Specular, light, negatedArgs, g, m, true);
+            } else {
+                shadeLight(Op::Specular, light, args, w, m);
+                shadeLight(Op::Specular, light, negatedArgs, g, m, true);
+            }
+            for (int i = 0; i < 3 * m; ++i)
+                ASSERT_EQ(std::memcmp(&want[i], &got[i], sizeof(float)), 0)
+                    << "lane " << i % m << " channel " << i / m << (baseline ? " baseline" : "")
+                    << " " << got[i] << " against " << want[i];
+        }
+}
+
+TEST(Lighting, ASpecularReadsItsNegatedViewWithoutANegationPass) {
+    // specular(N, -I, r): the three negations are not run (passCount), and the result is the
+    // bits of the same shader whose -I is also an output (its negations then kept and read).
+    ShaderBinding binding;
+    binding.lights.resize(2);
+    binding.lights[0].kind = LightKind::Point;
+    binding.lights[1].kind = LightKind::Distant;
+    const auto [point, distant] = pointAndDistantLights();
+    ShadingUniforms uniforms;
+    const std::vector<LightSample> lights = {point, distant};
+    uniforms.lights = lights;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    std::vector<test::ShadingPoint> points(21);
+    for (test::ShadingPoint& p : points) {
+        p.P = glm::vec3(uni(rng), uni(rng), uni(rng));
+        p.N = glm::normalize(glm::vec3(uni(rng), 1.0f, uni(rng)));
+        p.I = glm::normalize(glm::vec3(uni(rng), -1.0f, uni(rng)));
+    }
+    points[4].I.x = -0.0f;
+    const std::string fused = "surface f() { Ci = specular(N, -I, 0.3); }";
+    const std::string kept = "surface k() { vector V = -I; Ci = specular(N, V, 0.3); Oi = color(V); }";
+    const ShaderKernel kernel(lowerShader(*compileShaderText("f.sl", fused), binding));
+    EXPECT_EQ(kernel.passCount() + 3, kernel.instructionCount());
+    const auto a = test::runKernel(kernel, points, uniforms);
+    const auto b = test::runShader(kept, points, binding, uniforms);
+    for (size_t i = 0; i < points.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            ASSERT_EQ(std::memcmp(&a.Ci[i][k], &b.Ci[i][k], sizeof(float)), 0)
+                << "point " << i << " channel " << k;
 }
 
 TEST(Lighting, GgxRoughnessIsFlooredAtAHundredth) {
