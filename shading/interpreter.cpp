@@ -61,18 +61,17 @@ __attribute__((target_clones("avx2", "default"))) void runBatch(
         switch (e.fusion) {
             case MulFusion::None:
                 break;
-            case MulFusion::ProductPlus:
-                fusedLoop<MulFusion::ProductPlus>(o, a, b, c, m);
-                continue;
-            case MulFusion::PlusProduct:
-                fusedLoop<MulFusion::PlusProduct>(o, a, b, c, m);
-                continue;
-            case MulFusion::ProductMinus:
-                fusedLoop<MulFusion::ProductMinus>(o, a, b, c, m);
-                continue;
-            case MulFusion::MinusProduct:
-                fusedLoop<MulFusion::MinusProduct>(o, a, b, c, m);
-                continue;
+// clang-format off (it cannot lay out these case-making macros)
+#define MPSHADE_FUSED(X)                        \
+    case MulFusion::X:                          \
+        fusedLoop<MulFusion::X>(o, a, b, c, m); \
+        continue;
+                MPSHADE_FUSED(ProductPlus)
+                MPSHADE_FUSED(PlusProduct)
+                MPSHADE_FUSED(ProductMinus)
+                MPSHADE_FUSED(MinusProduct)
+#undef MPSHADE_FUSED
+                // clang-format on
         }
         switch (e.op) {
             case Op::Global: {
@@ -362,18 +361,26 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
         constantReg[static_cast<size_t>(r)] = 1;
         constants_.emplace_back(r, inst.constant);
     }
-    // Where a fused product's arguments are read: where its reader is.
+    // A fused product's arguments are read where its reader is.
+    std::vector<int> fusedFrom(program.insts.size(), -1);
     for (size_t k = 0; k < program.insts.size(); ++k) {
         if (fusedInto[k] < 0) continue;
+        fusedFrom[static_cast<size_t>(fusedInto[k])] = static_cast<int>(k);
         const Inst& mul = program.insts[k];
         for (int a = 0; a < mul.nargs; ++a) {
             int& last = lastUse[static_cast<size_t>(program.argsOf(mul)[a])];
             last = std::max(last, fusedInto[k]);
         }
     }
-    std::vector<int> fusedFrom(program.insts.size(), -1);
-    for (size_t k = 0; k < program.insts.size(); ++k)
-        if (fusedInto[k] >= 0) fusedFrom[static_cast<size_t>(fusedInto[k])] = static_cast<int>(k);
+    // Value v's register back to the pool if instruction k is its last reader.
+    auto releaseAfter = [&](int32_t v, size_t k) {
+        int& last = lastUse[static_cast<size_t>(v)];
+        const int32_t r = reg[static_cast<size_t>(v)];
+        if (last == static_cast<int>(k) && !constantReg[static_cast<size_t>(r)]) {
+            freeRegs.push_back(r);
+            last = -2;  // freed; a repeated argument is not freed twice
+        }
+    };
     for (size_t k = 0; k < program.insts.size(); ++k) {
         const Inst& inst = program.insts[k];
         if (inst.op == Op::Const) continue;
@@ -387,10 +394,11 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
         e.negatedView = negatedView[k] != 0;
         const int32_t* args = program.argsOf(inst);
         for (int a = 0; a < inst.nargs; ++a) e.in[a] = reg[static_cast<size_t>(args[a])];
-        if (fusedFrom[k] >= 0) {
-            const Inst& mul = program.insts[static_cast<size_t>(fusedFrom[k])];
-            const int32_t* margs = program.argsOf(mul);
-            const bool productFirst = args[0] == mul.result;
+        const Inst* mul =
+            fusedFrom[k] >= 0 ? &program.insts[static_cast<size_t>(fusedFrom[k])] : nullptr;
+        if (mul) {
+            const int32_t* margs = program.argsOf(*mul);
+            const bool productFirst = args[0] == mul->result;
             const int32_t other = e.in[productFirst ? 1 : 0];
             e.op = Op::Mul;
             e.fusion = inst.op == Op::Add
@@ -404,30 +412,11 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
         // Outputs never share a register with this instruction's own inputs.
         for (int o = 0; o < inst.nout; ++o)
             e.out[o] = reg[static_cast<size_t>(inst.result + o)] = allocate();
-        // The fused product's arguments are read here too (their lastUse moved here).
-        if (fusedFrom[k] >= 0) {
-            const Inst& mul = program.insts[static_cast<size_t>(fusedFrom[k])];
-            for (int a = 0; a < mul.nargs; ++a) {
-                const int32_t v = program.argsOf(mul)[a];
-                int& last = lastUse[static_cast<size_t>(v)];
-                const int32_t r = reg[static_cast<size_t>(v)];
-                if (last == static_cast<int>(k) && !constantReg[static_cast<size_t>(r)]) {
-                    freeRegs.push_back(r);
-                    last = -2;
-                }
-            }
-        }
-        for (int a = 0; a < inst.nargs; ++a) {
-            if (fusedFrom[k] >= 0 &&
-                args[a] == program.insts[static_cast<size_t>(fusedFrom[k])].result)
-                continue;  // the product: never in a register
-            int& last = lastUse[static_cast<size_t>(args[a])];
-            const int32_t r = reg[static_cast<size_t>(args[a])];
-            if (last == static_cast<int>(k) && !constantReg[static_cast<size_t>(r)]) {
-                freeRegs.push_back(r);
-                last = -2;  // freed; a repeated argument is not freed twice
-            }
-        }
+        // A fused product's arguments are read here; the product itself never had a register.
+        if (mul)
+            for (int a = 0; a < mul->nargs; ++a) releaseAfter(program.argsOf(*mul)[a], k);
+        for (int a = 0; a < inst.nargs; ++a)
+            if (!mul || args[a] != mul->result) releaseAfter(args[a], k);
         // Results nobody reads are dead at once.
         for (int o = 0; o < inst.nout; ++o)
             if (lastUse[static_cast<size_t>(inst.result + o)] == -1) freeRegs.push_back(e.out[o]);

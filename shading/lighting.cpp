@@ -83,46 +83,44 @@ void shadeLanes(const LightSample& light, const float* const* args, float* const
     for (; l < m; ++l) shadeLightLanes<kOp, kPoint, float, kNegV>(light, args, rgb, l);
 }
 
-template <Op kOp, bool kNegV = false>
+template <Op kOp>
 void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m,
-                bool baseline = false) {
+                bool negatedView, bool baseline) {
+    MPSHADE_CHECK(!negatedView || kOp == Op::Specular);
     static const bool avx2 = shadeLightAvx2Available();
     if (kOp != Op::Phong && avx2 && !baseline)
-        return shadeLightAvx2(kOp, light, args, rgb, m, kNegV);
-    if (light.kind == LightKind::Point)
-        shadeLanes<kOp, true, kNegV>(light, args, rgb, m);
-    else
-        shadeLanes<kOp, false, kNegV>(light, args, rgb, m);
+        return shadeLightAvx2(kOp, light, args, rgb, m, negatedView);
+    const bool point = light.kind == LightKind::Point;
+    if constexpr (kOp == Op::Specular)
+        if (negatedView)
+            return point ? shadeLanes<kOp, true, true>(light, args, rgb, m)
+                         : shadeLanes<kOp, false, true>(light, args, rgb, m);
+    point ? shadeLanes<kOp, true, false>(light, args, rgb, m)
+          : shadeLanes<kOp, false, false>(light, args, rgb, m);
+}
+
+void shadeLightWith(Op op, const LightSample& light, const float* const* args, float* const* rgb,
+                    int m, bool negatedView, bool baseline) {
+    switch (op) {
+        case Op::Diffuse:
+            return shadeLanes<Op::Diffuse>(light, args, rgb, m, negatedView, baseline);
+        case Op::Specular:
+            return shadeLanes<Op::Specular>(light, args, rgb, m, negatedView, baseline);
+        default:
+            return shadeLanes<Op::Phong>(light, args, rgb, m, negatedView, baseline);
+    }
 }
 
 }  // namespace
 
 void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb, int m,
                 bool negatedView) {
-    MPSHADE_CHECK(!negatedView || op == Op::Specular);
-    switch (op) {
-        case Op::Diffuse:
-            return shadeLanes<Op::Diffuse>(light, args, rgb, m);
-        case Op::Specular:
-            return negatedView ? shadeLanes<Op::Specular, true>(light, args, rgb, m)
-                               : shadeLanes<Op::Specular>(light, args, rgb, m);
-        default:
-            return shadeLanes<Op::Phong>(light, args, rgb, m);
-    }
+    shadeLightWith(op, light, args, rgb, m, negatedView, false);
 }
 
 void shadeLightBaseline(Op op, const LightSample& light, const float* const* args,
                         float* const* rgb, int m, bool negatedView) {
-    MPSHADE_CHECK(!negatedView || op == Op::Specular);
-    switch (op) {
-        case Op::Diffuse:
-            return shadeLanes<Op::Diffuse>(light, args, rgb, m, true);
-        case Op::Specular:
-            return negatedView ? shadeLanes<Op::Specular, true>(light, args, rgb, m, true)
-                               : shadeLanes<Op::Specular>(light, args, rgb, m, true);
-        default:
-            return shadeLanes<Op::Phong>(light, args, rgb, m, true);
-    }
+    shadeLightWith(op, light, args, rgb, m, negatedView, true);
 }
 
 uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,
