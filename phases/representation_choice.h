@@ -27,13 +27,22 @@
 namespace mpshade {
 
 struct RepresentationCostModel {
+    // Measured with `mpshade profile SCENE --threads 1` (per object: shading ms a frame over
+    // its shading points; the rasterize stage over the facets) on the four examples, each
+    // rendered once as the planner chose and once with its curved objects forced to facets
+    // (docs/multiphase.md, "The cost model's prices"). Points of a map cost 48-55 ns on the
+    // floors and 85-140 on small curved objects; points of facets 94-150 on the same
+    // objects: no cheaper, so facets only pay where their static work is much less.
     double facetNs = 25.0;         // warp, bin and rasterize one facet of the combined, per frame
-    double vertexPointNs = 170.0;  // interpolate and shade one point of a facets object
-    double mapPointNs = 290.0;     // interpolate, probe and shade one point of a map object
-    double nsPerCostUnit = 1.4;    // the static shader, per point and opCost unit
-    // Evaluating the surface and setting up one point before any shader work (measured on
-    // the always-resident levels of a 300,000-disc point cloud: 68 ns a texel).
-    double geometryPointNs = 60.0;
+    double vertexPointNs = 110.0;  // interpolate and shade one point of a facets object
+    double mapPointNs = 100.0;     // interpolate, probe and shade one point of a map object
+    // The static shader, per point and opCost unit, and evaluating the surface and setting
+    // up one point before any shader work: the TileFill benchmarks (a vase chart's texels,
+    // one thread) give 136 ns a texel for a static part of 0 units, 161 for wood's 265 and
+    // brick's 153, 1190 for rust_over_paint's 2702 and 1510 for marble's 3497 -- nearly all
+    // of those units its occlusion rays.
+    double nsPerCostUnit = 0.4;
+    double geometryPointNs = 130.0;
     // The reference renderer, for frames rendered single-phase: per sample, the camera
     // ray, the surface point, compositing and the filter, plus the whole shader per cost
     // unit (its batched shading runs a unit faster than the fills above). Measured in CPU

@@ -58,11 +58,11 @@ TEST(RepresentationChoice, SinglePhaseEstimateIsSamplesTimesRayAndShader) {
     EXPECT_NEAR(c.facetsSeconds, c.facetsStaticSeconds + 10.0 * c.facetsFrameSeconds, 1e-12);
     // Map texels go as the footprint's inverse square: at 8 samples and scale 1.2, 12 x 2 /
     // 4 = 6 a covered pixel, plus the chart's always-resident 34 x 34, each at the static
-    // part's 60 units x 1.4 ns plus 60 ns of geometry.
+    // part's 60 units x 0.4 ns plus 130 ns of geometry.
     in.samplesPerPixel = 8;
     in.footprintScale = 1.2f;
     EXPECT_NEAR(chooseRepresentation(in).mapStaticSeconds,
-                (1000.0 * 6.0 + 34.0 * 34.0) * (60.0 * 1.4 + 60.0) * 1e-9, 1e-9);
+                (1000.0 * 6.0 + 34.0 * 34.0) * (60.0 * 0.4 + 130.0) * 1e-9, 1e-9);
     in.samplesPerPixel = 4;
     in.footprintScale = 0.6f;
     // Per pixel shades once a pixel but the reference still traces every sample.
@@ -104,6 +104,36 @@ TEST(RepresentationChoice, SeenOftenAMapSeenOnceFacets) {
     EXPECT_EQ(chooseRepresentation(in).kind, Representation::Facets);
     in.frames = 500;
     EXPECT_EQ(chooseRepresentation(in).kind, Representation::ShaderMap)
+        << chooseRepresentation(in).reason;
+}
+
+TEST(RepresentationChoice, ACurvedObjectSeenForFramesIsAMapWhateverItsFacetsStaticCost) {
+    // The courtyard's nearest column as `play` met it at 640 x 360 (24 frames, its 48
+    // charts' always-resident levels filled up front): 16 facets a covered pixel. Its
+    // points cost as much shaded from facets as from a map (docs/multiphase.md, "The cost
+    // model's prices"), so the facets' rasterizing, 4.3 ms of CPU a frame, is not paid back
+    // by their cheaper static run. At the old prices (290 ns a map point, 170 a facet point,
+    // 1.4 ns a static unit) this was facets, 0.52 s against 0.58 s, and the courtyard's
+    // rasterizing doubled.
+    ObjectCostInputs in;
+    in.combinedFacets = 173106;
+    in.coveredPixels = 10700;
+    in.charts = 48;
+    in.frames = 24;
+    in.staticCostUnits = 1932;
+    in.originalCostUnits = 2004;
+    in.channels = 3;
+    in.pinnedTiles = 48 * 9;
+    in.pinnedBytes = 1679616;
+    in.screenPixels = 640 * 360;
+    const RepresentationChoice c = chooseRepresentation(in);
+    EXPECT_EQ(c.kind, Representation::ShaderMap) << c.reason;
+    // Each frame: 42,800 points at 100 ns against 173,106 facets at 25 ns and the points at 110.
+    EXPECT_NEAR(c.mapFrameSeconds, 42800 * 100e-9, 1e-9);
+    EXPECT_NEAR(c.facetsFrameSeconds, 173106 * 25e-9 + 42800 * 110e-9, 1e-9);
+    // Seen for one frame, the facets' one static run (a vertex per two facets) is the cheaper.
+    in.frames = 1;
+    EXPECT_EQ(chooseRepresentation(in).kind, Representation::Facets)
         << chooseRepresentation(in).reason;
 }
 
