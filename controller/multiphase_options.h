@@ -51,8 +51,9 @@ struct MultiphaseOptions {
     // missing tiles falling back to the finest coarser level resident; then, in the time left
     // of this many seconds, the tiles they found missing are filled (coarser levels first: each
     // serves more of the screen, for less) and the rest left for later frames. An object
-    // whose static phase is due is drawn from its last representation unless its last
-    // static run fits the time left; one never built is always built. 0: constant quality.
+    // whose static phase is due is drawn from its last representation unless its expected
+    // run (ObjectSlot::rebuildSeconds) fits the time left; one never built is always built.
+    // 0: constant quality.
     double frameBudgetSeconds = 0.0;
     // With a frame budget, the share of it static work gets even when the dynamic phase
     // took the whole budget: frames late anyway still make progress towards full quality.

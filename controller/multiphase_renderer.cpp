@@ -328,7 +328,8 @@ void MultiphaseRenderer::recordBuild(size_t i, Representation kind, const Static
     ObjectSlot& slot = slots_[i];
     slot.kind = kind;
     slot.longestEdge = 0.0f;
-    slot.lastBuildSeconds = costs.seconds;
+    const bool keepsMap = kind == Representation::ShaderMap && !static_.shading(i).staticReadsFrame;
+    slot.rebuildSeconds = costs.seconds - (keepsMap ? costs.newMapSeconds : 0.0);
     slot.staticInputs.read(uniforms, slot.builtInputs);
     ObjectReport& r = slot.report;
     r.kind = kind;

@@ -38,7 +38,9 @@ struct ObjectSlot {
     // Combined representation: the longest projected facet edge the last frame measured,
     // pixels (the sampling fiducial; 0 right after a static run).
     float longestEdge = 0.0f;
-    double lastBuildSeconds = 0.0;  // its last static run, wall seconds
+    // What its next static run should cost, wall seconds: its last run's, less the making of
+    // a shader map the next run keeps (a rebuild re-dices; the map's tiles stay valid).
+    double rebuildSeconds = 0.0;
     // The animated inputs its static part reads, how far each moves over the scene (its
     // span), and their values at its last static run (the photometric fiducial).
     StaticInputs staticInputs;

@@ -77,10 +77,10 @@ std::vector<size_t> admitRebuilds(std::span<const size_t> due, std::span<const O
     std::vector<size_t> admitted, again;
     for (size_t i : due) (slots[i].representation ? again : admitted).push_back(i);
     std::sort(again.begin(), again.end(), [&](size_t a, size_t b) {
-        return slots[a].lastBuildSeconds < slots[b].lastBuildSeconds;
+        return slots[a].rebuildSeconds < slots[b].rebuildSeconds;
     });
     for (size_t i : again) {
-        const double cost = 1.5 * slots[i].lastBuildSeconds;
+        const double cost = 1.5 * slots[i].rebuildSeconds;
         if (cost <= secondsLeft) {
             admitted.push_back(i);
             secondsLeft -= cost;

@@ -41,10 +41,10 @@ void compareWithReference(ObjectSlot& slot, double storedSeconds, double referen
                           bool directAllowed, int slowFrames = 2);
 
 // A frame budget: what was never built is built; what is due again is rebuilt, cheapest
-// first, only while its last run and half as much again (a re-dice of a nearer view makes
-// more facets) fits `secondsLeft`; the others are drawn from their last representation,
-// marked deferred in `dues` and counted in `deferred`. Returns the objects to build now,
-// in index order.
+// first, only while its expected run (ObjectSlot::rebuildSeconds) and half as much again (a
+// re-dice of a nearer view makes more facets) fits `secondsLeft`; the others are drawn from their
+// last representation, marked deferred in `dues` and counted in `deferred`. Returns the objects to
+// build now, in index order.
 std::vector<size_t> admitRebuilds(std::span<const size_t> due, std::span<const ObjectSlot> slots,
                                   double secondsLeft, std::vector<StaticRunDue>& dues,
                                   int& deferred);

@@ -367,8 +367,10 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     } else if (previous && previous->map && !obj.staticReadsFrame) {
         rep->map = previous->map;  // still valid: its tiles are kept
     } else {
+        const auto mapStart = Clock::now();
         rep->map = makeShaderMap(index, uniforms);
         costs.addFill(rep->map->fillStats(), obj.staticKernel->instructionCount());
+        costs.newMapSeconds += std::chrono::duration<double>(Clock::now() - mapStart).count();
     }
     ++costs.runs;
     costs.seconds += std::chrono::duration<double>(Clock::now() - start).count();

@@ -56,6 +56,9 @@ struct ObjectShading {
 struct StaticCosts {
     int runs = 0;  // representations built
     double seconds = 0.0;
+    // Of `seconds`: making new shader maps (their always-resident levels filled), which a
+    // later run that keeps the map does not pay again.
+    double newMapSeconds = 0.0;
     uint64_t instructions = 0;  // static shader instructions, times lanes
     uint64_t tilesFilled = 0, tilesFromChildren = 0, texelsFilled = 0, programRuns = 0;
     uint64_t tilesLoaded = 0;       // read from the store instead of filled
@@ -73,6 +76,7 @@ struct StaticCosts {
     StaticCosts& operator+=(const StaticCosts& o) {
         runs += o.runs;
         seconds += o.seconds;
+        newMapSeconds += o.newMapSeconds;
         instructions += o.instructions;
         tilesFilled += o.tilesFilled;
         tilesLoaded += o.tilesLoaded;

@@ -20,7 +20,7 @@ std::vector<ObjectSlot> slots(const std::vector<double>& lastRun) {
     for (size_t i = 0; i < lastRun.size(); ++i) {
         if (lastRun[i] < 0.0) continue;
         out[i].representation = std::make_unique<ObjectRepresentation>();
-        out[i].lastBuildSeconds = lastRun[i];
+        out[i].rebuildSeconds = lastRun[i];
     }
     return out;
 }
