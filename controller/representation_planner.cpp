@@ -10,6 +10,40 @@
 
 namespace mpshade {
 
+double footprintElongation(const Surface& surface, const ObjectState& state,
+                           const CameraState& camera, float levelAnisotropy) {
+    const int charts = chartCount(surface);
+    const int stride = std::max(1, charts / 64);
+    const int grid = charts == 1 ? 16 : (charts < 16 ? 4 : 2);
+    const double cap = std::max(1.0f, levelAnisotropy > 0.0f ? levelAnisotropy : 1e30f);
+    double pixels = 0.0, sum = 0.0;
+    for (int chart = 0; chart < charts; chart += stride)
+        for (int j = 0; j < grid; ++j)
+            for (int i = 0; i < grid; ++i) {
+                const float u = (static_cast<float>(i) + 0.5f) / static_cast<float>(grid);
+                const float v = (static_cast<float>(j) + 0.5f) / static_cast<float>(grid);
+                const SurfaceSample p = evaluate(surface, {chart, u, v});
+                const glm::vec3 world = glm::vec3(state.objectToWorld * glm::vec4(p.P, 1.0f));
+                float x = 0.0f, y = 0.0f;
+                if (!camera.project(world, x, y) || !(x >= 0.0f && y >= 0.0f) ||
+                    !(x < static_cast<float>(camera.width) &&
+                      y < static_cast<float>(camera.height)))
+                    continue;
+                const glm::vec3 toP = p.P - state.eye;
+                const double distance2 = glm::dot(toP, toP);
+                const double normal = glm::length(p.N);
+                const double area = glm::length(glm::cross(p.dPdu, p.dPdv));
+                const double cosine =
+                    std::fabs(glm::dot(toP, p.N)) / std::sqrt(distance2 * normal * normal);
+                if (!(cosine > 0.0 && area > 0.0 && std::isfinite(area * cosine / distance2)))
+                    continue;
+                const double w = area * cosine / distance2;
+                sum += w * std::min(1.0 / cosine, cap);
+                pixels += w;
+            }
+    return pixels > 0.0 ? sum / pixels : 1.0;
+}
+
 RepresentationPlanner::RepresentationPlanner(const Scene& scene, const StaticPhase& statics,
                                              const RepresentationCostModel& model,
                                              std::optional<Representation> forced)
@@ -63,6 +97,7 @@ ObjectCostInputs RepresentationPlanner::costInputs(size_t i, const ObjectSlot& s
         distance > radius ? 3.14159265 * std::pow(ppu * radius / distance, 2.0) : 1e30;
     in.coveredPixels = std::min(static_cast<double>(camera.width) * camera.height, projected);
     in.frames = std::max(1, framesSeenFrom(i, frame));
+    in.elongation = footprintElongation(*obj.surface, state, camera, dynamic.probe.levelAnisotropy);
     in.combinedRuns = predictedCombinedRuns(i, frame, state);
     in.screenPixels = static_cast<double>(camera.width) * camera.height;
     in.channels = static_cast<int>(shading.factored.staticPart.channelOutputs.size());

@@ -18,6 +18,19 @@
 
 namespace mpshade {
 
+// The mean, over the pixels a surface covers, of its shader-map footprints' elongation: major
+// over minor axis, 1 / |cos| of the view ray against the normal, up to `levelAnisotropy`
+// (the probe's ProbeOptions::levelAnisotropy: a footprint past it reads the level of
+// major / levelAnisotropy, and its fills stop growing). It says how many times a facing
+// surface's texels a map of it fills per covered pixel. Sampled in object space, a grid on
+// each of up to 64 charts (16 x 16 on a single chart), each sample weighed by the pixels it
+// covers (area times |cos| over squared distance); samples outside the image are left out.
+// 1 when none is inside. Measured on the grazing floor (examples/hard): 12, where a render
+// fills 40 texels a covered pixel, against 3.3 and 20 on the vase's floor -- an
+// overestimate there, on the side of the reference.
+double footprintElongation(const Surface& surface, const ObjectState& state,
+                           const CameraState& camera, float levelAnisotropy);
+
 class RepresentationPlanner {
   public:
     // scene, statics: not owned, must outlive the planner. forced: every object's

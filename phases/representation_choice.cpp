@@ -33,8 +33,8 @@ RepresentationChoice chooseRepresentation(const ObjectCostInputs& in,
                                 : in.shadingRate == ShadingRate::Pixel ? 1.0
                                                                        : 0.25;
     const double footprint = 0.6 / std::max(0.05f, in.footprintScale);
-    const double texelsPerPixel =
-        model.texelsPerCoveredPixel * samplesScale * footprint * footprint;
+    const double texelsPerPixel = model.texelsPerCoveredPixel * samplesScale * footprint *
+                                  footprint * (in.elongation / model.typicalElongation);
     // The always-resident levels, when filled up front (ShaderMapOptions::fillPinnedUpFront;
     // otherwise only the tiles frames ask for, already counted).
     const double pinnedTexels = in.pinnedUpFront ? in.charts * model.pinnedTexelsPerChart : 0.0;

@@ -32,17 +32,22 @@ struct RepresentationCostModel {
     // rendered once as the planner chose and once with its curved objects forced to facets
     // (docs/multiphase.md, "The cost model's prices"). Points of a map cost 48-55 ns on the
     // floors and 85-140 on small curved objects; points of facets 94-150 on the same
-    // objects: no cheaper, so facets only pay where their static work is much less.
+    // objects: no cheaper, so facets only pay where their static work is much less. (Both
+    // had been priced for a slower dynamic phase: 290 and 170.)
     double facetNs = 25.0;         // warp, bin and rasterize one facet of the combined, per frame
     double vertexPointNs = 110.0;  // interpolate and shade one point of a facets object
     double mapPointNs = 100.0;     // interpolate, probe and shade one point of a map object
     // The static shader, per point and opCost unit, and evaluating the surface and setting
-    // up one point before any shader work: the TileFill benchmarks (a vase chart's texels,
-    // one thread) give 136 ns a texel for a static part of 0 units, 161 for wood's 265 and
-    // brick's 153, 1190 for rust_over_paint's 2702 and 1510 for marble's 3497 -- nearly all
-    // of those units its occlusion rays.
-    double nsPerCostUnit = 0.4;
-    double geometryPointNs = 130.0;
+    // up one point before any shader work (measured on the always-resident levels of a
+    // 300,000-disc point cloud: 68 ns a texel). These price a whole static run by its
+    // points alone: a texel alone costs less (the TileFill benchmarks, a vase chart's texels
+    // on one thread: 136 ns for a static part of 0 units, 1510 for marble's 3497, about 0.4
+    // ns a unit), but a run also dices and builds its occlusion rays' scene, and a map fills
+    // 3-5 times the texels texelsPerCoveredPixel counts (docs/multiphase.md). Priced at 0.4
+    // and 130, a camera cut every frame went multi-phase and cost 4.6 times the reference
+    // (`mpshade eval --quick`, the courtyard: 18.4 s against 4.0; at these prices -6%).
+    double nsPerCostUnit = 1.4;
+    double geometryPointNs = 60.0;
     // The reference renderer, for frames rendered single-phase: per sample, the camera
     // ray, the surface point, compositing and the filter, plus the whole shader per cost
     // unit (its batched shading runs a unit faster than the fills above). Measured in CPU
@@ -55,10 +60,14 @@ struct RepresentationCostModel {
     // points of a 186-unit shader in 10 ms of CPU time, 87 ns a point.
     double directPointNs = 40.0;
     double directNsPerCostUnit = 0.25;
-    // Separate: texels filled per covered pixel at 4 samples per pixel and the default
-    // footprint scale 0.6; the texel density goes as the footprint's inverse square, so
-    // with the samples (per sample rate) and with 1 / scale^2.
+    // Separate: texels filled per covered pixel at 4 samples per pixel, footprint scale 0.6
+    // and the elongation of a typical object (below); the texel density goes as the
+    // footprint's inverse square, so with the samples (per sample rate) and with 1 / scale^2,
+    // and with ObjectCostInputs::elongation.
     double texelsPerCoveredPixel = 12.0;
+    // The examples' objects: 1.7-2.2 on curved ones, 2.6-3.4 on their floors; the grazing
+    // floor (examples/hard) 12.
+    double typicalElongation = 2.5;
     double pinnedTexelsPerChart = 34.0 * 34.0;   // the 32 x 32 level with its border
     double maxFacetsPerScreenPixel = 4.0;        // combined facets beyond this: always a map
     double maxPinnedBytes = 64.0 * 1024 * 1024;  // pinned levels beyond this: facets
@@ -82,7 +91,12 @@ struct ObjectCostInputs {
     double originalCostUnits = 0.0;  // the whole shader's, as the reference runs it
     int samplesPerPixel = 4;
     ShadingRate shadingRate = ShadingRate::Sample;
-    float footprintScale = 1.0f;       // the dynamic phase's probe footprint scale
+    float footprintScale = 1.0f;  // the dynamic phase's probe footprint scale
+    // How many times a facing surface's texels a map fills per covered pixel, on the mean
+    // over the pixels: the footprint's major over minor axis, capped at the probe's
+    // levelAnisotropy (footprintElongation, representation_planner.h). A sphere about 2, a
+    // floor near the horizon the cap; unmeasured, a typical object's.
+    double elongation = 2.5;
     int channels = 1;                  // floats of the n-tuple; 0: nothing static is stored
     double recomputedCostUnits = 0.0;  // with 0 channels: the static work the dynamic part repeats
     bool pinnedUpFront = true;         // a map's always-resident levels are filled when it is made

@@ -7,6 +7,8 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "controller/representation_planner.h"
 #include "test_support.h"
@@ -78,6 +80,36 @@ TEST(RepresentationPlanner, PinnedTilesAreWhatAMapHoldsAlwaysResident) {
         ++maps;
     }
     EXPECT_GT(maps, 0);
+}
+
+// A camera 10 away from a 0.1 x 0.1 plane at the origin (normal +y), looking at its centre
+// from `elevation` degrees above it: every sample sees it at about that angle.
+double elongationFrom(float elevationDegrees, float levelAnisotropy, bool lookAway = false) {
+    const Surface plane = Plane{0.1f, 0.1f};
+    const float a = glm::radians(elevationDegrees);
+    CameraState camera;
+    camera.eye = 10.0f * glm::vec3(0.0f, std::sin(a), std::cos(a));
+    camera.forward = glm::normalize(-camera.eye) * (lookAway ? -1.0f : 1.0f);
+    camera.right = glm::normalize(glm::cross(camera.forward, glm::vec3(1e-3f, 1.0f, 0.0f)));
+    camera.up = glm::cross(camera.right, camera.forward);
+    camera.tanHalfFovY = std::tan(glm::radians(20.0f));
+    camera.width = 64;
+    camera.height = 48;
+    camera.aspect = 64.0f / 48.0f;
+    ObjectState state;
+    state.eye = camera.eye;
+    return footprintElongation(plane, state, camera, levelAnisotropy);
+}
+
+TEST(RepresentationPlanner, FootprintElongationIsOneOverTheCosineUpToTheCap) {
+    // Seen at elevation e the view ray meets the normal at cos = sin e: footprints are 1 / sin e
+    // times longer than wide, up to the probe's levelAnisotropy.
+    EXPECT_NEAR(elongationFrom(90.0f, 12.0f), 1.0, 0.01);
+    EXPECT_NEAR(elongationFrom(30.0f, 12.0f), 2.0, 0.03);
+    EXPECT_NEAR(elongationFrom(10.0f, 12.0f), 1.0 / std::sin(glm::radians(10.0)), 0.15);
+    EXPECT_NEAR(elongationFrom(3.0f, 12.0f), 12.0, 1e-9);  // 19.1, capped
+    EXPECT_NEAR(elongationFrom(3.0f, 0.0f), 1.0 / std::sin(glm::radians(3.0)), 0.6);  // no cap
+    EXPECT_DOUBLE_EQ(elongationFrom(30.0f, 12.0f, true), 1.0);  // behind the eye: nothing seen
 }
 
 }  // namespace

@@ -58,11 +58,17 @@ TEST(RepresentationChoice, SinglePhaseEstimateIsSamplesTimesRayAndShader) {
     EXPECT_NEAR(c.facetsSeconds, c.facetsStaticSeconds + 10.0 * c.facetsFrameSeconds, 1e-12);
     // Map texels go as the footprint's inverse square: at 8 samples and scale 1.2, 12 x 2 /
     // 4 = 6 a covered pixel, plus the chart's always-resident 34 x 34, each at the static
-    // part's 60 units x 0.4 ns plus 130 ns of geometry.
+    // part's 60 units x 1.4 ns plus 60 ns of geometry.
     in.samplesPerPixel = 8;
     in.footprintScale = 1.2f;
     EXPECT_NEAR(chooseRepresentation(in).mapStaticSeconds,
-                (1000.0 * 6.0 + 34.0 * 34.0) * (60.0 * 0.4 + 130.0) * 1e-9, 1e-9);
+                (1000.0 * 6.0 + 34.0 * 34.0) * (60.0 * 1.4 + 60.0) * 1e-9, 1e-9);
+    // And as the footprints' elongation against a typical object's 2.5: a floor near the
+    // horizon (12) fills 4.8 times the texels a covered pixel.
+    in.elongation = 12.0;
+    EXPECT_NEAR(chooseRepresentation(in).mapStaticSeconds,
+                (1000.0 * 6.0 * 4.8 + 34.0 * 34.0) * (60.0 * 1.4 + 60.0) * 1e-9, 1e-9);
+    in.elongation = 2.5;
     in.samplesPerPixel = 4;
     in.footprintScale = 0.6f;
     // Per pixel shades once a pixel but the reference still traces every sample.
@@ -112,9 +118,8 @@ TEST(RepresentationChoice, ACurvedObjectSeenForFramesIsAMapWhateverItsFacetsStat
     // charts' always-resident levels filled up front): 16 facets a covered pixel. Its
     // points cost as much shaded from facets as from a map (docs/multiphase.md, "The cost
     // model's prices"), so the facets' rasterizing, 4.3 ms of CPU a frame, is not paid back
-    // by their cheaper static run. At the old prices (290 ns a map point, 170 a facet point,
-    // 1.4 ns a static unit) this was facets, 0.52 s against 0.58 s, and the courtyard's
-    // rasterizing doubled.
+    // by their cheaper static run. At the old prices (290 ns a map point, 170 a facet point)
+    // this was facets, 0.52 s against 0.58 s, and the courtyard's rasterizing doubled.
     ObjectCostInputs in;
     in.combinedFacets = 173106;
     in.coveredPixels = 10700;
