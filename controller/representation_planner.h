@@ -25,9 +25,9 @@ namespace mpshade {
 // surface's texels a map of it fills per covered pixel. Sampled in object space, a grid on
 // each of up to 64 charts (16 x 16 on a single chart), each sample weighed by the pixels it
 // covers (area times |cos| over squared distance); samples outside the image are left out.
-// 1 when none is inside. Measured on the grazing floor (examples/hard): 12, where a render
-// fills 40 texels a covered pixel, against 3.3 and 20 on the vase's floor -- an
-// overestimate there, on the side of the reference.
+// 1 when none is inside. The grazing floor (examples/hard) measures 12 and a render of it
+// fills 40 texels a covered pixel; the vase's floor measures 3.3 and its scene fills 20: an
+// overestimate near the horizon, on the side of the reference renderer.
 double footprintElongation(const Surface& surface, const ObjectState& state,
                            const CameraState& camera, float levelAnisotropy);
 
