@@ -328,8 +328,7 @@ void MultiphaseRenderer::recordBuild(size_t i, Representation kind, const Static
     ObjectSlot& slot = slots_[i];
     slot.kind = kind;
     slot.longestEdge = 0.0f;
-    const bool keepsMap = kind == Representation::ShaderMap && !static_.shading(i).staticReadsFrame;
-    slot.rebuildSeconds = costs.seconds - (keepsMap ? costs.newMapSeconds : 0.0);
+    slot.rebuildSeconds = costs.seconds - costs.keptMapSeconds;
     slot.staticInputs.read(uniforms, slot.builtInputs);
     ObjectReport& r = slot.report;
     r.kind = kind;

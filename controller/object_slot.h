@@ -39,7 +39,8 @@ struct ObjectSlot {
     // pixels (the sampling fiducial; 0 right after a static run).
     float longestEdge = 0.0f;
     // What its next static run should cost, wall seconds: its last run's, less the making of
-    // a shader map the next run keeps (a rebuild re-dices; the map's tiles stay valid).
+    // a shader map the next run keeps (StaticCosts::keptMapSeconds: a rebuild re-dices; the
+    // map's tiles stay valid).
     double rebuildSeconds = 0.0;
     // The animated inputs its static part reads, how far each moves over the scene (its
     // span), and their values at its last static run (the photometric fiducial).

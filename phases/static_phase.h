@@ -56,9 +56,10 @@ struct ObjectShading {
 struct StaticCosts {
     int runs = 0;  // representations built
     double seconds = 0.0;
-    // Of `seconds`: making new shader maps (their always-resident levels filled), which a
-    // later run that keeps the map does not pay again.
-    double newMapSeconds = 0.0;
+    // Of `seconds`: making new shader maps (their always-resident levels filled) that the
+    // object's later runs keep, so do not pay again (not those whose static part reads the
+    // frame: each run makes its map anew).
+    double keptMapSeconds = 0.0;
     uint64_t instructions = 0;  // static shader instructions, times lanes
     uint64_t tilesFilled = 0, tilesFromChildren = 0, texelsFilled = 0, programRuns = 0;
     uint64_t tilesLoaded = 0;       // read from the store instead of filled
@@ -76,7 +77,7 @@ struct StaticCosts {
     StaticCosts& operator+=(const StaticCosts& o) {
         runs += o.runs;
         seconds += o.seconds;
-        newMapSeconds += o.newMapSeconds;
+        keptMapSeconds += o.keptMapSeconds;
         instructions += o.instructions;
         tilesFilled += o.tilesFilled;
         tilesLoaded += o.tilesLoaded;
