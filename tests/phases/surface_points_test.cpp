@@ -36,8 +36,8 @@ DVec toD(const glm::vec3& v) {
     return {v.x, v.y, v.z};
 }
 
-// The ball scene with wood (three stored channels) for its plastic, written beside the
-// test's working folder.
+// The ball scene with wood (three stored channels) for its plastic, written to the test's
+// own folder.
 std::string woodenBall() {
     std::ifstream in(sourcePath("tests/data/scenes/ball.json"));
     std::stringstream text;
@@ -47,7 +47,7 @@ std::string woodenBall() {
     const size_t at = scene.find(plastic);
     EXPECT_NE(at, std::string::npos);
     scene.replace(at, plastic.size(), sourcePath("examples/shaders/wood.sl"));
-    const std::string path = "surface_points_wooden_ball.json";
+    const std::string path = test::testFolder("surface_points") + "wooden_ball.json";
     std::ofstream(path) << scene;
     return path;
 }
