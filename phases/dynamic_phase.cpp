@@ -349,8 +349,13 @@ void DynamicPhase::compareWithLastView() {
         }
     const bool still = haveLastView_ && key == lastView_;
     reusing_ = options_.reuseBytes > 0 && still && lastViewWhole_;
-    keeping_ = options_.reuseBytes > 0 && (still || (!haveLastView_ && options_.keepFirstView));
+    // The same frame again (play's first frame after its pre-roll rendered it at each step)
+    // says nothing of whether the animation holds still: it keeps as a first frame does.
+    const bool sameFrame = haveLastView_ && frame_->index == lastViewFrame_;
+    keeping_ =
+        options_.reuseBytes > 0 && (!haveLastView_ || sameFrame ? options_.keepFirstView : still);
     lastView_ = std::move(key);
+    lastViewFrame_ = frame_->index;
     haveLastView_ = true;
     stats_.viewReused = reusing_;
     inputLayout_.rows.assign(n, {});

@@ -73,7 +73,9 @@ struct DynamicOptions {
     // many bytes in all (about 60 a shading point); 0: never.
     size_t reuseBytes = size_t{256} << 20;
     // Whether a run's first frame keeps its inputs too, for a view expected to hold still;
-    // false: only a frame whose view held still since the last keeps them. A camera that
+    // false: only a frame whose view held still since an earlier frame keeps them. A frame
+    // rendered again (play's first, after its pre-roll rendered it at each step) counts as a
+    // first frame here. A camera that
     // moves from the first frame would pay for inputs it never replays: keeping them was
     // 15-30 ms of a warm vase's first frame (its whole sequence 1.29-1.30x its steady
     // frames against 1.21x, side by side).
@@ -256,6 +258,7 @@ class DynamicPhase {
     // The last frame's view (view_reuse.h); whether its visibility is whole; whether this
     // frame reuses it, and whether its bands keep their inputs.
     ViewKey lastView_;
+    int lastViewFrame_ = -1;  // the frame index lastView_ was of
     bool haveLastView_ = false, lastViewWhole_ = false;
     bool reusing_ = false, keeping_ = false;
     InputLayout inputLayout_;
