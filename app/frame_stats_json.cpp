@@ -129,13 +129,15 @@ nlohmann::json playFrameJson(const Scene& scene, const FrameStats& s,
           {"seconds", s.background.seconds}}},
         {"shaded_points", s.shadedPoints}};
     if (s.refine.ran) {
-        // Per step from the frame's own (level) up: the share of the image's pixels there.
+        // Per step from the frame's own up (its rate and footprint, at the frame's samples
+        // per pixel): the share of the image's pixels there.
         nlohmann::json share = nlohmann::json::array(), refined = nlohmann::json::array();
         uint64_t pixels = 0;
         for (int k = 0; k < s.refine.steps; ++k) pixels += s.refine.pixelsAt[k];
         for (int k = 0; k < s.refine.steps; ++k) {
             share.push_back(
-                {{"level", quality.level - k},
+                {{"shading_rate", shadingRateName(s.refine.rateAt[k])},
+                 {"footprint_scale", s.refine.footprintAt[k]},
                  {"pixel_share", pixels > 0 ? static_cast<double>(s.refine.pixelsAt[k]) /
                                                   static_cast<double>(pixels)
                                             : 0.0},

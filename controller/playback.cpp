@@ -1,5 +1,6 @@
 #include "controller/playback.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -20,6 +21,23 @@ RenderOptions atStep(const RenderOptions& render, const QualityStep& step, bool 
     if (withSamples && step.samplesPerPixel > 0) r.samplesPerPixel = step.samplesPerPixel;
     return r;
 }
+
+}  // namespace
+
+std::vector<RefineStep> refineStepsAbove(const QualityRegulator& regulator, int level) {
+    const QualityStep& base = regulator.step(level);
+    const RefineStep own{base.rate, base.footprintScale};
+    std::vector<RefineStep> steps;
+    for (int k = level - 1; k >= 0; --k) {
+        const QualityStep& q = regulator.step(k);
+        const RefineStep step{q.rate, q.footprintScale};
+        if (step == own || (k > 0 && regulator.step(k - 1).rate == q.rate)) continue;
+        if (std::find(steps.begin(), steps.end(), step) == steps.end()) steps.push_back(step);
+    }
+    return steps;
+}
+
+namespace {
 
 // One playback: the renderer, its regulator and predictor, and the steps of the pre-roll
 // and of each frame.
@@ -81,23 +99,11 @@ class Player {
     const Image& image() const { return image_; }
 
   private:
-    // The regulator's steps above `level` at its samples per pixel (refinement cannot add
-    // samples), nearest first; of those at one rate only the best (the same points to
-    // shade, at a sharper footprint). Per pixel at footprint x2 refines to per pixel, then
-    // per sample (on the courtyard, against per sample alone: 35.4 and 35.4 dB median
-    // against 35.3 and 34.5, docs/playback.md).
+    // Per pixel at footprint x2 refines to per pixel, then per sample (on the courtyard,
+    // against per sample alone: 35.4 and 35.4 dB median against 35.3 and 34.5,
+    // docs/playback.md).
     std::vector<RefineStep> betterSteps(int level) const {
-        std::vector<RefineStep> steps;
-        const int spp = regulator_.step(level).samplesPerPixel;
-        for (int k = level - 1; k >= 0; --k) {
-            const QualityStep& q = regulator_.step(k);
-            if (q.samplesPerPixel != spp) continue;
-            if (k > 0 && regulator_.step(k - 1).rate == q.rate &&
-                regulator_.step(k - 1).samplesPerPixel == spp)
-                continue;
-            steps.push_back({q.rate, q.footprintScale});
-        }
-        return steps;
+        return refineStepsAbove(regulator_, level);
     }
 
     // Refining, the step is chosen for the cheap pass alone, within a share of the budget.

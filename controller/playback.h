@@ -17,6 +17,7 @@
 
 #include "controller/multiphase_renderer.h"
 #include "controller/quality_regulator.h"
+#include "controller/tile_refiner.h"
 
 namespace mpshade {
 
@@ -98,5 +99,12 @@ using PlaybackFrameFn =
 PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
                           const PlaybackFrameFn& onFrame,
                           const std::function<void(const PlaybackSummary&)>& onPreroll = {});
+
+// The steps a frame played at `level` of `regulator`'s ladder refines its tiles to
+// (tile_refiner.h), nearest first: the ladder's steps above it as rates and footprints at
+// the frame's own samples per pixel (refinement cannot add samples, so a frame at fewer
+// refines its rate and footprint at them); the frame's own rate and footprint excluded, and
+// of those at one rate only the best (the same points to shade, at a sharper footprint).
+std::vector<RefineStep> refineStepsAbove(const QualityRegulator& regulator, int level);
 
 }  // namespace mpshade

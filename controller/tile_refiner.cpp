@@ -126,6 +126,11 @@ void TileRefiner::refine(DynamicPhase& dynamic, const RefineStep& base,
     if (better.empty() || image.width <= 0 || image.height <= 0) return;
     stats.ran = true;
     stats.steps = static_cast<int>(better.size()) + 1;
+    for (int k = 0; k < stats.steps; ++k) {
+        const RefineStep& step = k == 0 ? base : better[static_cast<size_t>(k) - 1];
+        stats.rateAt[k] = step.rate;
+        stats.footprintAt[k] = step.footprintScale;
+    }
     if (start >= deadline) {
         // No time left: not even the priorities are worth their time.
         stats.pixelsAt[0] = static_cast<uint64_t>(image.width) * image.height;

@@ -119,6 +119,9 @@ struct RefineStats {
     // once refined, and the tiles refined to it (a tile counts at its last).
     uint64_t pixelsAt[kMaxSteps] = {};
     int refined[kMaxSteps] = {};
+    // Per step, its shading rate and footprint scale (at the frame's samples per pixel).
+    ShadingRate rateAt[kMaxSteps] = {};
+    float footprintAt[kMaxSteps] = {};
     // The priority (errorWeight and ageWeight normalized over the image, hysteresis
     // included) of the last tile refined: tiles below it stayed at the cheap step. 0: none
     // refined, or every tile.

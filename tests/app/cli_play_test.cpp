@@ -50,11 +50,18 @@ TEST(CliPlay, MeasuresEachFrameAgainstConstantQualityAndReportsRefinement) {
             const nlohmann::json& r = f["refine"];
             EXPECT_EQ(r["tile_size"], 16);
             double share = 0.0;
-            int level = f["quality"]["level"].get<int>();
-            for (const nlohmann::json& s : r["steps"]) {
-                EXPECT_EQ(s["level"].get<int>(), level--);  // from the frame's step up
-                share += s["pixel_share"].get<double>();
-            }
+            // From the frame's own step up, each a rate or footprint of its own.
+            ASSERT_GE(r["steps"].size(), 2u);
+            EXPECT_EQ(r["steps"][0]["shading_rate"], f["quality"]["shading_rate"]);
+            EXPECT_EQ(r["steps"][0]["footprint_scale"], f["quality"]["footprint_scale"]);
+            EXPECT_EQ(r["steps"].back()["shading_rate"], "sample");
+            EXPECT_EQ(r["steps"].back()["footprint_scale"], 1.0);
+            for (size_t a = 0; a < r["steps"].size(); ++a)
+                for (size_t b = 0; b < a; ++b)
+                    EXPECT_FALSE(r["steps"][a]["shading_rate"] == r["steps"][b]["shading_rate"] &&
+                                 r["steps"][a]["footprint_scale"] ==
+                                     r["steps"][b]["footprint_scale"]);
+            for (const nlohmann::json& s : r["steps"]) share += s["pixel_share"].get<double>();
             EXPECT_NEAR(share, 1.0, 1e-9);
         }
     }

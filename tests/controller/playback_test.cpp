@@ -367,5 +367,27 @@ TEST(Playback, AOneMegabyteCacheHoldsEveryFrameAndStillDrawsThem) {
     EXPECT_GT(deferred, 0u);  // the cache, not time, left tiles unfilled
 }
 
+TEST(Playback, AFrameAtFewerSamplesRefinesItsRateAtThem) {
+    // The ladder of a per-sample scene at 4 spp: 0 per sample, 1 per pixel, 2 per pixel x2,
+    // 3 per 2x2, 4 per 2x2 x2, 5 the same at 2 spp, 6 at 1 spp. A frame at 5 or 6 refines to
+    // per 2x2, per pixel and per sample at its own samples (it had refined to nothing: no step
+    // above it had its samples); one at 4 the same; per pixel x2 to per pixel, then per
+    // sample; the best step to nothing.
+    const QualityRegulator regulator(ShadingRate::Sample, 4);
+    ASSERT_EQ(regulator.levels(), 7);
+    const std::vector<RefineStep> fromQuad = {
+        {ShadingRate::Quad, 1.0f}, {ShadingRate::Pixel, 1.0f}, {ShadingRate::Sample, 1.0f}};
+    for (int level : {4, 5, 6}) {
+        SCOPED_TRACE(level);
+        EXPECT_EQ(refineStepsAbove(regulator, level), fromQuad);
+    }
+    const std::vector<RefineStep> fromPixel = {{ShadingRate::Pixel, 1.0f},
+                                               {ShadingRate::Sample, 1.0f}};
+    EXPECT_EQ(refineStepsAbove(regulator, 2), fromPixel);
+    EXPECT_EQ(refineStepsAbove(regulator, 1),
+              (std::vector<RefineStep>{{ShadingRate::Sample, 1.0f}}));
+    EXPECT_TRUE(refineStepsAbove(regulator, 0).empty());
+}
+
 }  // namespace
 }  // namespace mpshade
