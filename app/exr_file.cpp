@@ -18,7 +18,11 @@ void writeExrFile(const ExrImage& image, const std::string& path) {
     if (image.width < 1 || image.height < 1 || image.channels.empty() || !image.pixels)
         throw std::invalid_argument("an empty image");
     Imf::Header header(image.width, image.height);
+    // Lossless either way; zlib's fastest level: the lamplight example's 48 frames at 640x360
+    // written in 0.2 s less CPU (4 ms a frame, on the writer thread that shares the cores
+    // with rendering), for files 5% larger than at OpenEXR's default level.
     header.compression() = Imf::ZIP_COMPRESSION;
+    header.zipCompressionLevel() = 1;
     for (const auto& [name, value] : image.attributes)
         header.insert(name, Imf::StringAttribute(value));
     // OpenEXR writes a channel from a slice of its own type: half channels from a copy of
