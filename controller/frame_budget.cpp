@@ -83,12 +83,17 @@ void MultiphaseRenderer::fillWithinBudget(Clock::time_point start, FrameStats& s
 void MultiphaseRenderer::refineWithinBudget(Clock::time_point start, Image& image,
                                             FrameStats& stats) {
     if (!dynamic_.complete() || dynamic_.abandoned() || refineSteps_.empty()) return;
-    // Room left for the resolve and the accounting that follow: as long as they last took,
-    // and at least twice this frame's first resolve (refined pixels' samples are read one
-    // by one).
-    const double reserve =
-        std::max(refiner_.lastFinishSeconds(), 2.0 * dynamic_.stats().resolveSeconds);
-    const double until = options_.refine.until * options_.frameBudgetSeconds - reserve;
+    // Room left for the resolve and the accounting that follow, which cover the pixels
+    // near the tiles refined: the share of the time left that they took the last time
+    // (refining tiles in the rest of it, the two grow together), and at least as long as
+    // the whole image's resolve, for a pass slower than the last (the courtyard at 640x360
+    // missed 1 of 24 deadlines without it). Twice the whole image's resolve, before the
+    // resolve again covered only the tiles refined, had left 1280x720 frames nothing to
+    // refine.
+    const double end = options_.refine.until * options_.frameBudgetSeconds;
+    const double left = std::max(0.0, end - secondsSince(start));
+    const double until =
+        end - std::max(refiner_.finishShare() * left, dynamic_.stats().resolveSeconds);
     const auto deadline =
         start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(until));
     const size_t before = missing_.size();

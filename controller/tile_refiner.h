@@ -75,20 +75,25 @@ class TileRefiner {
                 std::chrono::steady_clock::time_point deadline, Image& image, RefineStats& stats,
                 std::vector<TileRequest>& missing);
 
-    // What the last refinement took after its passes: the resolve and the accounting (a
-    // deadline leaves room for as much).
-    double lastFinishSeconds() const { return lastFinish_; }
+    // Of the time a refinement has, the share to keep for what follows its passes (the
+    // resolve of the pixels near the tiles refined, and the accounting): both grow with the
+    // tiles refined, so the share is what they took against the passes the last time
+    // anything was refined (0.5 until then).
+    double finishShare() const {
+        return lastPass_ + lastFinish_ > 0.0 ? lastFinish_ / (lastPass_ + lastFinish_) : 0.5;
+    }
 
   private:
     struct Tile {
         PixelRect rect;
         double contrast = 0.0;  // this frame's, in the cheap image
         double error = 0.0, priority = 0.0;
-        float mean[3] = {0, 0, 0};  // the final image's mean RGB, last frame (meansKept_)
-        int age = 0;                // frames since last refined to the best step
-        bool refinedLast = false;   // refined (to any step) in the last frame
-        bool seen = false;          // any surface in it this frame
-        int step = 0;               // where it ended this frame: 0 the base, k better[k - 1]
+        float mean[3] = {0, 0, 0};       // the final image's mean RGB, last frame (meansKept_)
+        float cheapMean[3] = {0, 0, 0};  // this frame's cheap image's
+        int age = 0;                     // frames since last refined to the best step
+        bool refinedLast = false;        // refined (to any step) in the last frame
+        bool seen = false;               // any surface in it this frame
+        int step = 0;                    // where it ended this frame: 0 the base, k better[k - 1]
     };
     void layOut(int width, int height);
     void measure(const DynamicPhase& dynamic, const Image& image);
@@ -99,14 +104,16 @@ class TileRefiner {
     int width_ = 0, height_ = 0, tileSize_ = 0;
     bool meansKept_ = false;  // the tiles' means are a last frame's (not since layOut)
     std::vector<Tile> tiles_;
-    Image cheap_;               // the frame before refinement
-    std::vector<double> gain_;  // per tile: the squared change refinement made
+    Image cheap_;  // the frame before refinement, in the tiles refined (account() reads no more)
+    std::vector<double> gain_;      // per tile: the squared change refinement made
+    std::vector<uint8_t> changed_;  // per tile: refined, or next to one refined
     // Measured squared change per unit of contrast from the base to each step (index as
     // Tile::step), < 0 until measured: kept while the base and the steps stay the same.
     std::vector<double> errorPerContrast_;
     RefineStep base_;
     std::vector<RefineStep> better_;
-    double lastFinish_ = 0.0;
+    double lastPass_ = 0.0, lastFinish_ = 0.0;  // the last refinement that refined tiles
+    double lastPriorities_ = 0.0;               // the last measure() and order(), seconds
 };
 
 }  // namespace mpshade

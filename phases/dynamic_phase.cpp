@@ -625,6 +625,16 @@ double DynamicPhase::resolveAgain(Image& out) {
     return secondsSince(start);
 }
 
+double DynamicPhase::resolveAgain(Image& out, std::span<const PixelRect> changed) {
+    const auto start = Clock::now();
+    const ScopedSpan span(options_.trace, "resolve", PhaseKind::Resolve, SpanLevel::Phase, -1,
+                          frame_->index);
+    layout_->resolveRects(samples_.rgba.data(), uniform_.data(), out,
+                          layout_->pixelsReading(changed),
+                          options_.shadingRate == ShadingRate::Quad);
+    return secondsSince(start);
+}
+
 RefineCounts DynamicPhase::refine(std::span<const PixelRect> tiles, const RefinePass& pass,
                                   std::vector<TileRequest>& missing) {
     RefineCounts counts;

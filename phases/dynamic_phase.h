@@ -158,12 +158,6 @@ struct DynamicFrameStats {
     }
 };
 
-// A rectangle of image pixels: columns [x0, x1), rows [y0, y1).
-struct PixelRect {
-    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-    int area() const { return (x1 - x0) * (y1 - y0); }
-};
-
 // One pass of DynamicPhase::refine().
 struct RefinePass {
     ShadingRate rate = ShadingRate::Sample;
@@ -208,12 +202,17 @@ class DynamicPhase {
     // order, at the pass's rate and footprint, with fallbacks (a missing tile reads a
     // coarser level and is appended to `missing`), each tile's samples composited anew.
     // Tiles are taken in order by every thread and none starts after the pass's deadline,
-    // so those done are always a prefix. resolveAgain() then makes the pixels.
+    // so those done are always a prefix. resolveAgain() or resolveRects() then makes the
+    // pixels.
     // The frame's own stats (stats(), objectCosts()) are left as shade() made them.
     RefineCounts refine(std::span<const PixelRect> tiles, const RefinePass& pass,
                         std::vector<TileRequest>& missing);
     // resolve() again after refine(); returns its seconds (stats() keeps the first's).
     double resolveAgain(Image& out);
+    // The same for the pixels that read samples of `changed` alone (the tiles refine() did:
+    // SampleLayout::pixelsReading, resolveRects; the same bits), the rest of `out` left as
+    // resolve() made it; returns its seconds.
+    double resolveAgain(Image& out, std::span<const PixelRect> changed);
 
     const DynamicFrameStats& stats() const { return stats_; }
     const std::vector<ObjectFrameCost>& objectCosts() const { return costs_; }

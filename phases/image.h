@@ -6,6 +6,12 @@
 
 namespace mpshade {
 
+// A rectangle of image pixels: columns [x0, x1), rows [y0, y1).
+struct PixelRect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    int area() const { return (x1 - x0) * (y1 - y0); }
+};
+
 struct Image {
     int width = 0, height = 0;
     std::vector<float> rgba;  // 4 floats per pixel, row-major, linear, alpha = coverage

@@ -12,7 +12,15 @@ namespace mpshade {
 struct ResolveFrame {
     const float* rgba = nullptr;
     const uint8_t* uniform = nullptr;  // per pixel, may be null
-    float* pixels = nullptr;           // RGBA, width x height
+    // RGBA output: image pixel (px, py) at pixels + 4 * ((py - y0) * stride + px - x0). The
+    // whole image: x0 = y0 = 0, stride = width.
+    float* pixels = nullptr;
+    int x0 = 0, y0 = 0, stride = 0;
+    // The image columns whose samples are read, [col0, col1) (col0 even where blocks are
+    // looked for: a block is met at its left column); the whole image: 0, width. Writes
+    // reach `reach` columns (with blocks, reach + 1 to the right) beyond them: the window
+    // above must hold those columns.
+    int col0 = 0, col1 = 0;
     const float* weights = nullptr;
     const float* pixelWeights = nullptr;
     const float* blockWeights = nullptr;

@@ -111,16 +111,20 @@ inline bool blockAlike(const ResolveFrame& f, int bx, int by) {
     return same(p + 1) && same(p + w) && same(p + w + 1);
 }
 
-// Output rows [r0, r1): every sample of the rows in reach read once and added to the pixels
-// it reaches in the band (SampleLayout::resolve says how), then each pixel normalized.
+// Output rows [r0, r1) of the frame's output: every sample of the rows in reach (and of its
+// columns) read once and added to the pixels it reaches in the band (SampleLayout::resolve
+// says how), then each pixel of the output's rows normalized. The writes go to the output's
+// window: image pixel (px, py) at its (px - x0, py - y0), rows `stride` pixels apart (the
+// whole image: 0, 0, width).
 inline void resolveRowsOf(const ResolveFrame& f, int r0, int r1) {
     const int width = f.width, height = f.height, reach = f.reach;
     const size_t taps = f.taps, spp = f.spp;
     const float* rgba = f.rgba;
     float* pixels = f.pixels;
+    const int stride = f.stride, dx = f.x0, dy = f.y0;
     const int blocksX = width / 2;
-    std::fill(pixels + static_cast<size_t>(r0) * width * 4,
-              pixels + static_cast<size_t>(r1) * width * 4, 0.0f);
+    std::fill(pixels + static_cast<size_t>(r0 - dy) * stride * 4,
+              pixels + static_cast<size_t>(r1 - dy) * stride * 4, 0.0f);
     // With blocks, from an even row, so every 2x2 block in reach is met at its top row.
     const int firstRow = std::max(0, r0 - reach) & (f.blocks ? ~1 : ~0);
     for (int qy = firstRow; qy < std::min(height, r1 + reach); ++qy) {
@@ -128,7 +132,7 @@ inline void resolveRowsOf(const ResolveFrame& f, int r0, int r1) {
         const int by = qy / 2;
         const bool blockRow = f.blocks && by >= 1 && 2 * by + 2 < height;
         bool alike = false;  // the current block's, found at its left column
-        for (int qx = 0; qx < width; ++qx) {
+        for (int qx = f.col0; qx < f.col1; ++qx) {
             if (qx % 2 == 0)
                 alike = blockRow && qx >= 2 && qx + 3 < width && blockAlike(f, qx / 2, by);
             if (alike) {
@@ -136,9 +140,10 @@ inline void resolveRowsOf(const ResolveFrame& f, int r0, int r1) {
                 // color to the 4 x 4 pixels it reaches, from its top row, for both.
                 if (qy % 2 == 0 && qx % 2 == 0)
                     addWeighted<4>(
-                        pixels, width, qx - 1, std::max(r0, qy - 1), std::min(r1 - 1, qy + 2),
-                        qy - 1, f.blockWeights + (static_cast<size_t>(by) * blocksX + qx / 2) * 16,
-                        4, loadFloat4(rgba + 4 * (static_cast<size_t>(qy) * width + qx) * spp));
+                        pixels, stride, qx - 1 - dx, std::max(r0, qy - 1) - dy,
+                        std::min(r1 - 1, qy + 2) - dy, qy - 1 - dy,
+                        f.blockWeights + (static_cast<size_t>(by) * blocksX + qx / 2) * 16, 4,
+                        loadFloat4(rgba + 4 * (static_cast<size_t>(qy) * width + qx) * spp));
                 continue;
             }
             if (py0 > py1) continue;  // a row read for the blocks it starts
@@ -148,10 +153,11 @@ inline void resolveRowsOf(const ResolveFrame& f, int r0, int r1) {
             const size_t last = same ? first + 1 : first + spp;
             if (reach == 1 && qx > 0 && qx + 1 < width) {
                 if (same)  // one color, its samples' weights summed
-                    addWeighted<3>(pixels, width, qx - 1, py0, py1, qy - 1,
+                    addWeighted<3>(pixels, stride, qx - 1 - dx, py0 - dy, py1 - dy, qy - 1 - dy,
                                    f.pixelWeights + pixel * 9, 3, loadFloat4(rgba + 4 * first));
                 else
-                    addSamples3x3(pixels, width, qx, qy, py0, py1, rgba, f.weights, first, last);
+                    addSamples3x3(pixels, stride, qx - dx, qy - dy, py0 - dy, py1 - dy, rgba,
+                                  f.weights, first, last);
                 continue;
             }
             // The general case: a wider filter, or a pixel at the image's edge.
@@ -162,19 +168,22 @@ inline void resolveRowsOf(const ResolveFrame& f, int r0, int r1) {
                 const Float4 c = loadFloat4(rgba + 4 * s);
                 for (int py = py0; py <= py1; ++py) {
                     const size_t oy = static_cast<size_t>(py - qy + reach);
-                    float* row = pixels + static_cast<size_t>(py) * width * 4;
+                    float* row = pixels + static_cast<size_t>(py - dy) * stride * 4;
                     for (int px = px0; px <= px1; ++px) {
                         const size_t ox = static_cast<size_t>(px - qx + reach);
                         const float k = same ? w[oy * taps + ox] : w[taps + oy] * w[ox];
-                        float* o = row + 4 * static_cast<size_t>(px);
+                        float* o = row + 4 * static_cast<size_t>(px - dx);
                         storeFloat4(o, loadFloat4(o) + k * c);
                     }
                 }
             }
         }
     }
-    for (size_t p = static_cast<size_t>(r0) * width; p < static_cast<size_t>(r1) * width; ++p)
-        storeFloat4(pixels + 4 * p, loadFloat4(pixels + 4 * p) * f.inverseSum[p]);
+    for (int py = r0; py < r1; ++py) {
+        float* o = pixels + static_cast<size_t>(py - dy) * stride * 4;
+        const float* inverse = f.inverseSum + static_cast<size_t>(py) * width + dx;
+        for (int k = 0; k < stride; ++k) storeFloat4(o + 4 * k, loadFloat4(o + 4 * k) * inverse[k]);
+    }
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <sys/mman.h>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "geometry/error.h"
@@ -290,17 +291,10 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
     // goes in one step: 16 pixels reached, against 36 for four pixels (1.3x faster
     // resolves at one sample a pixel; looking for such blocks in frames shaded otherwise
     // costs more than it finds).
-    ResolveFrame f;
-    f.rgba = rgba;
-    f.uniform = uniform;
+    ResolveFrame f = resolveFrame(rgba, uniform, quads);
     f.pixels = out.rgba.data();
-    f.weights = weights_.data();
-    f.pixelWeights = pixelWeights_.data();
-    f.blockWeights = blockWeights_.data();
-    f.inverseSum = inverseSum_.data();
-    f.width = width_, f.height = height_, f.reach = reach_;
-    f.taps = static_cast<size_t>(taps_), f.spp = static_cast<size_t>(spp_);
-    f.blocks = quads && uniform && reach_ == 1 && !blockWeights_.empty();
+    f.stride = width_;
+    f.col0 = 0, f.col1 = width_;
     const bool avx512 = build == ResolveBuild::Fastest && resolveAvx512Available();
     constexpr int kBand = 8;
     tbb::parallel_for(0, (height_ + kBand - 1) / kBand, [&](int band) {
@@ -310,6 +304,88 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
         else
             resolveRowsOf(f, r0, r1);
     });
+}
+
+ResolveFrame SampleLayout::resolveFrame(const float* rgba, const uint8_t* uniform,
+                                        bool quads) const {
+    ResolveFrame f;
+    f.rgba = rgba;
+    f.uniform = uniform;
+    f.weights = weights_.data();
+    f.pixelWeights = pixelWeights_.data();
+    f.blockWeights = blockWeights_.data();
+    f.inverseSum = inverseSum_.data();
+    f.width = width_, f.height = height_, f.reach = reach_;
+    f.taps = static_cast<size_t>(taps_), f.spp = static_cast<size_t>(spp_);
+    f.blocks = quads && uniform && reach_ == 1 && !blockWeights_.empty();
+    return f;
+}
+
+void SampleLayout::resolveRects(const float* rgba, const uint8_t* uniform, Image& out,
+                                std::span<const PixelRect> rects, bool quads,
+                                ResolveBuild build) const {
+    MPSHADE_CHECK(out.width == width_ && out.height == height_);
+    const ResolveFrame frame = resolveFrame(rgba, uniform, quads);
+    const bool avx512 = build == ResolveBuild::Fastest && resolveAvx512Available();
+    tbb::enumerable_thread_specific<std::vector<float>> windows;
+    tbb::parallel_for(size_t{0}, rects.size(), [&](size_t i) {
+        const PixelRect& r = rects[i];
+        MPSHADE_CHECK(0 <= r.x0 && r.x0 <= r.x1 && r.x1 <= width_ && 0 <= r.y0 && r.y0 <= r.y1 &&
+                      r.y1 <= height_);
+        if (r.area() == 0) return;
+        ResolveFrame f = frame;
+        // The samples of every column reaching the rectangle, from an even column (a 2x2
+        // block is met at its left one); the window holds every column they are added to
+        // (a block's reach one more to the right).
+        f.col0 = std::max(0, r.x0 - reach_) & ~1;
+        f.col1 = std::min(width_, r.x1 + reach_);
+        f.x0 = std::max(0, f.col0 - reach_);
+        f.stride = std::min(width_, f.col1 + reach_ + 1) - f.x0;
+        f.y0 = r.y0;
+        std::vector<float>& window = windows.local();
+        window.resize(static_cast<size_t>(f.stride) * static_cast<size_t>(r.y1 - r.y0) * 4);
+        f.pixels = window.data();
+        if (avx512)
+            resolveRowsAvx512(f, r.y0, r.y1);
+        else
+            resolveRowsOf(f, r.y0, r.y1);
+        const size_t columns = static_cast<size_t>(r.x1 - r.x0) * 4;
+        for (int y = r.y0; y < r.y1; ++y)
+            std::copy_n(
+                window.data() + (static_cast<size_t>(y - r.y0) * f.stride + r.x0 - f.x0) * 4,
+                columns, out.pixel(r.x0, y));
+    });
+}
+
+std::vector<PixelRect> SampleLayout::pixelsReading(std::span<const PixelRect> changed) const {
+    // Each row's columns in reach of a changed pixel, as sorted, merged intervals; then
+    // runs of rows with the same intervals, one rectangle per interval.
+    std::vector<std::vector<std::pair<int, int>>> rows(static_cast<size_t>(height_));
+    for (const PixelRect& r : changed) {
+        if (r.area() <= 0) continue;
+        const int x0 = std::max(0, r.x0 - reach_), x1 = std::min(width_, r.x1 + reach_);
+        for (int y = std::max(0, r.y0 - reach_); y < std::min(height_, r.y1 + reach_); ++y)
+            rows[static_cast<size_t>(y)].emplace_back(x0, x1);
+    }
+    for (auto& row : rows) {
+        std::sort(row.begin(), row.end());
+        size_t merged = 0;
+        for (const auto& span : row)
+            if (merged > 0 && span.first <= row[merged - 1].second)
+                row[merged - 1].second = std::max(row[merged - 1].second, span.second);
+            else
+                row[merged++] = span;
+        row.resize(merged);
+    }
+    std::vector<PixelRect> rects;
+    for (int y = 0; y < height_;) {
+        int end = y + 1;
+        while (end < height_ && rows[static_cast<size_t>(end)] == rows[static_cast<size_t>(y)])
+            ++end;
+        for (const auto& [x0, x1] : rows[static_cast<size_t>(y)]) rects.push_back({x0, y, x1, end});
+        y = end;
+    }
+    return rects;
 }
 
 void SampleBuffer::reset(std::shared_ptr<const SampleLayout> l) {

@@ -6,9 +6,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "phases/image.h"
+#include "phases/resolve_frame.h"
 
 namespace mpshade {
 
@@ -78,6 +80,19 @@ class SampleLayout {
     // baseline's; the same bits either way.
     void resolve(const float* rgba, const uint8_t* uniform, Image& out, bool quads = false,
                  ResolveBuild build = ResolveBuild::Fastest) const;
+    // The pixels of `rects` (inside the image, disjoint) resolved again into `out`, which
+    // has the layout's size, the same bits resolve() gives them; the rest of `out` is left
+    // as it is. Each rectangle is resolved in a window of its own holding the columns its
+    // samples reach, so what it reads and adds is exactly what the whole image's resolve
+    // reads and adds for those pixels, in the same order. For a frame changed in a few
+    // places (refinement by tile): their cost, not the image's.
+    void resolveRects(const float* rgba, const uint8_t* uniform, Image& out,
+                      std::span<const PixelRect> rects, bool quads = false,
+                      ResolveBuild build = ResolveBuild::Fastest) const;
+    // The pixels whose resolve reads a sample of the pixels of `changed` (those within the
+    // filter's reach of them), as disjoint rectangles, row strips in order: where a frame
+    // changed only there, resolveRects() of these makes the image resolve() would.
+    std::vector<PixelRect> pixelsReading(std::span<const PixelRect> changed) const;
 
   private:
     // Resizing leaves the elements unset: every one is written before it is read, and
@@ -107,6 +122,8 @@ class SampleLayout {
     // filter's separable taps per sample, their sums per pixel and per block, and each
     // pixel's inverse weight sum.
     void prepareFilter();
+    // What every resolve reads (its output window and columns left for the caller to set).
+    ResolveFrame resolveFrame(const float* rgba, const uint8_t* uniform, bool quads) const;
     void prepareCentroids();
     void prepareQuadCentroids();
     void prepareTaps();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -225,6 +226,31 @@ TEST(TileRefiner, APassedDeadlineRefinesNothingAndAmpleTimeReachesTheBestStep) {
     // Nothing better to go to: no refinement at all.
     refiner.refine(cheap.phase, kQuad, {}, kNever, cheap.image, stats, missing);
     EXPECT_FALSE(stats.ran);
+}
+
+TEST(TileRefiner, TheImageRefinedInPlacesIsTheWholeResolveOfItsSamples) {
+    // Three tiles refined to per pixel and per sample, the rest per 2x2 pixels: only the
+    // pixels near the three are resolved again, and the image is, bit for bit, what
+    // resolving all the frame's samples gives (resolving only the tiles themselves, or
+    // without their filter's ring, would not be).
+    Frame f(writeStripedPlane(), Representation::Facets, kW, kH);
+    RefineOptions o;
+    o.maxTiles = 3;
+    TileRefiner refiner(o);
+    Cheap cheap(f);
+    const Image before = cheap.image;
+    RefineStats stats;
+    std::vector<TileRequest> missing;
+    refiner.refine(cheap.phase, kQuad, kBetter, kNever, cheap.image, stats, missing);
+    ASSERT_EQ(stats.refined[1] + stats.refined[2], 3);
+    EXPECT_GT(stats.gainMse, 0.0);
+    EXPECT_NE(cheap.image.rgba, before.rgba);
+    Image whole;
+    cheap.phase.resolveAgain(whole);
+    ASSERT_EQ(whole.rgba.size(), cheap.image.rgba.size());
+    EXPECT_EQ(
+        std::memcmp(whole.rgba.data(), cheap.image.rgba.data(), whole.rgba.size() * sizeof(float)),
+        0);
 }
 
 TEST(TileRefiner, TheEstimateFollowsTheErrorLeft) {
