@@ -197,7 +197,7 @@ void TileRefiner::refine(DynamicPhase& dynamic, const RefineStep& base,
                             cheap_.pixel(r.x0, y));
         stats.resolveSeconds = dynamic.resolveAgain(image, refined);
     }
-    account(cheap_, image, static_cast<int>(better.size()), stats);
+    account(cheap_, image, static_cast<int>(better.size()), dynamic.layout()->filterReach(), stats);
     if (!refined.empty()) {
         lastPass_ = stats.passSeconds;
         lastFinish_ = std::chrono::duration<double>(Clock::now() - passes).count() - lastPass_;
@@ -207,19 +207,21 @@ void TileRefiner::refine(DynamicPhase& dynamic, const RefineStep& base,
 
 // What refinement changed, the change per unit of contrast it measured per step, the
 // estimate of the error left, and each tile's state for the next frame.
-void TileRefiner::account(const Image& cheap, const Image& image, int best, RefineStats& stats) {
+void TileRefiner::account(const Image& cheap, const Image& image, int best, int reach,
+                          RefineStats& stats) {
     gain_.assign(tiles_.size(), 0.0);
     // The final image differs from the cheap one in the tiles refined and, by the filter's
-    // reach, the tiles around them: only there are the means measured again (a pass over
-    // the whole image had been 1.5 ms at 1280x720).
+    // reach, the tiles that far around them: only there are the means measured again (a
+    // pass over the whole image had been 1.5 ms at 1280x720).
     const int across = (width_ + tileSize_ - 1) / tileSize_;
     const int down = static_cast<int>(tiles_.size()) / std::max(1, across);
+    const int ring = (reach + tileSize_ - 1) / tileSize_;
     changed_.assign(tiles_.size(), 0);
     for (size_t i = 0; i < tiles_.size(); ++i) {
         if (tiles_[i].step == 0) continue;
         const int tx = static_cast<int>(i) % across, ty = static_cast<int>(i) / across;
-        for (int y = std::max(0, ty - 1); y <= std::min(down - 1, ty + 1); ++y)
-            for (int x = std::max(0, tx - 1); x <= std::min(across - 1, tx + 1); ++x)
+        for (int y = std::max(0, ty - ring); y <= std::min(down - 1, ty + ring); ++y)
+            for (int x = std::max(0, tx - ring); x <= std::min(across - 1, tx + ring); ++x)
                 changed_[static_cast<size_t>(y) * across + x] = 1;
     }
     tbb::parallel_for(size_t{0}, tiles_.size(), [&](size_t i) {

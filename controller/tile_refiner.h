@@ -98,7 +98,8 @@ class TileRefiner {
     void layOut(int width, int height);
     void measure(const DynamicPhase& dynamic, const Image& image);
     std::vector<uint32_t> order();
-    void account(const Image& cheap, const Image& image, int best, RefineStats& stats);
+    // reach: the resolve filter's, in pixels (SampleLayout::filterReach).
+    void account(const Image& cheap, const Image& image, int best, int reach, RefineStats& stats);
 
     RefineOptions options_;
     int width_ = 0, height_ = 0, tileSize_ = 0;

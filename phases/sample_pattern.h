@@ -47,6 +47,9 @@ class SampleLayout {
     int width() const { return width_; }
     int height() const { return height_; }
     int spp() const { return spp_; }
+    // Pixels the reconstruction filter reaches around a pixel (a pixel reads the samples of
+    // the pixels this far, in x and in y).
+    int filterReach() const { return reach_; }
     size_t count() const { return xy_.size() / 2; }
     size_t index(int px, int py, int k) const {
         return (static_cast<size_t>(py) * width_ + px) * spp_ + k;
