@@ -293,8 +293,6 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
     // costs more than it finds).
     ResolveFrame f = resolveFrame(rgba, uniform, quads);
     f.pixels = out.rgba.data();
-    f.stride = width_;
-    f.col0 = 0, f.col1 = width_;
     const bool avx512 = build == ResolveBuild::Fastest && resolveAvx512Available();
     constexpr int kBand = 8;
     tbb::parallel_for(0, (height_ + kBand - 1) / kBand, [&](int band) {
@@ -318,6 +316,8 @@ ResolveFrame SampleLayout::resolveFrame(const float* rgba, const uint8_t* unifor
     f.width = width_, f.height = height_, f.reach = reach_;
     f.taps = static_cast<size_t>(taps_), f.spp = static_cast<size_t>(spp_);
     f.blocks = quads && uniform && reach_ == 1 && !blockWeights_.empty();
+    f.stride = width_;  // the whole image's window and columns
+    f.col0 = 0, f.col1 = width_;
     return f;
 }
 

@@ -125,7 +125,8 @@ class SampleLayout {
     // filter's separable taps per sample, their sums per pixel and per block, and each
     // pixel's inverse weight sum.
     void prepareFilter();
-    // What every resolve reads (its output window and columns left for the caller to set).
+    // What every resolve reads, with the whole image as its window and columns (its output
+    // pixels left for the caller to set).
     ResolveFrame resolveFrame(const float* rgba, const uint8_t* uniform, bool quads) const;
     void prepareCentroids();
     void prepareQuadCentroids();
