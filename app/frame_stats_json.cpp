@@ -26,6 +26,9 @@ void addMultiphaseFrameJson(const Scene& scene, const FrameStats& stats, nlohman
     entry["tiles_evicted"] = stats.tiles.evicted;
     entry["resident_bytes"] = stats.tiles.residentBytes;
     entry["resident_pinned_bytes"] = stats.tiles.residentPinnedBytes;
+    if (stats.footprintCalibration.objects > 0)
+        entry["footprint_calibration"] = {{"objects", stats.footprintCalibration.objects},
+                                          {"seconds", stats.footprintCalibration.seconds}};
 }
 
 nlohmann::json staticRunsDueJson(const Scene& scene, const FrameStats& stats) {
@@ -178,6 +181,12 @@ nlohmann::json objectReportsJson(const MultiphaseRenderer& renderer) {
                            {"map_bytes", r.mapBytes}});
         // The direct rule's last priced frame (static_run_triggers.h): CPU ms by the model.
         const ObjectSlot& slot = renderer.slot(i);
+        if (r.footprint.pixels > 0)
+            objects.back()["footprint"] = {{"scale", r.footprintScale},
+                                           {"pixels", r.footprint.pixels},
+                                           {"noise", r.footprint.noise},
+                                           {"scales_tried", r.footprint.scales},
+                                           {"change", r.footprint.change}};
         if (slot.referenceMs > 0.0f)
             objects.back()["priced_ms_per_frame"] = {{"stored", slot.measuredMs},
                                                      {"reference", slot.referenceMs}};

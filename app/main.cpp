@@ -60,6 +60,12 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--footprint-scale", render.footprintScale,
                           "Multiphase: shader map texels per shading point spacing, inverted "
                           "(default 1; larger reads coarser levels: faster, blurrier)");
+    renderCmd
+        ->add_option("--footprints", render.footprints,
+                     "Multiphase: 'measured': each object's footprint widened as far as its "
+                     "measured error allows, at the first frame that shows it well; 'uniform': "
+                     "every object's alike")
+        ->capture_default_str();
     renderCmd->add_flag("--no-single-phase", render.noSinglePhase,
                         "Multiphase: every frame multi-phase, even where its static work would "
                         "cost more than rendering the frames asked for single-phase");
@@ -202,6 +208,11 @@ int main(int argc, char** argv) {
     playCmd
         ->add_option("--refine-tile", play.refineTile,
                      "Refinement's image tiles, pixels a side (even, 4..256)")
+        ->capture_default_str();
+    playCmd
+        ->add_option("--footprints", play.footprints,
+                     "'measured': each object's footprint measured before the clock as `render` "
+                     "measures it; 'uniform': every object's alike")
         ->capture_default_str();
     playCmd->add_option(
         "--compare-to", play.compareTo,

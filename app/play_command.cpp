@@ -142,6 +142,9 @@ PlaybackOptions playbackOptions(const PlayCommandOptions& options, const FrameRe
     if (options.refine != "on" && options.refine != "off")
         throw InputError({"--refine", 0, 0, {}},
                          "expected 'on' or 'off', found '" + options.refine + "'");
+    if (options.footprints != "measured" && options.footprints != "uniform")
+        throw InputError({"--footprints", 0, 0, {}},
+                         "expected measured or uniform, found '" + options.footprints + "'");
     if (options.refineTile < 4 || options.refineTile > 256 || options.refineTile % 2 != 0)
         throw InputError({"--refine-tile", 0, 0, {}},
                          "expected an even number of pixels 4..256, found " +
@@ -156,6 +159,7 @@ PlaybackOptions playbackOptions(const PlayCommandOptions& options, const FrameRe
     po.backgroundFills = !options.noBackgroundFills;
     po.refine.enabled = options.refine == "on";
     po.refine.tileSize = options.refineTile;
+    po.footprints.enabled = options.footprints == "measured";
     return po;
 }
 
@@ -180,6 +184,8 @@ int runPlayCommand(const PlayCommandOptions& options) {
     double preroll = 0.0;
     std::vector<PlaybackStep> steps;  // frames counted here as they are played
     std::vector<FrameStats> playedFrames;
+    // Object name to the footprint multiplier the pre-roll measured (empty: none measured).
+    nlohmann::json footprints = nlohmann::json::object();
     // stats.json, rewritten (atomically) after every frame: what a stopped playback
     // finished is always described.
     const auto writeStats = [&](double prerollSeconds) {
@@ -213,6 +219,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
             {"deadline_met_fraction", played > 0 ? static_cast<double>(met) / played : 1.0},
             {"peak_resident_mb", peakResidentBytes() >> 20},
             {"steps", ladder},
+            {"object_footprints", footprints},
             {"store", storeReport(po.store)},
             {"frames", frames}};
         writeTextFile(dir / "stats.json", doc.dump(2) + "\n");
@@ -247,6 +254,8 @@ int runPlayCommand(const PlayCommandOptions& options) {
     const PlaybackSummary summary = playScene(scene, po, onFrame, [&](const PlaybackSummary& s) {
         preroll = s.prerollSeconds;
         steps = s.steps;
+        for (size_t i = 0; i < s.objectFootprints.size(); ++i)
+            footprints[scene.objects[i].name] = s.objectFootprints[i];
     });
     if (tty) std::fprintf(stderr, "\n");
     cleanUpStore(po.store, options.run);

@@ -25,6 +25,7 @@ struct PlayCommandOptions {
     bool noBackgroundFills = false;  // no worker thread filling deferred tiles (comparisons)
     std::string refine = "on";       // "on" or "off": refinement by image tile (tile_refiner.h)
     int refineTile = 16;             // refinement's tiles, pixels a side: even, 4..256
+    std::string footprints = "measured";  // or "uniform": as render's --footprints
     // A folder of constant-quality frames (frame_NNNN.exr, as `render` writes them): each
     // played frame measured against its own there. Empty: none.
     std::string compareTo;

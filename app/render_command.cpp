@@ -124,6 +124,10 @@ MultiphaseOptions multiphaseOptions(const RenderCommandOptions& options) {
                              "expected 0.05..8, found " + std::to_string(options.footprintScale));
         mo.dynamic.footprintScale = options.footprintScale;
     }
+    if (options.footprints != "measured" && options.footprints != "uniform")
+        throw InputError({"--footprints", 0, 0, {}},
+                         "expected measured or uniform, found '" + options.footprints + "'");
+    mo.footprints.enabled = options.footprints == "measured";
     if (options.cacheMb != 0) {
         if (options.cacheMb < 1 || options.cacheMb > (int64_t{1} << 20))
             throw InputError({"--cache-mb", 0, 0, {}},

@@ -24,6 +24,9 @@ struct RenderCommandOptions {
     // Multiphase: probe footprint over the shading points' spacing (texel spacing of the
     // shader maps read); 0: the default (DynamicOptions::footprintScale); else 0.05..8.
     float footprintScale = 0.0f;
+    // "measured" (each object's from its measured error, controller/footprint_calibration.h)
+    // or "uniform" (every object's 1, times footprintScale).
+    std::string footprints = "measured";
     // Multiphase: never render a frame single-phase, even where the static work it needs
     // would not pay for itself over the frames asked for (MultiphaseOptions).
     bool noSinglePhase = false;

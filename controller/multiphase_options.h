@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <optional>
 
+#include "controller/footprint_calibration.h"
 #include "controller/tile_refiner.h"
 #include "phases/dynamic_phase.h"
 #include "phases/phase_trace.h"
@@ -27,6 +28,10 @@ inline StaticPhaseOptions constantQualityStaticPhase() {
 struct MultiphaseOptions {
     StaticPhaseOptions staticPhase = constantQualityStaticPhase();
     DynamicOptions dynamic;  // its shadingRate is the scene's unless shadingRate is set
+    // Each object's footprint chosen from measured error at the first constant-quality frame
+    // that shows it well (footprint_calibration.h); its objectFootprint is then set per frame
+    // from those choices. Off: every object's is 1 (or dynamic.objectFootprint as given).
+    FootprintCalibrationOptions footprints;
     std::optional<ShadingRate> shadingRate;
     RepresentationCostModel costModel;
     // The shader maps' tiles stay under this many bytes: before tiles are filled, the tiles

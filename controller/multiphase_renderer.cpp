@@ -36,7 +36,8 @@ MultiphaseRenderer::MultiphaseRenderer(const Scene& scene, const MultiphaseOptio
       tiles_(static_, cache_),
       planner_(scene, static_, options.costModel, options.representation),
       slots_(scene.objects.size()),
-      refiner_(options.refine) {
+      refiner_(options.refine),
+      planLast_(scene.frameCount()) {
     options_.dynamic.trace = options.trace;
     std::vector<StaticInputs> inputs(slots_.size());
     for (size_t i = 0; i < slots_.size(); ++i) {
@@ -86,13 +87,18 @@ DynamicOptions MultiphaseRenderer::dynamicOptionsFor(const RenderOptions& option
         options.shadingRate.value_or(options_.shadingRate.value_or(scene_.settings.shadingRate));
     if (options.footprintScale > 0.0f) o.footprintScale = options.footprintScale;
     if (!options.reuseStillView) o.reuseBytes = 0;
-    // A camera or a placement animated: the first frame's view does not hold still.
-    bool viewAnimated =
+    o.keepFirstView = o.keepFirstView && !viewAnimated();
+    if (options_.footprints.enabled) o.objectFootprint = footprintScales();
+    return o;
+}
+
+// A camera or a placement animated: the first frame's view does not hold still.
+bool MultiphaseRenderer::viewAnimated() const {
+    bool animated =
         scene_.camera.eye.varies() || scene_.camera.target.varies() || scene_.camera.up.varies();
     for (const SceneObject& object : scene_.objects)
-        viewAnimated = viewAnimated || object.transform.animated();
-    o.keepFirstView = o.keepFirstView && !viewAnimated;
-    return o;
+        animated = animated || object.transform.animated();
+    return animated;
 }
 
 void MultiphaseRenderer::discardStaticWork() {
@@ -110,6 +116,7 @@ void MultiphaseRenderer::discardStaticWork() {
 void MultiphaseRenderer::plan(int first, int last, const RenderOptions& options) {
     const RenderOptions o = options.resolved(scene_.settings);
     planner_.plan(first, last, o.width, o.height);
+    planLast_ = last;
 }
 
 void MultiphaseRenderer::setFrameBudget(double seconds) {
@@ -132,6 +139,9 @@ void MultiphaseRenderer::setFrameBudget(double seconds) {
 //                       are filled (tile_filler.h) and only the bands that missed them are
 //                       shaded again, so no sample reads a coarser level than its footprint
 //                       asks and the image does not depend on what earlier frames filled.
+//   calibrateFootprints at constant quality, objects shown well for the first time have
+//                       their footprints chosen from measured error
+//                       (footprint_calibration.h); the frame is then shaded again with them.
 //   recordFrame         what the frame drew and cost, per object (object_slot.h) and in all.
 // renderFrame() then resolves pixels and, within a budget, fills the missing tiles in the
 // time left (frame_budget.cpp). Playback's look-ahead and prefetching are frame_budget.cpp
@@ -162,8 +172,22 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
                              Clock::now(), -1, frame);
     if (progress) progress(1, 4);
     shadeAndFill(plan, stats, progress);
+    const bool calibrated = calibrateFootprints(plan.frame, plan.drawn, stats);
+    const DynamicFrameStats firstPass = dynamic_.stats();
+    if (calibrated) shadeAndFill(plan, stats, progress);
     recordFrame(plan, stats);
+    if (calibrated) addPassTimes(firstPass, stats.dynamic);
     stats.wallSeconds = secondsSince(start);
+}
+
+// The times of a pass shaded again (after the footprints' calibration) added to the frame's:
+// its counts are the last pass's, its time both passes'.
+void MultiphaseRenderer::addPassTimes(const DynamicFrameStats& pass, DynamicFrameStats& frame) {
+    frame.warpSeconds += pass.warpSeconds;
+    frame.rasterSeconds += pass.rasterSeconds;
+    frame.shadeSeconds += pass.shadeSeconds;
+    frame.shadeParts += pass.shadeParts;
+    frame.shadePasses += pass.shadePasses;
 }
 
 // The frame's state, its costs reset, the background filler held and its work counted,

@@ -106,6 +106,12 @@ class MultiphaseRenderer : public Renderer {
     bool rendersSinglePhase(FramePlan& plan);
     void buildDue(const FramePlan& plan, FrameStats& stats);
     void shadeAndFill(FramePlan& plan, FrameStats& stats, const ProgressFn& progress);
+    bool calibrateFootprints(int frame, std::span<const ObjectRepresentation* const> drawn,
+                             FrameStats& stats);
+    bool viewAnimated() const;  // the camera or an object's placement animated
+    static void addPassTimes(const DynamicFrameStats& pass, DynamicFrameStats& frame);
+    // Per object, its footprint multiplier (ObjectSlot::footprintScale); empty if all are 1.
+    std::vector<float> footprintScales() const;
     void recordFrame(const FramePlan& plan, FrameStats& stats);
     void compareLastFrameWithReference();
     void render(int frame, const RenderOptions& options, FrameStats& stats,
@@ -154,6 +160,7 @@ class MultiphaseRenderer : public Renderer {
     PrefetchLedger prefetched_;  // the tiles prefetched and not yet read
     TileRefiner refiner_;
     std::vector<RefineStep> refineSteps_;
+    int planLast_;  // the end of the frames planned (plan()); the scene's last frame by default
     // The background filler (made at the first frame that defers tiles), and its totals at
     // the last frame. Last: destroyed (its worker joined) before anything it uses.
     BackgroundTotals fillerTotals_;

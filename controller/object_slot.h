@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "controller/footprint_calibration.h"
 #include "phases/dynamic_phase.h"
 #include "phases/object_representation.h"
 #include "phases/static_inputs.h"
@@ -28,6 +29,10 @@ struct ObjectReport {
     uint64_t residentTiles = 0, mapBytes = 0;
     float longestEdgePixels = 0.0f;  // combined: last frame's longest projected facet edge
     StaticCosts staticCosts;
+    // Its footprint calibration (footprint_calibration.h): what was measured (no pixels: not
+    // measured) and the scale chosen.
+    FootprintMeasure footprint;
+    float footprintScale = 1.0f;
 };
 
 struct ObjectSlot {
@@ -42,6 +47,10 @@ struct ObjectSlot {
     // a shader map the next run keeps (StaticCosts::keptMapSeconds: a rebuild re-dices; the
     // map's tiles stay valid).
     double rebuildSeconds = 0.0;
+    // Its footprint multiplier (DynamicOptions::objectFootprint), once measured: chosen by
+    // MultiphaseRenderer::calibrateFootprints, kept for the rest of the render.
+    bool footprintMeasured = false;
+    float footprintScale = 1.0f;
     // The animated inputs its static part reads, how far each moves over the scene (its
     // span), and their values at its last static run (the photometric fiducial).
     StaticInputs staticInputs;

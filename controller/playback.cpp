@@ -60,10 +60,18 @@ class Player {
     // its fills go through the budgeted path, which stops when the cache is full), the
     // regulator calibrated, and the cache warmed.
     void preroll(PlaybackSummary& summary) {
-        renderer_.setFrameBudget(1e9);
         RenderOptions first = options_.render;
         first.shadingRate = scene_.settings.shadingRate;  // the regulator's top step
         FrameStats stats;
+        // The footprints measured on the first frame at constant quality, as a render from it
+        // measures them (each tile it reads filled: a fallback would skew the measure).
+        if (options_.footprints.enabled) {
+            renderer_.renderFrame(options_.first, first, stats, image_);
+            if (stats.footprintCalibration.objects > 0)
+                for (size_t i = 0; i < scene_.objects.size(); ++i)
+                    summary.objectFootprints.push_back(renderer_.report(i).footprintScale);
+        }
+        renderer_.setFrameBudget(1e9);
         renderer_.renderFrame(options_.first, first, stats, image_);
         calibrate(summary);
         if (options_.refine.enabled && regulator_.level() > 0) {
@@ -125,6 +133,7 @@ class Player {
         mo.trace = options.trace;
         mo.staticPhase.store = options.store;
         mo.refine = options.refine;
+        mo.footprints = options.footprints;
         return mo;
     }
 

@@ -33,6 +33,10 @@ struct PlaybackOptions {
     // What frames give up when the dynamic phase alone takes most of the budget: shading
     // rate, then probe footprint (quality_regulator.h).
     QualityRegulatorOptions regulator;
+    // Each object's footprint measured before the clock, as `render` measures it at its first
+    // frame (footprint_calibration.h), so played frames read the levels constant-quality
+    // frames read. Off: every object's footprint is 1.
+    FootprintCalibrationOptions footprints;
     // Each frame, once shaded at the regulator's step, refined by image tile at finer rates
     // in order of priority in the time left (tile_refiner.h); the regulator's shares are then
     // scaled by RefineOptions::baseShare. Off (`play --refine off`): the whole-frame step alone.
@@ -83,6 +87,9 @@ struct PlaybackSummary {
     double prerollSeconds = 0.0;  // the first frame at constant quality, before the clock
     int frames = 0, deadlinesMet = 0;
     std::vector<PlaybackStep> steps;  // the ladder, best first (PlaybackQuality::level)
+    // Per scene object, the footprint multiplier the pre-roll measured
+    // (controller/footprint_calibration.h); 1 for one not measured. Empty if none was.
+    std::vector<float> objectFootprints;
 };
 
 // Plays frames [first, last); after each, onFrame(stats, image, the quality step it used)

@@ -337,6 +337,7 @@ void DynamicPhase::compareWithLastView() {
     key.layout = layout_.get();
     key.shadingRate = static_cast<int>(options_.shadingRate);
     key.footprintScale = options_.footprintScale;
+    key.objectFootprint = options_.objectFootprint;
     key.probe = options_.probe;
     key.bandRows = options_.bandRows;
     key.wholePixelShortcut = options_.wholePixelShortcut;
@@ -412,7 +413,7 @@ void DynamicPhase::warpObjects() {
         v.d0 = toObject * d0;
         v.dx = toObject * ddx;
         v.dy = toObject * ddy;
-        v.footprintScale = footprint;
+        v.footprintScale = footprint * objectFootprintAt(options_.objectFootprint, i);
     });
     for (size_t i = 0; i < n; ++i)
         if (objects_[i]) {
@@ -643,7 +644,11 @@ RefineCounts DynamicPhase::refine(std::span<const PixelRect> tiles, const Refine
                           frame_->index);
     refineViews_ = views_;
     const float footprint = pass.footprintScale * footprintPixels(pass.rate, layout_->spp());
-    for (ObjectView& v : refineViews_) v.footprintScale = footprint;
+    const std::span<const float> scales = pass.objectFootprint.empty()
+                                              ? std::span<const float>(options_.objectFootprint)
+                                              : pass.objectFootprint;
+    for (size_t i = 0; i < refineViews_.size(); ++i)
+        refineViews_[i].footprintScale = footprint * objectFootprintAt(scales, i);
     const size_t objects = objects_.size();
     // Every worker takes the next tile in order, so the tiles done are a prefix of the list.
     std::atomic<size_t> next{0};

@@ -54,6 +54,10 @@ struct DynamicOptions {
     // Multiplies each shading point's probe footprint of 1/sqrt(spp) pixel per sample (its
     // stratum), or half a pixel per pixel.
     float footprintScale = 1.0f;
+    // Per object (by scene index), a further multiplier of its points' footprints, as the
+    // controller's footprint calibration chooses them (controller/footprint_calibration.h);
+    // objects past the end, or all when empty: 1.
+    std::vector<float> objectFootprint;
     int bandRows = 4;  // pixel rows per unit of shading work
     // Per pixel or 2x2 pixels: a pixel (block) whose samples all see one surface in front
     // takes its point from the layout's precomputed centroid and nearest sample instead of
@@ -87,6 +91,11 @@ struct DynamicOptions {
 inline float footprintPixels(ShadingRate rate, int spp) {
     return rate == ShadingRate::Sample ? 1.0f / std::sqrt(static_cast<float>(spp))
                                        : (rate == ShadingRate::Pixel ? 0.5f : 1.0f);
+}
+
+// Object i's entry of a per-object footprint multiplier (DynamicOptions::objectFootprint).
+inline float objectFootprintAt(std::span<const float> scales, size_t i) {
+    return i < scales.size() ? scales[i] : 1.0f;
 }
 
 // What one object cost this frame.
@@ -164,6 +173,9 @@ struct RefinePass {
     float footprintScale = 1.0f;  // times footprintPixels(rate, spp), as DynamicOptions'
     // No tile starts after this moment; one started is finished.
     std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
+    // Per object, multiplies footprintScale for its points; empty: the frame's
+    // (DynamicOptions::objectFootprint). Not owned; read during refine() only.
+    std::span<const float> objectFootprint{};
 };
 
 // What a refine() pass did: the first `tiles` of those asked were shaded again, at so many
@@ -195,6 +207,8 @@ class DynamicPhase {
     bool abandoned() const { return abandoned_; }
     // The composited samples (after shade() completed every band).
     const SampleBuffer& samples() const { return samples_; }
+    // Per pixel: 1 where its samples all came out alike and only its first was written.
+    std::span<const uint8_t> uniformPixels() const { return uniform_; }
     // Filters the samples into pixels.
     void resolve(Image& out);
 

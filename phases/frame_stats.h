@@ -201,6 +201,12 @@ struct FrameStats {
     PrefetchStats prefetch;
     BackgroundStats background;
     RefineStats refine;
+    // Objects whose footprints were measured this frame (controller/footprint_calibration.h),
+    // and the wall seconds it took (within wallSeconds; its fills are in staticWork too).
+    struct FootprintCalibration {
+        uint64_t objects = 0;
+        double seconds = 0.0;
+    } footprintCalibration;
     // The controller's own work, within wallSeconds: re-run triggers and deferrals, cache
     // bookkeeping (eviction, prefetch accounting), the regulator.
     double controllerSeconds = 0.0;

@@ -22,7 +22,8 @@ bool sameProbe(const ProbeOptions& a, const ProbeOptions& b) {
 
 bool ViewKey::operator==(const ViewKey& o) const {
     return sameCamera(camera, o.camera) && layout == o.layout && shadingRate == o.shadingRate &&
-           footprintScale == o.footprintScale && sameProbe(probe, o.probe) &&
+           footprintScale == o.footprintScale && objectFootprint == o.objectFootprint &&
+           sameProbe(probe, o.probe) &&
            bandRows == o.bandRows && wholePixelShortcut == o.wholePixelShortcut &&
            serials == o.serials && placements == o.placements;
 }

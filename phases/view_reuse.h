@@ -34,6 +34,7 @@ struct ViewKey {
     const SampleLayout* layout = nullptr;  // layouts are shared and immutable: by identity
     int shadingRate = 0;
     float footprintScale = 0.0f;
+    std::vector<float> objectFootprint;  // DynamicOptions::objectFootprint
     ProbeOptions probe;
     int bandRows = 0;
     bool wholePixelShortcut = false;

@@ -14,12 +14,8 @@ namespace {
 
 using mpshade::cli::CliRun;
 using mpshade::cli::mpshade;
+using mpshade::cli::readStats;
 using mpshade::cli::tempDir;
-
-nlohmann::json readStats(const std::string& dir) {
-    std::ifstream file(dir + "/stats.json");
-    return nlohmann::json::parse(file);
-}
 
 TEST(CliPlay, MeasuresEachFrameAgainstConstantQualityAndReportsRefinement) {
     const std::string truth = tempDir("play_truth");

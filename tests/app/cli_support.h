@@ -6,9 +6,11 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 namespace mpshade::cli {
 
@@ -36,6 +38,12 @@ inline std::string tempDir(const std::string& name) {
     const std::string dir = ::testing::TempDir() + "mpshade_cli_" + name;
     std::filesystem::remove_all(dir);
     return dir;
+}
+
+// DIR/stats.json, parsed.
+inline nlohmann::json readStats(const std::string& dir) {
+    std::ifstream file(dir + "/stats.json");
+    return nlohmann::json::parse(file);
 }
 
 }  // namespace mpshade::cli

@@ -55,6 +55,9 @@ TEST(Playback, WithTimeEnoughAFrameIsTheConstantQualityFrame) {
 
     MultiphaseOptions constant;
     constant.singlePhaseFrames = false;
+    // A renderer with a budget measures no footprints (playback measures them before it
+    // sets one): uniform ones here too.
+    constant.footprints.enabled = false;
     MultiphaseRenderer render(scene, constant);
     FrameStats stats;
     const Image reference = render.renderFrame(3, small(), stats);
@@ -135,10 +138,46 @@ TEST(Playback, DeferredTilesAreFilledInTheBackgroundForTheNextFrames) {
     EXPECT_EQ(stats.dynamic.probeFallbacks, 0u);
     MultiphaseOptions constant;
     constant.singlePhaseFrames = false;
+    // A renderer with a budget measures no footprints (playback measures them before it
+    // sets one): uniform ones here too.
+    constant.footprints.enabled = false;
     MultiphaseRenderer reference(scene, constant);
     FrameStats cs;
     reference.renderFrame(3, small(), cs);  // the same views built
     EXPECT_GT(compareImages(image, reference.renderFrame(4, small(), cs)).psnr, 60.0);
+}
+
+TEST(Playback, ThePrerollMeasuresFootprintsAndTheFramesPlayAtThem) {
+    const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    PlaybackOptions options;
+    options.render = small();
+    options.first = 0;
+    options.last = 24;  // enough frames to repay the measuring (minFrames)
+    options.fps = 0.5;  // time enough: frames at constant quality
+    Image played;
+    const PlaybackSummary summary = playScene(
+        scene, options, [&](const FrameStats& s, const Image& image, const PlaybackQuality&) {
+            played = image;
+            return s.index < 2;
+        });
+    ASSERT_EQ(summary.objectFootprints.size(), scene.objects.size());
+    float widest = 1.0f;
+    for (float f : summary.objectFootprints) widest = std::max(widest, f);
+    EXPECT_GT(widest, 1.0f);  // the floor's static part is smooth at this size
+
+    MultiphaseOptions constant;
+    constant.singlePhaseFrames = false;
+    constant.footprints.enabled = false;
+    constant.dynamic.objectFootprint = summary.objectFootprints;
+    MultiphaseRenderer told(scene, constant);
+    FrameStats cs;
+    for (int f = 0; f < 2; ++f) told.renderFrame(f, small(), cs);
+    const Image want = told.renderFrame(2, small(), cs);
+    EXPECT_GT(compareImages(played, want).psnr, 60.0);
+    constant.dynamic.objectFootprint = {};
+    MultiphaseRenderer uniform(scene, constant);
+    for (int f = 0; f < 2; ++f) uniform.renderFrame(f, small(), cs);
+    EXPECT_LT(compareImages(played, uniform.renderFrame(2, small(), cs)).psnr, 60.0);
 }
 
 TEST(Playback, PlaysEveryFrameAndRegulatesItsQuality) {
