@@ -51,8 +51,8 @@ struct FootprintCalibrationOptions {
     // then, and if it never does, its footprint stays at 1.
     int minPixels = 256;
     // Measured only at a frame with at least this many frames planned from it on (itself
-    // included): measuring and shading the frame again cost its first frame 0.04-0.21 s at
-    // 480x270 on 2 cores, repaid after 17-27 frames on the courtyard, the gallery, the vase
+    // included): measuring and shading the frame again cost its first frame 0.04-0.25 s at
+    // 480x270 on 2 cores, repaid after 17-30 frames on the courtyard, the gallery, the vase
     // and a camera dolly (docs/shader-maps.md).
     int minFrames = 24;
     // Image tiles measured: those of a checkerboard of tiles this many pixels a side.
