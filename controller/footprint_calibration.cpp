@@ -138,9 +138,11 @@ std::vector<PixelRect> tilesOwnedBy(std::span<const int32_t> owners, int width, 
 // The pipeline's step (multiphase_renderer.cpp lists it). The frame was shaded at every
 // object's current footprint; the tiles of a checkerboard holding the objects measured are
 // shaded again, each object at its candidate of a bisection, with the tiles that reads
-// filled as at constant quality, so each change is the footprint's alone. Returns whether
-// it ran: the frame's samples are then the last pass's and the frame must be shaded again.
-bool MultiphaseRenderer::calibrateFootprints(int frame,
+// filled as at constant quality, so each change is the footprint's alone. The frame's own
+// samples are put back after: it is the frame its pass shaded, and the frames after it are
+// shaded at the footprints chosen (shading it again would cost a frame's shading for a
+// first frame a few hundredths of a dB better).
+void MultiphaseRenderer::calibrateFootprints(int frame,
                                              std::span<const ObjectRepresentation* const> drawn,
                                              FrameStats& stats) {
     const FootprintCalibrationOptions& o = options_.footprints;
@@ -149,7 +151,7 @@ bool MultiphaseRenderer::calibrateFootprints(int frame,
     const bool replays = !viewAnimated() && dynamicOptions_.reuseBytes > 0;
     if (!o.enabled || replays || o.scales.empty() || options_.frameBudgetSeconds > 0.0 ||
         planLast_ - frame < o.minFrames || dynamic_.abandoned() || !dynamic_.complete())
-        return false;
+        return;
     const int width = frame_.width, height = frame_.height;
     std::vector<uint64_t> pixels;
     std::vector<int32_t> owners = pixelOwners(dynamic_.visibility(), slots_.size(), pixels);
@@ -163,10 +165,11 @@ bool MultiphaseRenderer::calibrateFootprints(int frame,
         if (drawn[i] && drawn[i]->map && !slots_[i].footprintMeasured &&
             pixels[i] >= static_cast<uint64_t>(std::max(1, o.minPixels)))
             measured.push_back(i);
-    if (measured.empty()) return false;
+    if (measured.empty()) return;
     const auto start = std::chrono::steady_clock::now();
     const ScopedSpan span(options_.trace, "footprint calibration", PhaseKind::Dynamic,
                           SpanLevel::Phase, -1, frame);
+    const DynamicPhase::KeptSamples kept = dynamic_.keepSamples();
     std::vector<FootprintMeasure> measures(slots_.size());
     for (size_t i : measured) measures[i].pixels = pixels[i];
     addSampleNoise(dynamic_.samples(), dynamic_.uniformPixels(), owners, measures);
@@ -202,6 +205,7 @@ bool MultiphaseRenderer::calibrateFootprints(int frame,
             return high[i] - low[i] <= 1;
         });
     }
+    dynamic_.restoreSamples(kept);
     countFills(fills, stats);
     for (size_t i : measured) {
         ObjectSlot& slot = slots_[i];
@@ -213,7 +217,6 @@ bool MultiphaseRenderer::calibrateFootprints(int frame,
     dynamicOptions_.objectFootprint = footprintScales();
     stats.footprintCalibration.objects += measured.size();
     stats.footprintCalibration.seconds += secondsSince(start);
-    return true;
 }
 
 std::vector<float> MultiphaseRenderer::footprintScales() const {

@@ -20,8 +20,9 @@
 // variance of its samples' mean, the error a few-sample renderer's pixel carries anyway
 // (the reference renderer's included). The object takes the largest candidate whose change
 // stays within `tolerance` of that noise, plus `floor` a pixel, so that an object without
-// noise (a flat colour) widens freely. Hakura and Snyder's layers make the same trade per
-// layer, at their error's cost.
+// noise (a flat colour) widens freely, from the next frame on (the measured frame keeps the
+// samples its own pass shaded). Hakura and Snyder's layers make the same trade per layer,
+// at their error's cost.
 #pragma once
 
 #include <cstddef>
@@ -51,9 +52,9 @@ struct FootprintCalibrationOptions {
     // then, and if it never does, its footprint stays at 1.
     int minPixels = 256;
     // Measured only at a frame with at least this many frames planned from it on (itself
-    // included): measuring and shading the frame again cost its first frame 0.04-0.25 s at
-    // 480x270 on 2 cores, repaid after 17-30 frames on the courtyard, the gallery, the vase
-    // and a camera dolly (docs/shader-maps.md).
+    // included): measuring costs its frame 0.03-0.2 s at 480x270 on 2 cores, repaid after
+    // 17-30 frames on the courtyard, the gallery, the vase and a camera dolly
+    // (docs/shader-maps.md).
     int minFrames = 24;
     // Image tiles measured: those of a checkerboard of tiles this many pixels a side.
     int tileSize = 32;

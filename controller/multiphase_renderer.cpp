@@ -140,8 +140,8 @@ void MultiphaseRenderer::setFrameBudget(double seconds) {
 //                       shaded again, so no sample reads a coarser level than its footprint
 //                       asks and the image does not depend on what earlier frames filled.
 //   calibrateFootprints at constant quality, objects shown well for the first time have
-//                       their footprints chosen from measured error
-//                       (footprint_calibration.h); the frame is then shaded again with them.
+//                       their footprints chosen from measured error, for the frames after
+//                       (footprint_calibration.h); this frame's samples are left as shaded.
 //   recordFrame         what the frame drew and cost, per object (object_slot.h) and in all.
 // renderFrame() then resolves pixels and, within a budget, fills the missing tiles in the
 // time left (frame_budget.cpp). Playback's look-ahead and prefetching are frame_budget.cpp
@@ -172,22 +172,9 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
                              Clock::now(), -1, frame);
     if (progress) progress(1, 4);
     shadeAndFill(plan, stats, progress);
-    const bool calibrated = calibrateFootprints(plan.frame, plan.drawn, stats);
-    const DynamicFrameStats firstPass = dynamic_.stats();
-    if (calibrated) shadeAndFill(plan, stats, progress);
+    calibrateFootprints(plan.frame, plan.drawn, stats);
     recordFrame(plan, stats);
-    if (calibrated) addPassTimes(firstPass, stats.dynamic);
     stats.wallSeconds = secondsSince(start);
-}
-
-// The times of a pass shaded again (after the footprints' calibration) added to the frame's:
-// its counts are the last pass's, its time both passes'.
-void MultiphaseRenderer::addPassTimes(const DynamicFrameStats& pass, DynamicFrameStats& frame) {
-    frame.warpSeconds += pass.warpSeconds;
-    frame.rasterSeconds += pass.rasterSeconds;
-    frame.shadeSeconds += pass.shadeSeconds;
-    frame.shadeParts += pass.shadeParts;
-    frame.shadePasses += pass.shadePasses;
 }
 
 // The frame's state, its costs reset, the background filler held and its work counted,

@@ -106,10 +106,9 @@ class MultiphaseRenderer : public Renderer {
     bool rendersSinglePhase(FramePlan& plan);
     void buildDue(const FramePlan& plan, FrameStats& stats);
     void shadeAndFill(FramePlan& plan, FrameStats& stats, const ProgressFn& progress);
-    bool calibrateFootprints(int frame, std::span<const ObjectRepresentation* const> drawn,
+    void calibrateFootprints(int frame, std::span<const ObjectRepresentation* const> drawn,
                              FrameStats& stats);
     bool viewAnimated() const;  // the camera or an object's placement animated
-    static void addPassTimes(const DynamicFrameStats& pass, DynamicFrameStats& frame);
     // Per object, its footprint multiplier (ObjectSlot::footprintScale); empty if all are 1.
     std::vector<float> footprintScales() const;
     void recordFrame(const FramePlan& plan, FrameStats& stats);

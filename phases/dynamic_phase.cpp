@@ -636,6 +636,13 @@ double DynamicPhase::resolveAgain(Image& out, std::span<const PixelRect> changed
     return secondsSince(start);
 }
 
+void DynamicPhase::restoreSamples(const KeptSamples& kept) {
+    MPSHADE_CHECK(kept.rgba.size() == samples_.rgba.size() &&
+                  kept.uniform.size() == uniform_.size());
+    std::copy(kept.rgba.begin(), kept.rgba.end(), samples_.rgba.begin());
+    std::copy(kept.uniform.begin(), kept.uniform.end(), uniform_.begin());
+}
+
 RefineCounts DynamicPhase::refine(std::span<const PixelRect> tiles, const RefinePass& pass,
                                   std::vector<TileRequest>& missing) {
     RefineCounts counts;

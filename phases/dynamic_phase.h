@@ -209,6 +209,15 @@ class DynamicPhase {
     const SampleBuffer& samples() const { return samples_; }
     // Per pixel: 1 where its samples all came out alike and only its first was written.
     std::span<const uint8_t> uniformPixels() const { return uniform_; }
+    // The composited samples and uniform marks, kept before trial refine() passes and put
+    // back after them, so the frame is the one its own pass shaded. Restoring needs a copy
+    // kept from this frame (same size).
+    struct KeptSamples {
+        std::vector<float> rgba;
+        std::vector<uint8_t> uniform;
+    };
+    KeptSamples keepSamples() const { return {samples_.rgba, uniform_}; }
+    void restoreSamples(const KeptSamples& kept);
     // Filters the samples into pixels.
     void resolve(Image& out);
 
