@@ -9,24 +9,58 @@
 
 namespace mpshade {
 
-std::vector<int32_t> pixelOwners(const VisibilityBuffer& vis, size_t objects,
+std::vector<int32_t> pixelOwners(const VisibilityBuffer& vis, size_t objects, int margin,
                                  std::vector<uint64_t>& pixels) {
-    const size_t n = static_cast<size_t>(vis.width) * static_cast<size_t>(vis.height);
+    const int width = vis.width, height = vis.height;
+    const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
     const size_t spp = static_cast<size_t>(vis.spp), layers = static_cast<size_t>(vis.layers);
+    // Per pixel, the one object any surface of its samples belongs to: kNone, or kSeveral.
+    constexpr int32_t kNone = -1, kSeveral = -2;
+    std::vector<int32_t> seen(n, kNone);
     std::vector<int32_t> owners(n, -1);
-    pixels.assign(objects, 0);
     for (size_t p = 0; p < n; ++p) {
         const size_t first = p * spp;
-        if (vis.count[first] == 0) continue;
-        const uint32_t o = vis.object[first * layers];
-        bool whole = o < objects;
-        for (size_t k = 1; k < spp && whole; ++k)
-            whole = vis.count[first + k] > 0 && vis.object[(first + k) * layers] == o;
-        if (!whole) continue;
-        owners[p] = static_cast<int32_t>(o);
-        ++pixels[o];
+        int32_t one = kNone;
+        bool whole = true;  // every sample sees a surface, the first of one object
+        for (size_t k = 0; k < spp; ++k) {
+            const size_t s = first + k;
+            whole =
+                whole && vis.count[s] > 0 && vis.object[s * layers] == vis.object[first * layers];
+            for (size_t l = 0; l < vis.count[s]; ++l) {
+                const auto o = static_cast<int32_t>(vis.object[s * layers + l]);
+                one = one == kNone || one == o ? o : kSeveral;
+            }
+        }
+        seen[p] = one;
+        if (whole && vis.object[first * layers] < objects)
+            owners[p] = static_cast<int32_t>(vis.object[first * layers]);
     }
-    return owners;
+    // A pixel whose filter reaches another object's samples would measure that object's
+    // change too (every object is searched at once).
+    pixels.assign(objects, 0);
+    std::vector<int32_t> kept(owners);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const size_t p = static_cast<size_t>(y) * width + x;
+            const int32_t o = owners[p];
+            if (o < 0) continue;
+            bool alone = true;
+            for (int qy = std::max(0, y - margin); qy <= std::min(height - 1, y + margin) && alone;
+                 ++qy)
+                for (int qx = std::max(0, x - margin); qx <= std::min(width - 1, x + margin);
+                     ++qx) {
+                    const int32_t q = seen[static_cast<size_t>(qy) * width + qx];
+                    if (q != kNone && q != o) {
+                        alone = false;
+                        break;
+                    }
+                }
+            if (alone)
+                ++pixels[static_cast<size_t>(o)];
+            else
+                kept[p] = -1;
+        }
+    return kept;
 }
 
 void addSampleNoise(const SampleBuffer& samples, std::span<const uint8_t> uniform,
@@ -154,7 +188,8 @@ void MultiphaseRenderer::calibrateFootprints(int frame,
         return;
     const int width = frame_.width, height = frame_.height;
     std::vector<uint64_t> pixels;
-    std::vector<int32_t> owners = pixelOwners(dynamic_.visibility(), slots_.size(), pixels);
+    std::vector<int32_t> owners =
+        pixelOwners(dynamic_.visibility(), slots_.size(), dynamic_.layout()->filterReach(), pixels);
     keepCheckerboard(owners, width, height, std::max(1, o.tileSize),
                      dynamic_.layout()->filterReach());
     pixels.assign(slots_.size(), 0);

@@ -71,9 +71,10 @@ struct FootprintMeasure {
 };
 
 // Per pixel of the visibility buffer: the object whose surface every sample of the pixel
-// sees in front, or -1 (samples that see nothing or differ). `pixels`, per object (resized
-// to `objects`): how many pixels it owns.
-std::vector<int32_t> pixelOwners(const VisibilityBuffer& vis, size_t objects,
+// sees in front, or -1 (samples that see nothing or differ, or a surface of another object
+// seen by a sample of a pixel within `margin` pixels, the filter's reach, in any layer).
+// `pixels`, per object (resized to `objects`): how many pixels it owns.
+std::vector<int32_t> pixelOwners(const VisibilityBuffer& vis, size_t objects, int margin,
                                  std::vector<uint64_t>& pixels);
 
 // Adds each owned pixel's sampling noise to its owner's measure: the unbiased variance of its

@@ -31,9 +31,40 @@ TEST(FootprintCalibration, APixelBelongsToTheObjectEverySampleSees) {
     const VisibilityBuffer vis =
         visibilityOf(4, 1, {1, 1, 1, 1, 1, 1, 0, 1, 0, 0, 0, 0, 2, 2, -1, 2});
     std::vector<uint64_t> pixels;
-    const std::vector<int32_t> owners = pixelOwners(vis, 3, pixels);
+    const std::vector<int32_t> owners = pixelOwners(vis, 3, 0, pixels);
     EXPECT_EQ(owners, (std::vector<int32_t>{1, -1, 0, -1}));
     EXPECT_EQ(pixels, (std::vector<uint64_t>{1, 1, 0}));
+}
+
+TEST(FootprintCalibration, APixelWithinTheFiltersReachOfAnotherObjectIsNotMeasured) {
+    // 6 x 2 pixels, every sample of a pixel alike: object 1 in columns 0-2, nothing in
+    // column 3, object 2 in columns 4-5. Margin 1: column 2 is next to nothing (kept),
+    // column 4 next to nothing too; margin 2 reaches across the gap.
+    std::vector<int> samples;
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 6; ++x)
+            for (int k = 0; k < 4; ++k) samples.push_back(x < 3 ? 1 : x == 3 ? -1 : 2);
+    const VisibilityBuffer vis = visibilityOf(6, 2, samples);
+    std::vector<uint64_t> pixels;
+    EXPECT_EQ(pixelOwners(vis, 3, 1, pixels),
+              (std::vector<int32_t>{1, 1, 1, -1, 2, 2, 1, 1, 1, -1, 2, 2}));
+    EXPECT_EQ(pixels, (std::vector<uint64_t>{0, 6, 4}));
+    EXPECT_EQ(pixelOwners(vis, 3, 2, pixels),
+              (std::vector<int32_t>{1, 1, -1, -1, -1, 2, 1, 1, -1, -1, -1, 2}));
+    EXPECT_EQ(pixels, (std::vector<uint64_t>{0, 4, 2}));
+
+    // A surface of object 2 behind a sample of pixel (0, 0), in a second layer: that pixel
+    // and, at margin 1, its neighbours within reach are no longer object 1's alone.
+    VisibilityBuffer layered;
+    layered.resize(4, 1, 4, 2);
+    for (size_t s = 0; s < 16; ++s) {
+        layered.count[s] = 1;
+        layered.object[2 * s] = 1;
+    }
+    layered.count[1] = 2;
+    layered.object[2 * 1 + 1] = 2;
+    EXPECT_EQ(pixelOwners(layered, 3, 0, pixels), (std::vector<int32_t>{-1, 1, 1, 1}));
+    EXPECT_EQ(pixelOwners(layered, 3, 1, pixels), (std::vector<int32_t>{-1, -1, 1, 1}));
 }
 
 TEST(FootprintCalibration, NoiseIsTheSpreadOfTheCheckerboardsHalves) {
