@@ -222,7 +222,16 @@ __attribute__((target_clones("avx2", "default"))) void runBatch(
                 const float* arg[10];
                 for (int k = 0; k < e.nin; ++k) arg[k] = S[e.in[k]];
                 float* rgb[3] = {R(e.out[0]), R(e.out[1]), R(e.out[2])};
-                shadeLight(e.op, light, arg, rgb, m, e.negatedView);
+                if (e.lightEpilogue) {
+                    LightEpilogue epilogue;
+                    for (int k = 0; k < 3; ++k) {
+                        epilogue.scale[k] = e.epilogue[k] >= 0 ? S[e.epilogue[k]] : nullptr;
+                        epilogue.base[k] = S[e.epilogue[3 + k]];
+                    }
+                    shadeLight(e.op, light, arg, rgb, m, e.negatedView, &epilogue);
+                } else {
+                    shadeLight(e.op, light, arg, rgb, m, e.negatedView);
+                }
                 break;
             }
             case Op::Occlusion: {
@@ -320,13 +329,86 @@ std::vector<int> findMulFusions(const IrProgram& program, const std::vector<int>
     return fusedInto;
 }
 
-}  // namespace
+// A light instruction's three results each ending in a sum (LightEpilogue): per channel the
+// sum's index, the product's (-1 if the light is the sum's own operand) and the two
+// registers-to-be (values) of scale and base.
+struct LightEnding {
+    int sum[3] = {-1, -1, -1};
+    int product[3] = {-1, -1, -1};
+    int32_t scale[3] = {-1, -1, -1};
+    int32_t base[3] = {-1, -1, -1};
+};
 
-ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
-    IrProgram program = source;
-    std::vector<char> negatedView, unread;
-    readNegatedViews(program, negatedView, unread);
-    // Last instruction reading each value; outputs live to the end.
+// For each light instruction (diffuse, specular, phong) whose every result is read once, by
+// an addition (light + base) or by a product fused into an addition (scale * light + base),
+// with scale and base made before the light: how it ends, so it is written in the light's
+// own pass. A sum already absorbing another light or a product of its own is left alone.
+std::vector<LightEnding> findLightEndings(const IrProgram& program, const std::vector<int>& lastUse,
+                                          const std::vector<int>& fusedInto,
+                                          std::vector<char>& ends) {
+    const size_t count = program.insts.size();
+    std::vector<int> uses(static_cast<size_t>(program.valueCount), 0), madeAt(uses.size(), -1);
+    std::vector<int> fusedFrom(count, -1);
+    for (size_t k = 0; k < count; ++k) {
+        const Inst& inst = program.insts[k];
+        for (int a = 0; a < inst.nargs; ++a) ++uses[static_cast<size_t>(program.argsOf(inst)[a])];
+        for (int o = 0; o < inst.nout; ++o)
+            madeAt[static_cast<size_t>(inst.result + o)] = static_cast<int>(k);
+        if (fusedInto[k] >= 0) fusedFrom[static_cast<size_t>(fusedInto[k])] = static_cast<int>(k);
+    }
+    std::vector<LightEnding> endings(count);
+    ends.assign(count, 0);
+    for (size_t k = 0; k < count; ++k) {
+        const Inst& light = program.insts[k];
+        if ((light.op != Op::Diffuse && light.op != Op::Specular && light.op != Op::Phong) ||
+            light.nout != 3)
+            continue;
+        auto before = [&](int32_t v) {
+            return madeAt[static_cast<size_t>(v)] < static_cast<int>(k);
+        };
+        auto other = [&](const Inst& inst, int32_t v) {
+            const int32_t* args = program.argsOf(inst);
+            return args[0] == v ? args[1] : args[0];
+        };
+        LightEnding end;
+        bool ok = true;
+        for (int c = 0; c < 3 && ok; ++c) {
+            const int32_t v = light.result + c;
+            const int reader = lastUse[static_cast<size_t>(v)];
+            ok = uses[static_cast<size_t>(v)] == 1 && reader >= 0 &&
+                 reader < static_cast<int>(count);
+            if (!ok) break;
+            const Inst& r = program.insts[static_cast<size_t>(reader)];
+            int sum = reader;
+            int32_t operand = v;  // what the sum reads of this channel
+            if (r.op == Op::Mul && fusedInto[static_cast<size_t>(reader)] >= 0) {
+                end.product[c] = reader;
+                end.scale[c] = other(r, v);
+                ok = before(end.scale[c]);
+                sum = fusedInto[static_cast<size_t>(reader)];
+                operand = r.result;
+            } else {
+                ok = fusedFrom[static_cast<size_t>(reader)] < 0;  // no product of its own
+            }
+            const Inst& s = program.insts[static_cast<size_t>(sum)];
+            ok = ok && s.op == Op::Add && s.nargs == 2 && s.nout == 1 &&
+                 !ends[static_cast<size_t>(sum)];
+            if (!ok) break;
+            end.sum[c] = sum;
+            end.base[c] = other(s, operand);
+            ok = before(end.base[c]) && end.base[c] != operand;
+        }
+        const bool oneKind = (end.product[0] < 0) == (end.product[1] < 0) &&
+                             (end.product[0] < 0) == (end.product[2] < 0);
+        if (!ok || !oneKind) continue;
+        endings[k] = end;
+        for (int c = 0; c < 3; ++c) ends[static_cast<size_t>(end.sum[c])] = 1;
+    }
+    return endings;
+}
+
+// The last instruction reading each value (-1: none); outputs live to the end (INT_MAX).
+std::vector<int> lastReaders(const IrProgram& program) {
     std::vector<int> lastUse(static_cast<size_t>(program.valueCount), -1);
     for (size_t k = 0; k < program.insts.size(); ++k) {
         const Inst& inst = program.insts[k];
@@ -339,7 +421,38 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
     for (int v : program.ci) keepToTheEnd(v);
     for (int v : program.oi) keepToTheEnd(v);
     for (int v : program.channelOutputs) keepToTheEnd(v);
+    return lastUse;
+}
+
+// A fused product's arguments are read where its sum is: their last use moved there.
+// Returns, per instruction, the product fused into it, else -1.
+std::vector<int> readProductsAtTheirSums(const IrProgram& program,
+                                         const std::vector<int>& fusedInto,
+                                         std::vector<int>& lastUse) {
+    std::vector<int> fusedFrom(program.insts.size(), -1);
+    for (size_t k = 0; k < program.insts.size(); ++k) {
+        if (fusedInto[k] < 0) continue;
+        fusedFrom[static_cast<size_t>(fusedInto[k])] = static_cast<int>(k);
+        const Inst& mul = program.insts[k];
+        for (int a = 0; a < mul.nargs; ++a) {
+            int& last = lastUse[static_cast<size_t>(program.argsOf(mul)[a])];
+            last = std::max(last, fusedInto[k]);
+        }
+    }
+    return fusedFrom;
+}
+
+}  // namespace
+
+ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
+    IrProgram program = source;
+    std::vector<char> negatedView, unread;
+    readNegatedViews(program, negatedView, unread);
+    std::vector<int> lastUse = lastReaders(program);
     const std::vector<int> fusedInto = findMulFusions(program, lastUse);
+    std::vector<char> endsLight;  // a sum written by the light before it
+    const std::vector<LightEnding> lightEndings =
+        findLightEndings(program, lastUse, fusedInto, endsLight);
 
     std::vector<int32_t> reg(static_cast<size_t>(program.valueCount), -1);
     std::vector<char> constantReg;
@@ -361,17 +474,7 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
         constantReg[static_cast<size_t>(r)] = 1;
         constants_.emplace_back(r, inst.constant);
     }
-    // A fused product's arguments are read where its reader is.
-    std::vector<int> fusedFrom(program.insts.size(), -1);
-    for (size_t k = 0; k < program.insts.size(); ++k) {
-        if (fusedInto[k] < 0) continue;
-        fusedFrom[static_cast<size_t>(fusedInto[k])] = static_cast<int>(k);
-        const Inst& mul = program.insts[k];
-        for (int a = 0; a < mul.nargs; ++a) {
-            int& last = lastUse[static_cast<size_t>(program.argsOf(mul)[a])];
-            last = std::max(last, fusedInto[k]);
-        }
-    }
+    const std::vector<int> fusedFrom = readProductsAtTheirSums(program, fusedInto, lastUse);
     // Value v's register back to the pool if instruction k is its last reader.
     auto releaseAfter = [&](int32_t v, size_t k) {
         int& last = lastUse[static_cast<size_t>(v)];
@@ -385,6 +488,19 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
         const Inst& inst = program.insts[k];
         if (inst.op == Op::Const) continue;
         ++instructions_;
+        if (endsLight[k]) {
+            // Written by its light; its scale's and base's reads were there, but they live
+            // until here.
+            auto release = [&](int32_t v) {
+                if (reg[static_cast<size_t>(v)] >= 0) releaseAfter(v, k);  // not the light's
+            };
+            if (fusedFrom[k] >= 0) {
+                const Inst& mul = program.insts[static_cast<size_t>(fusedFrom[k])];
+                for (int a = 0; a < mul.nargs; ++a) release(program.argsOf(mul)[a]);
+            }
+            for (int a = 0; a < inst.nargs; ++a) release(program.argsOf(inst)[a]);
+            continue;
+        }
         if (fusedInto[k] >= 0 || unread[k]) continue;  // emitted with its reader, or not needed
         ExecInst e;
         e.op = inst.op;
@@ -409,9 +525,22 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
             e.in[1] = reg[static_cast<size_t>(margs[1])];
             e.in[2] = other;
         }
+        // A light ending in sums writes them (their values' registers, made here).
+        const LightEnding& ending = lightEndings[k];
+        const bool ends = ending.sum[0] >= 0;
+        int32_t outValue[3] = {inst.result, inst.result + 1, inst.result + 2};
+        if (ends) {
+            e.lightEpilogue = true;
+            for (int c = 0; c < 3; ++c) {
+                e.epilogue[c] =
+                    ending.scale[c] >= 0 ? reg[static_cast<size_t>(ending.scale[c])] : -1;
+                e.epilogue[3 + c] = reg[static_cast<size_t>(ending.base[c])];
+                outValue[c] = program.insts[static_cast<size_t>(ending.sum[c])].result;
+            }
+        }
         // Outputs never share a register with this instruction's own inputs.
         for (int o = 0; o < inst.nout; ++o)
-            e.out[o] = reg[static_cast<size_t>(inst.result + o)] = allocate();
+            e.out[o] = reg[static_cast<size_t>(outValue[o])] = allocate();
         // A fused product's arguments are read here; the product itself never had a register.
         if (mul)
             for (int a = 0; a < mul->nargs; ++a) releaseAfter(program.argsOf(*mul)[a], k);
@@ -419,7 +548,7 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
             if (!mul || args[a] != mul->result) releaseAfter(args[a], k);
         // Results nobody reads are dead at once.
         for (int o = 0; o < inst.nout; ++o)
-            if (lastUse[static_cast<size_t>(inst.result + o)] == -1) freeRegs.push_back(e.out[o]);
+            if (lastUse[static_cast<size_t>(outValue[o])] == -1) freeRegs.push_back(e.out[o]);
         code_.push_back(e);
     }
     for (int k = 0; k < 3; ++k) {

@@ -29,6 +29,16 @@ struct LightSample {
     glm::vec3 toLight{0.0f, 1.0f, 0.0f};  // Distant: unit direction towards the light
 };
 
+// What a light's result goes on to, done in the light's own pass over the lanes (the kernel
+// is bound by its passes through L1): channel c is written as base[c] + scale[c] * light, or
+// base[c] + light where scale[c] is null, each product and sum rounded as the shader's own
+// instructions round them (no fused multiply-add), so the same bits as those instructions
+// after the light (but for a NaN's payload). Rows of m lanes, read at the light's lanes.
+struct LightEpilogue {
+    const float* scale[3] = {};
+    const float* base[3] = {};
+};
+
 // Per object, per frame.
 struct ShadingUniforms {
     float time = 0.0f;
@@ -85,10 +95,14 @@ struct ExecInst {
     Op op;
     MulFusion fusion = MulFusion::None;
     bool negatedView = false;  // Specular: in[6..8] hold -V (shadeLight)
+    // A light whose results end in sums (LightEpilogue): epilogue[c] its scale's register
+    // (-1: none), epilogue[3 + c] its base's; out[] are the sums' registers.
+    bool lightEpilogue = false;
     uint8_t nin = 0, nout = 0;
     int32_t imm = 0;
     int32_t in[10] = {};
     int32_t out[3] = {};
+    int32_t epilogue[6] = {};
 };
 
 class ShaderKernel {

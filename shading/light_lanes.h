@@ -51,9 +51,10 @@ inline Float4 root(Float4 x) {
 // shadeLightOne's; max(0, x) is a select that is 0 for NaN, as std::fmax(0, x) is.
 // kNegV (Specular): args 6-8 hold -V, so L + V is L - args, the very bits a pass negating
 // them first would give (x + -y is x - y in IEEE arithmetic; only a NaN's sign may differ).
-template <Op kOp, bool kPoint, typename V, bool kNegV = false>
+// kEpilogue: the light's value goes through `epilogue` (interpreter.h) before it is stored.
+template <Op kOp, bool kPoint, typename V, bool kNegV = false, bool kEpilogue = false>
 inline void shadeLightLanes(const LightSample& light, const float* const* args, float* const* rgb,
-                            int l) {
+                            int l, const LightEpilogue* epilogue = nullptr) {
     const V zero = splat(0.0f, V{}), one = splat(1.0f, V{});
     auto positive = [&](V x) { return x > zero ? x : zero; };
     V Lx, Ly, Lz, cr, cg, cb;
@@ -111,9 +112,16 @@ inline void shadeLightLanes(const LightSample& light, const float* const* args, 
             f = scalar::safePow(positive(rx * Lx + ry * Ly + rz * Lz), load(args[9] + l, V{}));
         }
     }
-    store(rgb[0] + l, cr * f);
-    store(rgb[1] + l, cg * f);
-    store(rgb[2] + l, cb * f);
+    const V channel[3] = {cr * f, cg * f, cb * f};
+    for (int c = 0; c < 3; ++c) {
+        V value = channel[c];
+        if constexpr (kEpilogue) {
+            // The shader's mul(scale, light) then add(base, product): each rounded alone.
+            if (epilogue->scale[c]) value = load(epilogue->scale[c] + l, V{}) * value;
+            value = load(epilogue->base[c] + l, V{}) + value;
+        }
+        store(rgb[c] + l, value);
+    }
 }
 
 }  // namespace

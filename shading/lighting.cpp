@@ -75,52 +75,63 @@ namespace {
 // One light over m lanes: four at a time in vector registers (the compiler did not
 // vectorize the one-lane loop) for diffuse and specular, the rest one at a time. Phong's
 // power is a library call: one lane at a time.
-template <Op kOp, bool kPoint, bool kNegV>
-void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
+template <Op kOp, bool kPoint, bool kNegV, bool kEpi>
+void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m,
+                const LightEpilogue* epilogue) {
     int l = 0;
     if constexpr (kOp != Op::Phong)
-        for (; l + 4 <= m; l += 4) shadeLightLanes<kOp, kPoint, Float4, kNegV>(light, args, rgb, l);
-    for (; l < m; ++l) shadeLightLanes<kOp, kPoint, float, kNegV>(light, args, rgb, l);
+        for (; l + 4 <= m; l += 4)
+            shadeLightLanes<kOp, kPoint, Float4, kNegV, kEpi>(light, args, rgb, l, epilogue);
+    for (; l < m; ++l)
+        shadeLightLanes<kOp, kPoint, float, kNegV, kEpi>(light, args, rgb, l, epilogue);
+}
+
+template <Op kOp, bool kNegV, bool kEpi>
+void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m,
+                const LightEpilogue* epilogue) {
+    if (light.kind == LightKind::Point)
+        shadeLanes<kOp, true, kNegV, kEpi>(light, args, rgb, m, epilogue);
+    else
+        shadeLanes<kOp, false, kNegV, kEpi>(light, args, rgb, m, epilogue);
 }
 
 template <Op kOp>
 void shadeLanes(const LightSample& light, const float* const* args, float* const* rgb, int m,
-                bool negatedView, bool baseline) {
+                bool negatedView, bool baseline, const LightEpilogue* epilogue) {
     MPSHADE_CHECK(!negatedView || kOp == Op::Specular);
     static const bool avx2 = shadeLightAvx2Available();
     if (kOp != Op::Phong && avx2 && !baseline)
-        return shadeLightAvx2(kOp, light, args, rgb, m, negatedView);
-    const bool point = light.kind == LightKind::Point;
+        return shadeLightAvx2(kOp, light, args, rgb, m, negatedView, epilogue);
     if constexpr (kOp == Op::Specular)
         if (negatedView)
-            return point ? shadeLanes<kOp, true, true>(light, args, rgb, m)
-                         : shadeLanes<kOp, false, true>(light, args, rgb, m);
-    point ? shadeLanes<kOp, true, false>(light, args, rgb, m)
-          : shadeLanes<kOp, false, false>(light, args, rgb, m);
+            return epilogue ? shadeLanes<kOp, true, true>(light, args, rgb, m, epilogue)
+                            : shadeLanes<kOp, true, false>(light, args, rgb, m, epilogue);
+    epilogue ? shadeLanes<kOp, false, true>(light, args, rgb, m, epilogue)
+             : shadeLanes<kOp, false, false>(light, args, rgb, m, epilogue);
 }
 
 void shadeLightWith(Op op, const LightSample& light, const float* const* args, float* const* rgb,
-                    int m, bool negatedView, bool baseline) {
+                    int m, bool negatedView, bool baseline, const LightEpilogue* epilogue) {
     switch (op) {
         case Op::Diffuse:
-            return shadeLanes<Op::Diffuse>(light, args, rgb, m, negatedView, baseline);
+            return shadeLanes<Op::Diffuse>(light, args, rgb, m, negatedView, baseline, epilogue);
         case Op::Specular:
-            return shadeLanes<Op::Specular>(light, args, rgb, m, negatedView, baseline);
+            return shadeLanes<Op::Specular>(light, args, rgb, m, negatedView, baseline, epilogue);
         default:
-            return shadeLanes<Op::Phong>(light, args, rgb, m, negatedView, baseline);
+            return shadeLanes<Op::Phong>(light, args, rgb, m, negatedView, baseline, epilogue);
     }
 }
 
 }  // namespace
 
 void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb, int m,
-                bool negatedView) {
-    shadeLightWith(op, light, args, rgb, m, negatedView, false);
+                bool negatedView, const LightEpilogue* epilogue) {
+    shadeLightWith(op, light, args, rgb, m, negatedView, false, epilogue);
 }
 
 void shadeLightBaseline(Op op, const LightSample& light, const float* const* args,
-                        float* const* rgb, int m, bool negatedView) {
-    shadeLightWith(op, light, args, rgb, m, negatedView, true);
+                        float* const* rgb, int m, bool negatedView, const LightEpilogue* epilogue) {
+    shadeLightWith(op, light, args, rgb, m, negatedView, true, epilogue);
 }
 
 uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,

@@ -18,16 +18,18 @@
 
 namespace mpshade {
 
-// args: P(3) N(3) [V(3) param]; each a run of m lanes. Writes rgb[3][m]. negatedView
-// (Specular only): args 6-8 hold -V, as a shader's specular(N, -I, r) has them before I is
-// negated; the same bits as negating them first (but for a NaN's sign).
+// args: P(3) N(3) [V(3) param]; each a run of m lanes. Writes rgb[3][m]: the light, or what
+// `epilogue` (may be null) makes of it. negatedView (Specular only): args 6-8 hold -V, as a
+// shader's specular(N, -I, r) has them before I is negated; the same bits as negating them
+// first (but for a NaN's sign). rgb may not alias args or the epilogue's rows.
 void shadeLight(Op op, const LightSample& light, const float* const* args, float* const* rgb, int m,
-                bool negatedView = false);
+                bool negatedView = false, const LightEpilogue* epilogue = nullptr);
 
 // shadeLight in baseline code (four lanes at a time and one) whatever the processor, for
 // tests of the AVX2 path against it.
 void shadeLightBaseline(Op op, const LightSample& light, const float* const* args,
-                        float* const* rgb, int m, bool negatedView = false);
+                        float* const* rgb, int m, bool negatedView = false,
+                        const LightEpilogue* epilogue = nullptr);
 
 // args: P(3) N(3). Writes the open fraction per lane; returns the rays traced.
 uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,

@@ -51,32 +51,46 @@ inline Lanes8 root(Lanes8 x) {
 namespace mpshade {
 namespace {
 
-template <Op kOp, bool kPoint, bool kNegV>
-void lanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
+template <Op kOp, bool kPoint, bool kNegV, bool kEpi>
+void lanes(const LightSample& light, const float* const* args, float* const* rgb, int m,
+           const LightEpilogue* epilogue) {
     int l = 0;
-    for (; l + 8 <= m; l += 8) shadeLightLanes<kOp, kPoint, Lanes8, kNegV>(light, args, rgb, l);
-    for (; l + 4 <= m; l += 4) shadeLightLanes<kOp, kPoint, Float4, kNegV>(light, args, rgb, l);
-    for (; l < m; ++l) shadeLightLanes<kOp, kPoint, float, kNegV>(light, args, rgb, l);
+    for (; l + 8 <= m; l += 8)
+        shadeLightLanes<kOp, kPoint, Lanes8, kNegV, kEpi>(light, args, rgb, l, epilogue);
+    for (; l + 4 <= m; l += 4)
+        shadeLightLanes<kOp, kPoint, Float4, kNegV, kEpi>(light, args, rgb, l, epilogue);
+    for (; l < m; ++l)
+        shadeLightLanes<kOp, kPoint, float, kNegV, kEpi>(light, args, rgb, l, epilogue);
 }
 
-template <Op kOp, bool kNegV = false>
-void lanes(const LightSample& light, const float* const* args, float* const* rgb, int m) {
+template <Op kOp, bool kNegV, bool kEpi>
+void lanes(const LightSample& light, const float* const* args, float* const* rgb, int m,
+           const LightEpilogue* epilogue) {
     if (light.kind == LightKind::Point)
-        lanes<kOp, true, kNegV>(light, args, rgb, m);
+        lanes<kOp, true, kNegV, kEpi>(light, args, rgb, m, epilogue);
     else
-        lanes<kOp, false, kNegV>(light, args, rgb, m);
+        lanes<kOp, false, kNegV, kEpi>(light, args, rgb, m, epilogue);
+}
+
+template <Op kOp, bool kNegV>
+void lanes(const LightSample& light, const float* const* args, float* const* rgb, int m,
+           const LightEpilogue* epilogue) {
+    if (epilogue)
+        lanes<kOp, kNegV, true>(light, args, rgb, m, epilogue);
+    else
+        lanes<kOp, kNegV, false>(light, args, rgb, m, epilogue);
 }
 
 }  // namespace
 
 void shadeLightAvx2(Op op, const LightSample& light, const float* const* args, float* const* rgb,
-                    int m, bool negatedView) {
+                    int m, bool negatedView, const LightEpilogue* epilogue) {
     if (op == Op::Diffuse)
-        lanes<Op::Diffuse>(light, args, rgb, m);
+        lanes<Op::Diffuse, false>(light, args, rgb, m, epilogue);
     else if (negatedView)
-        lanes<Op::Specular, true>(light, args, rgb, m);
+        lanes<Op::Specular, true>(light, args, rgb, m, epilogue);
     else
-        lanes<Op::Specular>(light, args, rgb, m);
+        lanes<Op::Specular, false>(light, args, rgb, m, epilogue);
 }
 
 }  // namespace mpshade
@@ -103,7 +117,8 @@ namespace mpshade {
 bool shadeLightAvx2Available() {
     return false;
 }
-void shadeLightAvx2(Op, const LightSample&, const float* const*, float* const*, int, bool) {}
+void shadeLightAvx2(Op, const LightSample&, const float* const*, float* const*, int, bool,
+                    const LightEpilogue*) {}
 
 }  // namespace mpshade
 

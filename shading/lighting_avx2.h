@@ -11,6 +11,6 @@ namespace mpshade {
 bool shadeLightAvx2Available();
 // shadeLight for Diffuse and Specular (not Phong). Only where shadeLightAvx2Available().
 void shadeLightAvx2(Op op, const LightSample& light, const float* const* args, float* const* rgb,
-                    int m, bool negatedView = false);
+                    int m, bool negatedView = false, const LightEpilogue* epilogue = nullptr);
 
 }  // namespace mpshade

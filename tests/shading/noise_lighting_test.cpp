@@ -449,15 +449,74 @@ TEST(Lighting, ASpecularReadsItsNegatedViewWithoutANegationPass) {
     }
     points[4].I.x = -0.0f;
     const std::string fused = "surface f() { Ci = specular(N, -I, 0.3); }";
-    const std::string kept = "surface k() { vector V = -I; Ci = specular(N, V, 0.3); Oi = color(V); }";
+    const std::string kept =
+        "surface k() { vector V = -I; Ci = specular(N, V, 0.3); Oi = color(V); }";
     const ShaderKernel kernel(lowerShader(*compileShaderText("f.sl", fused), binding));
-    EXPECT_EQ(kernel.passCount() + 3, kernel.instructionCount());
+    // The negations' three passes, and the second light's sum with the first written in its
+    // own pass (LightEpilogue).
+    EXPECT_EQ(kernel.passCount() + 6, kernel.instructionCount());
     const auto a = test::runKernel(kernel, points, uniforms);
     const auto b = test::runShader(kept, points, binding, uniforms);
     for (size_t i = 0; i < points.size(); ++i)
         for (int k = 0; k < 3; ++k)
             ASSERT_EQ(std::memcmp(&a.Ci[i][k], &b.Ci[i][k], sizeof(float)), 0)
                 << "point " << i << " channel " << k;
+}
+
+TEST(Lighting, ALightEndingInSumsWritesThemInItsOwnPass) {
+    // Ci = base + 0.5 specular and Oi = t + diffuse: each light's sums (and the product
+    // fused into Ci's) written by the light, each product and sum rounded alone, against
+    // the lane light with no epilogue and the arithmetic done here.
+    ShaderBinding binding;
+    binding.lights.resize(1);
+    binding.lights[0].kind = LightKind::Point;
+    const auto [point, distant] = pointAndDistantLights();
+    (void)distant;
+    ShadingUniforms uniforms;
+    const std::vector<LightSample> lights = {point};
+    uniforms.lights = lights;
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+    std::vector<test::ShadingPoint> points(21);  // eight lanes twice, four, one
+    for (test::ShadingPoint& p : points) {
+        p.P = glm::vec3(uni(rng), uni(rng), uni(rng));
+        p.N = glm::normalize(glm::vec3(uni(rng), 1.0f, uni(rng)));
+        p.I = glm::normalize(glm::vec3(uni(rng), -1.0f, uni(rng)));
+        p.u = uni(rng), p.v = uni(rng), p.s = 1e-3f * uni(rng), p.t = uni(rng);
+    }
+    const std::string source =
+        "surface e() { Ci = color(u, v, s) + 0.5 * specular(N, -I, 0.3);\n"
+        "  Oi = color(t) + diffuse(N); }";
+    const ShaderKernel kernel(lowerShader(*compileShaderText("e.sl", source), binding));
+    // Two light passes and nothing else but reading the inputs: the three fused products'
+    // sums and the three plain sums are no passes of their own, nor are the negations.
+    EXPECT_EQ(kernel.instructionCount() - kernel.passCount(), 3u + 3u + 3u + 3u);
+    const auto r = test::runKernel(kernel, points, uniforms);
+    const size_t n = points.size();
+    std::vector<float> rows[10], spec[3], diff[3];
+    for (auto& row : rows) row.resize(n);
+    for (int c = 0; c < 3; ++c) spec[c].resize(n), diff[c].resize(n);
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) {
+            rows[c][i] = points[i].P[c];
+            rows[3 + c][i] = points[i].N[c];
+            rows[6 + c][i] = -points[i].I[c];
+            rows[9][i] = 0.3f;
+        }
+    const float* args[10];
+    for (int k = 0; k < 10; ++k) args[k] = rows[k].data();
+    float* specRows[3] = {spec[0].data(), spec[1].data(), spec[2].data()};
+    float* diffRows[3] = {diff[0].data(), diff[1].data(), diff[2].data()};
+    shadeLightBaseline(Op::Specular, point, args, specRows, static_cast<int>(n));
+    shadeLightBaseline(Op::Diffuse, point, args, diffRows, static_cast<int>(n));
+    for (size_t i = 0; i < n; ++i) {
+        const float base[3] = {points[i].u, points[i].v, points[i].s};
+        for (int c = 0; c < 3; ++c) {
+            const volatile float product = 0.5f * spec[c][i];  // rounded alone
+            EXPECT_EQ(r.Ci[i][c], base[c] + product) << "point " << i << " channel " << c;
+            EXPECT_EQ(r.Oi[i][c], points[i].t + diff[c][i]) << "point " << i << " channel " << c;
+        }
+    }
 }
 
 TEST(Lighting, GgxRoughnessIsFlooredAtAHundredth) {
