@@ -38,7 +38,6 @@ std::vector<int32_t> pixelOwners(const VisibilityBuffer& vis, size_t objects, in
     // A pixel whose filter reaches another object's samples would measure that object's
     // change too (every object is searched at once).
     pixels.assign(objects, 0);
-    std::vector<int32_t> kept(owners);
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
             const size_t p = static_cast<size_t>(y) * width + x;
@@ -58,9 +57,9 @@ std::vector<int32_t> pixelOwners(const VisibilityBuffer& vis, size_t objects, in
             if (alone)
                 ++pixels[static_cast<size_t>(o)];
             else
-                kept[p] = -1;
+                owners[p] = -1;  // the window reads `seen`, never owners
         }
-    return kept;
+    return owners;
 }
 
 void addSampleNoise(const SampleBuffer& samples, std::span<const uint8_t> uniform,

@@ -222,16 +222,14 @@ __attribute__((target_clones("avx2", "default"))) void runBatch(
                 const float* arg[10];
                 for (int k = 0; k < e.nin; ++k) arg[k] = S[e.in[k]];
                 float* rgb[3] = {R(e.out[0]), R(e.out[1]), R(e.out[2])};
-                if (e.lightEpilogue) {
-                    LightEpilogue epilogue;
+                LightEpilogue epilogue;
+                if (e.lightEpilogue)
                     for (int k = 0; k < 3; ++k) {
                         epilogue.scale[k] = e.epilogue[k] >= 0 ? S[e.epilogue[k]] : nullptr;
                         epilogue.base[k] = S[e.epilogue[3 + k]];
                     }
-                    shadeLight(e.op, light, arg, rgb, m, e.negatedView, &epilogue);
-                } else {
-                    shadeLight(e.op, light, arg, rgb, m, e.negatedView);
-                }
+                shadeLight(e.op, light, arg, rgb, m, e.negatedView,
+                           e.lightEpilogue ? &epilogue : nullptr);
                 break;
             }
             case Op::Occlusion: {
@@ -303,14 +301,28 @@ void readNegatedViews(IrProgram& program, std::vector<char>& negatedView,
             unread[k] = 1;
 }
 
-// For each instruction, the index of the addition or subtraction its product is fused
-// into (MulFusion), else -1: a one-result Mul whose value only that instruction reads, once,
-// and that no output keeps (lastUse past the program).
-std::vector<int> findMulFusions(const IrProgram& program, const std::vector<int>& lastUse) {
-    const size_t count = program.insts.size();
+// How many times each value is read (an instruction reading it twice counts twice).
+std::vector<int> useCounts(const IrProgram& program) {
     std::vector<int> uses(static_cast<size_t>(program.valueCount), 0);
     for (const Inst& inst : program.insts)
         for (int a = 0; a < inst.nargs; ++a) ++uses[static_cast<size_t>(program.argsOf(inst)[a])];
+    return uses;
+}
+
+// Per instruction, the product fused into it (the inverse of fusedInto), else -1.
+std::vector<int> productsFused(const std::vector<int>& fusedInto) {
+    std::vector<int> fusedFrom(fusedInto.size(), -1);
+    for (size_t k = 0; k < fusedInto.size(); ++k)
+        if (fusedInto[k] >= 0) fusedFrom[static_cast<size_t>(fusedInto[k])] = static_cast<int>(k);
+    return fusedFrom;
+}
+
+// For each instruction, the index of the addition or subtraction its product is fused
+// into (MulFusion), else -1: a one-result Mul whose value only that instruction reads, once,
+// and that no output keeps (lastUse past the program).
+std::vector<int> findMulFusions(const IrProgram& program, const std::vector<int>& uses,
+                                const std::vector<int>& lastUse) {
+    const size_t count = program.insts.size();
     std::vector<int> fusedInto(count, -1);
     std::vector<char> absorbs(count, 0);
     for (size_t k = 0; k < count; ++k) {
@@ -330,11 +342,10 @@ std::vector<int> findMulFusions(const IrProgram& program, const std::vector<int>
 }
 
 // A light instruction's three results each ending in a sum (LightEpilogue): per channel the
-// sum's index, the product's (-1 if the light is the sum's own operand) and the two
-// registers-to-be (values) of scale and base.
+// sum's index and the values of scale (-1 if the light is the sum's own operand, no
+// product) and base.
 struct LightEnding {
     int sum[3] = {-1, -1, -1};
-    int product[3] = {-1, -1, -1};
     int32_t scale[3] = {-1, -1, -1};
     int32_t base[3] = {-1, -1, -1};
 };
@@ -343,19 +354,16 @@ struct LightEnding {
 // an addition (light + base) or by a product fused into an addition (scale * light + base),
 // with scale and base made before the light: how it ends, so it is written in the light's
 // own pass. A sum already absorbing another light or a product of its own is left alone.
-std::vector<LightEnding> findLightEndings(const IrProgram& program, const std::vector<int>& lastUse,
+std::vector<LightEnding> findLightEndings(const IrProgram& program, const std::vector<int>& uses,
+                                          const std::vector<int>& lastUse,
                                           const std::vector<int>& fusedInto,
+                                          const std::vector<int>& fusedFrom,
                                           std::vector<char>& ends) {
     const size_t count = program.insts.size();
-    std::vector<int> uses(static_cast<size_t>(program.valueCount), 0), madeAt(uses.size(), -1);
-    std::vector<int> fusedFrom(count, -1);
-    for (size_t k = 0; k < count; ++k) {
-        const Inst& inst = program.insts[k];
-        for (int a = 0; a < inst.nargs; ++a) ++uses[static_cast<size_t>(program.argsOf(inst)[a])];
-        for (int o = 0; o < inst.nout; ++o)
-            madeAt[static_cast<size_t>(inst.result + o)] = static_cast<int>(k);
-        if (fusedInto[k] >= 0) fusedFrom[static_cast<size_t>(fusedInto[k])] = static_cast<int>(k);
-    }
+    std::vector<int> madeAt(uses.size(), -1);
+    for (size_t k = 0; k < count; ++k)
+        for (int o = 0; o < program.insts[k].nout; ++o)
+            madeAt[static_cast<size_t>(program.insts[k].result + o)] = static_cast<int>(k);
     std::vector<LightEnding> endings(count);
     ends.assign(count, 0);
     for (size_t k = 0; k < count; ++k) {
@@ -382,7 +390,6 @@ std::vector<LightEnding> findLightEndings(const IrProgram& program, const std::v
             int sum = reader;
             int32_t operand = v;  // what the sum reads of this channel
             if (r.op == Op::Mul && fusedInto[static_cast<size_t>(reader)] >= 0) {
-                end.product[c] = reader;
                 end.scale[c] = other(r, v);
                 ok = before(end.scale[c]);
                 sum = fusedInto[static_cast<size_t>(reader)];
@@ -398,8 +405,8 @@ std::vector<LightEnding> findLightEndings(const IrProgram& program, const std::v
             end.base[c] = other(s, operand);
             ok = before(end.base[c]) && end.base[c] != operand;
         }
-        const bool oneKind = (end.product[0] < 0) == (end.product[1] < 0) &&
-                             (end.product[0] < 0) == (end.product[2] < 0);
+        const bool oneKind =
+            (end.scale[0] < 0) == (end.scale[1] < 0) && (end.scale[0] < 0) == (end.scale[2] < 0);
         if (!ok || !oneKind) continue;
         endings[k] = end;
         for (int c = 0; c < 3; ++c) ends[static_cast<size_t>(end.sum[c])] = 1;
@@ -425,21 +432,16 @@ std::vector<int> lastReaders(const IrProgram& program) {
 }
 
 // A fused product's arguments are read where its sum is: their last use moved there.
-// Returns, per instruction, the product fused into it, else -1.
-std::vector<int> readProductsAtTheirSums(const IrProgram& program,
-                                         const std::vector<int>& fusedInto,
-                                         std::vector<int>& lastUse) {
-    std::vector<int> fusedFrom(program.insts.size(), -1);
+void readProductsAtTheirSums(const IrProgram& program, const std::vector<int>& fusedInto,
+                             std::vector<int>& lastUse) {
     for (size_t k = 0; k < program.insts.size(); ++k) {
         if (fusedInto[k] < 0) continue;
-        fusedFrom[static_cast<size_t>(fusedInto[k])] = static_cast<int>(k);
         const Inst& mul = program.insts[k];
         for (int a = 0; a < mul.nargs; ++a) {
             int& last = lastUse[static_cast<size_t>(program.argsOf(mul)[a])];
             last = std::max(last, fusedInto[k]);
         }
     }
-    return fusedFrom;
 }
 
 }  // namespace
@@ -449,10 +451,12 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
     std::vector<char> negatedView, unread;
     readNegatedViews(program, negatedView, unread);
     std::vector<int> lastUse = lastReaders(program);
-    const std::vector<int> fusedInto = findMulFusions(program, lastUse);
+    const std::vector<int> uses = useCounts(program);
+    const std::vector<int> fusedInto = findMulFusions(program, uses, lastUse);
+    const std::vector<int> fusedFrom = productsFused(fusedInto);
     std::vector<char> endsLight;  // a sum written by the light before it
     const std::vector<LightEnding> lightEndings =
-        findLightEndings(program, lastUse, fusedInto, endsLight);
+        findLightEndings(program, uses, lastUse, fusedInto, fusedFrom, endsLight);
 
     std::vector<int32_t> reg(static_cast<size_t>(program.valueCount), -1);
     std::vector<char> constantReg;
@@ -474,7 +478,7 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
         constantReg[static_cast<size_t>(r)] = 1;
         constants_.emplace_back(r, inst.constant);
     }
-    const std::vector<int> fusedFrom = readProductsAtTheirSums(program, fusedInto, lastUse);
+    readProductsAtTheirSums(program, fusedInto, lastUse);
     // Value v's register back to the pool if instruction k is its last reader.
     auto releaseAfter = [&](int32_t v, size_t k) {
         int& last = lastUse[static_cast<size_t>(v)];
