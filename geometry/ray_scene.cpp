@@ -232,6 +232,18 @@ bool SurfaceRayScene::intersect(const glm::vec3& org, const glm::vec3& dir, floa
     return resolveHit(rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar, org, dir, hit);
 }
 
+bool SurfaceRayScene::escapes(const glm::vec3& org, const glm::vec3& dir) const {
+    if (std::holds_alternative<Plane>(surface_))
+        return (org.y > 0.0f && dir.y >= 0.0f) || (org.y < 0.0f && dir.y <= 0.0f);
+    if (const auto* sphere = std::get_if<Sphere>(&surface_)) {
+        // The tessellation's vertices are radius * a unit vector rounded to float: within a
+        // few parts in 10^7 of the radius. 1e-5 keeps the test far from that.
+        const float r = sphere->radius;
+        return glm::dot(org, dir) >= 0.0f && glm::dot(org, org) > r * r * (1.0f + 1e-5f);
+    }
+    return false;
+}
+
 void SurfaceRayScene::occluded(const float* const org[3], const float* const dir[3],
                                const uint8_t* active, int n, float tnear, float tfar,
                                uint8_t* blocked) const {
@@ -240,24 +252,31 @@ void SurfaceRayScene::occluded(const float* const org[3], const float* const dir
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    const bool shaped = tnear >= 0.0f && (std::holds_alternative<Plane>(surface_) ||
+                                          std::holds_alternative<Sphere>(surface_));
     alignas(16) RTCRay rays[kStream];
+    bool traced[kStream];
     for (int first = 0; first < n; first += kStream) {
         const int count = std::min(kStream, n - first);
+        int tracing = 0;
         for (int k = 0; k < count; ++k) {
             const int i = first + k;
+            const glm::vec3 o(org[0][i], org[1][i], org[2][i]), d(dir[0][i], dir[1][i], dir[2][i]);
+            traced[k] = (!active || active[i]) && !(shaped && escapes(o, d));
+            tracing += traced[k] ? 1 : 0;
             RTCRay& ray = rays[k];
             ray = RTCRay{};
-            ray.org_x = org[0][i], ray.org_y = org[1][i], ray.org_z = org[2][i];
-            ray.dir_x = dir[0][i], ray.dir_y = dir[1][i], ray.dir_z = dir[2][i];
-            // Inactive: tnear above tfar (Embree's rule for streams).
-            const bool on = !active || active[i];
-            ray.tnear = on ? tnear : 1.0f;
-            ray.tfar = on ? tfar : 0.0f;
+            ray.org_x = o.x, ray.org_y = o.y, ray.org_z = o.z;
+            ray.dir_x = d.x, ray.dir_y = d.y, ray.dir_z = d.z;
+            // Not traced: tnear above tfar (Embree's rule for streams).
+            ray.tnear = traced[k] ? tnear : 1.0f;
+            ray.tfar = traced[k] ? tfar : 0.0f;
             ray.mask = 0xFFFFFFFFu;
         }
-        rtcOccluded1M(scene_, &ctx, rays, static_cast<unsigned>(count), sizeof(RTCRay));
+        if (tracing > 0)
+            rtcOccluded1M(scene_, &ctx, rays, static_cast<unsigned>(count), sizeof(RTCRay));
         for (int k = 0; k < count; ++k)
-            blocked[first + k] = (!active || active[first + k]) && rays[k].tfar < 0.0f ? 1 : 0;
+            blocked[first + k] = traced[k] && rays[k].tfar < 0.0f ? 1 : 0;
     }
 }
 

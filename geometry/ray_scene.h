@@ -65,9 +65,18 @@ class SurfaceRayScene {
     // is 0 is not traced (active may be null: all). Writes blocked[i] = 1 where ray i hits.
     // Rays given in coherent order (one direction of a pattern from neighbouring points)
     // are traced as a stream, which Embree takes in packets: ambient occlusion's rays cost
-    // a third less than one by one.
+    // a third less than one by one. A ray that provably cannot meet the surface is answered
+    // without Embree (escapes()): on a plane or a sphere, every ray of a point's
+    // hemisphere of occlusion.
     void occluded(const float* const org[3], const float* const dir[3], const uint8_t* active,
                   int n, float tnear, float tfar, uint8_t* blocked) const;
+
+    // True when the ray org + t dir, t >= 0, cannot meet the surface's tessellation, by its
+    // shape alone: a plane (y = 0) with org off it and dir not toward it; a sphere with org
+    // outside it by more than its vertices' rounding and dir not toward its centre (the ray
+    // then only moves away from the centre, and the tessellation lies within the sphere).
+    // False whenever this is not certain, and for every other surface.
+    bool escapes(const glm::vec3& org, const glm::vec3& dir) const;
 
     size_t triangleCount() const {
         build();

@@ -246,6 +246,78 @@ TEST(SphereRays, OcclusionStreamsAnswerEachRayByItsSegment) {
     }
 }
 
+// escapes() at its boundaries: a plane's ray parallel to it from just above escapes, one
+// from on it or tilted the least bit toward it does not; a sphere's ray from its surface
+// itself or a millionth of its radius outside does not (the vertices' rounding margin), one
+// tangent from a two-thousandth outside it does; and no ray escapes a torus, whose shape
+// the test does not know.
+TEST(SurfaceRays, EscapeHoldsOnlyWhereTheShapeRulesOutAHit) {
+    const Surface plane = Plane{4.0f, 4.0f};
+    const SurfaceRayScene planeRays(plane);
+    EXPECT_TRUE(planeRays.escapes({0.3f, 1e-6f, 0.2f}, {1.0f, 0.0f, 0.0f}));
+    EXPECT_TRUE(planeRays.escapes({0.3f, 0.5f, 0.2f}, {0.0f, 1.0f, 0.0f}));
+    EXPECT_TRUE(planeRays.escapes({0.3f, -0.5f, 0.2f}, {0.6f, -0.8f, 0.0f}));
+    EXPECT_FALSE(planeRays.escapes({0.3f, 0.0f, 0.2f}, {0.0f, 1.0f, 0.0f}));
+    EXPECT_FALSE(planeRays.escapes({0.3f, 0.5f, 0.2f}, {1.0f, -1e-6f, 0.0f}));
+    EXPECT_FALSE(planeRays.escapes({0.3f, -0.5f, 0.2f}, {0.0f, 1e-6f, 1.0f}));
+
+    const Surface sphere = Sphere{2.0f};
+    const SurfaceRayScene sphereRays(sphere);
+    EXPECT_FALSE(sphereRays.escapes({2.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}));
+    EXPECT_FALSE(sphereRays.escapes({2.000002f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}));
+    EXPECT_TRUE(sphereRays.escapes({2.001f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}));
+    EXPECT_TRUE(sphereRays.escapes({0.0f, 0.0f, -3.0f}, {0.0f, 0.6f, -0.8f}));
+    EXPECT_FALSE(sphereRays.escapes({2.001f, 0.0f, 0.0f}, {-1e-3f, 1.0f, 0.0f}));
+    EXPECT_FALSE(sphereRays.escapes({0.5f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}));  // inside
+
+    const Surface torus = Torus{1.0f, 0.25f};
+    const SurfaceRayScene torusRays(torus);
+    EXPECT_FALSE(torusRays.escapes({0.0f, 5.0f, 0.0f}, {0.0f, 1.0f, 0.0f}));
+}
+
+// Against Embree itself: over random rays near a plane and a sphere, no ray escapes() lets
+// through meets the tessellation (intersect() traces them all), while many of the others
+// do; and occluded(), which answers escaping rays without tracing them, agrees with
+// intersect() on every ray.
+TEST(SurfaceRays, EscapingRaysNeverMeetTheTessellation) {
+    const Surface plane = Plane{6.0f, 6.0f}, sphere = Sphere{1.5f};
+    for (const Surface* surface : {&plane, &sphere}) {
+        const SurfaceRayScene rays(*surface);
+        constexpr int n = 400;
+        std::mt19937 rng(11);
+        std::uniform_real_distribution<float> uni(-1.0f, 1.0f);
+        std::vector<float> o[3], d[3];
+        for (int k = 0; k < 3; ++k) o[k].resize(n), d[k].resize(n);
+        int escaping = 0, hitting = 0;
+        std::vector<uint8_t> expected(n);
+        for (int i = 0; i < n; ++i) {
+            glm::vec3 org(2.0f * uni(rng), 0.3f * uni(rng), 2.0f * uni(rng));
+            if (std::holds_alternative<Sphere>(*surface))
+                org = glm::normalize(org + glm::vec3(0.0f, 0.5f, 0.0f)) *
+                      (1.5f + 0.01f * (uni(rng) + 1.0f));
+            const glm::vec3 dir = glm::normalize(glm::vec3(uni(rng), uni(rng), uni(rng)));
+            for (int k = 0; k < 3; ++k) o[k][i] = org[k], d[k][i] = dir[k];
+            SurfaceHit hit;
+            const bool meets = rays.intersect(org, dir, 0.0f, 100.0f, hit);
+            expected[static_cast<size_t>(i)] = meets ? 1 : 0;
+            if (rays.escapes(org, dir)) {
+                ++escaping;
+                EXPECT_FALSE(meets) << surfaceTypeName(*surface) << " ray " << i;
+            }
+            hitting += meets ? 1 : 0;
+        }
+        EXPECT_GT(escaping, n / 4) << surfaceTypeName(*surface);
+        EXPECT_GT(hitting, n / 8) << surfaceTypeName(*surface);
+        const float* org[3] = {o[0].data(), o[1].data(), o[2].data()};
+        const float* dir[3] = {d[0].data(), d[1].data(), d[2].data()};
+        std::vector<uint8_t> blocked(n, 7);
+        rays.occluded(org, dir, nullptr, n, 0.0f, 100.0f, blocked.data());
+        for (int i = 0; i < n; ++i)
+            EXPECT_EQ(blocked[static_cast<size_t>(i)], expected[static_cast<size_t>(i)])
+                << surfaceTypeName(*surface) << " ray " << i;
+    }
+}
+
 TEST(SphereGeometry, PolesHaveExactNormals) {
     const Sphere s{1.0f};
     EXPECT_NEAR(s.evaluate(0, 0.3f, 1.0f).N.y, 1.0f, 1e-6f);
