@@ -185,6 +185,21 @@ void MultiphaseRenderer::calibrateFootprints(int frame,
     if (!o.enabled || replays || o.scales.empty() || options_.frameBudgetSeconds > 0.0 ||
         planLast_ - frame < o.minFrames || dynamic_.abandoned() || !dynamic_.complete())
         return;
+    // Most frames have no object left to measure that could own minPixels pixels (a point
+    // shades at most a 2x2 quad's pixels) or that has grown since it last owned too few:
+    // pixelOwners, whose window reads the whole visibility, had cost 2-3% of every steady
+    // frame.
+    const std::vector<ObjectFrameCost>& costs = dynamic_.objectCosts();
+    std::vector<uint8_t> looked(slots_.size(), 0);
+    bool any = false;
+    for (size_t i = 0; i < slots_.size() && i < costs.size(); ++i) {
+        const uint64_t points = costs[i].shadingPoints;
+        looked[i] = drawn[i] && drawn[i]->map && !slots_[i].footprintMeasured &&
+                    4 * points >= static_cast<uint64_t>(std::max(1, o.minPixels)) &&
+                    points >= 2 * slots_[i].footprintTooFewAt;
+        any = any || looked[i];
+    }
+    if (!any) return;
     const int width = frame_.width, height = frame_.height;
     std::vector<uint64_t> pixels;
     std::vector<int32_t> owners =
@@ -195,10 +210,13 @@ void MultiphaseRenderer::calibrateFootprints(int frame,
     for (int32_t owner : owners)
         if (owner >= 0) ++pixels[static_cast<size_t>(owner)];
     std::vector<size_t> measured;
-    for (size_t i = 0; i < slots_.size(); ++i)
-        if (drawn[i] && drawn[i]->map && !slots_[i].footprintMeasured &&
-            pixels[i] >= static_cast<uint64_t>(std::max(1, o.minPixels)))
+    for (size_t i = 0; i < slots_.size(); ++i) {
+        if (!looked[i]) continue;
+        if (pixels[i] >= static_cast<uint64_t>(std::max(1, o.minPixels)))
             measured.push_back(i);
+        else
+            slots_[i].footprintTooFewAt = std::max<uint64_t>(1, costs[i].shadingPoints);
+    }
     if (measured.empty()) return;
     const auto start = std::chrono::steady_clock::now();
     const ScopedSpan span(options_.trace, "footprint calibration", PhaseKind::Dynamic,

@@ -51,6 +51,9 @@ struct ObjectSlot {
     // MultiphaseRenderer::calibrateFootprints, kept for the rest of the render.
     bool footprintMeasured = false;
     float footprintScale = 1.0f;
+    // Its shading points at the last frame whose pixels were too few to measure it (0:
+    // none): it is looked at again once it shades twice as many.
+    uint64_t footprintTooFewAt = 0;
     // The animated inputs its static part reads, how far each moves over the scene (its
     // span), and their values at its last static run (the photometric fiducial).
     StaticInputs staticInputs;

@@ -188,9 +188,10 @@ TEST(FootprintCalibration, TilesHoldingTheObjectsPixelsClippedToTheImage) {
 
 // Two spheres under one shader: the left one's static colour varies slowly, the right one's
 // at the scale of its texels. The camera pans unless `still`.
-Scene twoSpheres(bool still = false) {
-    const std::string dir =
-        ::testing::TempDir() + (still ? "mpshade_footprints_still/" : "mpshade_footprints/");
+Scene twoSpheres(bool still = false, bool approach = false) {
+    const std::string dir = ::testing::TempDir() + (approach ? "mpshade_footprints_approach/"
+                                                    : still  ? "mpshade_footprints_still/"
+                                                             : "mpshade_footprints/");
     std::filesystem::create_directories(dir);
     std::ofstream(dir + "speckle.sl")
         << "surface speckle(float freq = 1.0) { float n = 0.5 + 0.5 * snoise(P * freq); color Cd "
@@ -198,11 +199,17 @@ Scene twoSpheres(bool still = false) {
            "0.3); }";
     std::ofstream(dir + "scene.json") << R"({
       "settings": { "width": 96, "height": 48, "samples_per_pixel": 4, "background": [0, 0, 0],
-                    "fps": 24, "duration": 1 },
+                    "fps": 24, "duration": )" +
+                                             std::string(approach ? "2" : "1") + R"( },
       "camera": { "fov_y": 30, "near": 0.1, "far": 100, "keys": [
-        { "t": 0, "eye": [0, 0, 6], "target": [0, 0, 0] },
+        { "t": 0, "eye": [0, 0, )" + std::string(approach ? "40" : "6") +
+                                             R"(], "target": [0, 0, 0] },
         { "t": 1, "eye": [)" + std::string(still ? "0" : "0.5") +
-                                             R"(, 0, 6], "target": [0, 0, 0] } ] },
+                                             R"(, 0, 6], "target": [0, 0, 0] })" +
+                                             std::string(approach ? R"(,
+        { "t": 2, "eye": [0.5, 0, 6], "target": [0, 0, 0] })"
+                                                                  : "") +
+                                             R"( ] },
       "lights": [ { "type": "ambient", "color": [0.2, 0.2, 0.2] },
                   { "type": "distant", "direction": [-1, -1, -1], "color": [1, 1, 1], "intensity": 2 } ],
       "shaders": { "s": "speckle.sl" },
@@ -255,6 +262,28 @@ TEST(FootprintCalibration, ASmoothObjectWidensAndAFinelyTexturedOneDoesNot) {
     MultiphaseRenderer uniform(scene, told);
     EXPECT_EQ(uniform.renderFrame(0, {}, g).rgba, firstImage.rgba);
     EXPECT_NE(uniform.renderFrame(1, {}, g).rgba, want.rgba);
+}
+
+TEST(FootprintCalibration, AnObjectTooSmallAtFirstIsMeasuredOnceItHasGrown) {
+    // The camera comes in from 40 units to 6 over frames 0-24, then holds (48 frames): at
+    // first each sphere is a few pixels, too few to measure (minPixels); it is looked at
+    // again as it grows, and measured once it owns enough.
+    const Scene scene = twoSpheres(false, true);
+    MultiphaseOptions o;
+    o.singlePhaseFrames = false;
+    MultiphaseRenderer renderer(scene, o);
+    int measuredAt = -1;
+    for (int frame = 0; frame <= 24 && measuredAt < 0; ++frame) {
+        FrameStats s;
+        renderer.renderFrame(frame, {}, s);
+        if (s.footprintCalibration.objects > 0) {
+            measuredAt = frame;
+            EXPECT_EQ(s.footprintCalibration.objects, 2u);
+        }
+    }
+    EXPECT_GT(measuredAt, 0);
+    EXPECT_GE(renderer.report(0).footprint.pixels, static_cast<uint64_t>(o.footprints.minPixels));
+    EXPECT_GE(renderer.report(1).footprint.pixels, static_cast<uint64_t>(o.footprints.minPixels));
 }
 
 TEST(FootprintCalibration, AStillViewIsNotMeasuredWhileItsFramesReplay) {
