@@ -86,7 +86,8 @@ void orderCoarsestFirst(std::vector<TileRequest>& tiles) {
 }
 
 double budgetedFillEnd(double elapsed, double budget, double minimumStaticShare) {
-    return elapsed < 0.95 * budget ? 0.95 * budget : elapsed + minimumStaticShare * budget;
+    if (elapsed > budget) return elapsed + minimumStaticShare * budget;
+    return std::max(elapsed, 0.95 * budget);
 }
 
 }  // namespace mpshade

@@ -93,8 +93,8 @@ void orderCoarsestFirst(std::vector<TileRequest>& tiles);
 
 // When a budgeted frame's fills end, seconds from the frame's start, the frame's own work
 // having taken `elapsed` of `budget`: a twentieth of the budget is kept for what follows the
-// fills, so a frame on time is never made late by them; a frame already late gets its
-// minimum share of the budget.
+// fills, so a frame on time is never made late by them (one already in that twentieth
+// fills nothing); a frame already past its budget gets its minimum share of the budget.
 double budgetedFillEnd(double elapsed, double budget, double minimumStaticShare);
 
 }  // namespace mpshade

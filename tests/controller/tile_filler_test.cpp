@@ -153,8 +153,13 @@ TEST(BudgetedFills, EndAtTheKeptTwentiethOrGiveALateFrameItsShare) {
     // On time: to 95% of the budget, however little the frame took.
     EXPECT_DOUBLE_EQ(budgetedFillEnd(0.0, budget, share), 0.038);
     EXPECT_DOUBLE_EQ(budgetedFillEnd(0.03, budget, share), 0.038);
-    // At the kept twentieth exactly, or past it: the minimum share on top of what it took.
-    EXPECT_DOUBLE_EQ(budgetedFillEnd(0.038, budget, share), 0.038 + 0.004);
+    // In the kept twentieth, on time still (the budget itself included): nothing more, a
+    // fill would make it late.
+    EXPECT_DOUBLE_EQ(budgetedFillEnd(0.038, budget, share), 0.038);
+    EXPECT_DOUBLE_EQ(budgetedFillEnd(0.039, budget, share), 0.039);
+    EXPECT_DOUBLE_EQ(budgetedFillEnd(budget, budget, share), budget);
+    // Past the budget, late anyway: the minimum share on top of what it took.
+    EXPECT_DOUBLE_EQ(budgetedFillEnd(0.0401, budget, share), 0.0401 + 0.004);
     EXPECT_DOUBLE_EQ(budgetedFillEnd(0.05, budget, share), 0.05 + 0.004);
     EXPECT_DOUBLE_EQ(budgetedFillEnd(0.05, budget, 0.0), 0.05);
 }
