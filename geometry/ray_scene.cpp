@@ -252,8 +252,7 @@ void SurfaceRayScene::occluded(const float* const org[3], const float* const dir
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    const bool shaped = tnear >= 0.0f && (std::holds_alternative<Plane>(surface_) ||
-                                          std::holds_alternative<Sphere>(surface_));
+    const bool fromOrigin = tnear >= 0.0f;  // escapes() speaks of t >= 0
     alignas(16) RTCRay rays[kStream];
     bool traced[kStream];
     for (int first = 0; first < n; first += kStream) {
@@ -262,7 +261,7 @@ void SurfaceRayScene::occluded(const float* const org[3], const float* const dir
         for (int k = 0; k < count; ++k) {
             const int i = first + k;
             const glm::vec3 o(org[0][i], org[1][i], org[2][i]), d(dir[0][i], dir[1][i], dir[2][i]);
-            traced[k] = (!active || active[i]) && !(shaped && escapes(o, d));
+            traced[k] = (!active || active[i]) && !(fromOrigin && escapes(o, d));
             tracing += traced[k] ? 1 : 0;
             RTCRay& ray = rays[k];
             ray = RTCRay{};
