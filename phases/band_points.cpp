@@ -107,82 +107,177 @@ void samplePoints(const SampleLayout& layout, const VisibilityBuffer& vis, const
             }
 }
 
-// Per pixel or per block of 2x2 pixels: the points of the band's blocks in the order made,
-// then grouped by object.
+// Per pixel or per block of 2x2 pixels, in two passes over the blocks. The first finds
+// each block's surface where one surface covers it whole (most blocks), groups the others'
+// fragments (groupFragments), and counts the points of each object; the second writes each
+// point straight to its place in its object's run. Grouping by object after the fact (a
+// third array set and a permutation applied to every pixel) took twice as long.
 class BlockPoints {
   public:
     BlockPoints(const SampleLayout& layout, const VisibilityBuffer& vis, const BandRange& r,
-                int block, BandPoints& pts, BandPointScratch& s)
+                int block, bool shortcut, BandPoints& pts, BandPointScratch& s)
         : layout_(layout),
           vis_(vis),
           r_(r),
           block_(block),
           layers_(vis.layers),
           spp_(layout.spp()),
+          shortcut_(shortcut),
           pixelSlots_(static_cast<size_t>(layout.spp()) * vis.layers),
           pts_(pts),
           s_(s) {
         s.unsortedObject.clear(), s.unsortedFacet.clear();
         s.unsortedX.clear(), s.unsortedY.clear();
-        // Only the range's own pixels are read back (a refined tile's: its columns).
-        const size_t width = static_cast<size_t>(layout.width());
-        if (r.wholeRows(layout)) {
-            pts.pixelPoint.assign(static_cast<size_t>(r.row1 - r.row0) * width, kNoPoint);
-        } else {
-            pts.pixelPoint.resize(static_cast<size_t>(r.row1 - r.row0) * width);
-            for (int y = r.row0; y < r.row1; ++y) {
-                const auto row =
-                    pts.pixelPoint.begin() + static_cast<std::ptrdiff_t>((y - r.row0) * width);
-                std::fill(row + r.col0, row + r.col1, kNoPoint);
-            }
-        }
+        s.blockObject.clear(), s.groupEnd.clear();
+        // Every pixel of the range is written by place(); the others are never read.
+        pts.pixelPoint.resize(static_cast<size_t>(r.row1 - r.row0) *
+                              static_cast<size_t>(layout.width()));
         s.member.resize(static_cast<size_t>(block * block) * pixelSlots_);
     }
 
-    // The common case: one surface covers every sample of the pixel, in front. Its point is
-    // the pixel's precomputed centroid, on the facet of its nearest sample: what
-    // groupFragments finds.
-    bool wholePixel(int bx, int by) {
-        const size_t first = layout_.index(bx, by, 0);
-        bool whole = vis_.count[first] == 1;
-        const uint32_t o = whole ? vis_.object[first * layers_] : 0;
-        for (int k = 1; k < spp_ && whole; ++k)
-            whole = vis_.count[first + k] == 1 && vis_.object[(first + k) * layers_] == o;
-        if (!whole) return false;
+    // Pass 1: per block its object if one surface covers it whole, kEmpty if nothing does,
+    // else kMixed and its groups made; the points of each object counted in
+    // objectStart[o + 1].
+    void classify() {
+        uint32_t current = kMixed, run = 0;  // a run of whole blocks of one object
+        forEachBlock([&](int bx, int by, int x1, int y1) {
+            const uint32_t o = blockState(bx, by, x1, y1);
+            s_.blockObject.push_back(o);
+            if (o == kEmpty) return;
+            if (o == kMixed) {
+                groupFragments(bx, by, x1, y1);
+                s_.groupEnd.push_back(static_cast<uint32_t>(s_.unsortedObject.size()));
+                return;
+            }
+            if (o != current) {
+                if (current != kMixed) pts_.objectStart[current + 1] += run;
+                current = o, run = 0;
+            }
+            ++run;
+        });
+        if (current != kMixed) pts_.objectStart[current + 1] += run;
+    }
+
+    // Pass 2: every point written at its place, pixels and fragments pointing at it.
+    void place(size_t objects) {
+        sizePoints(pts_, objects);
+        s_.cursor.assign(pts_.objectStart.begin(), pts_.objectStart.end() - 1);
+        s_.permutation.resize(s_.unsortedObject.size());
+        size_t b = 0, mixed = 0;
+        uint32_t group = 0;
+        uint32_t current = kMixed, at = 0;  // the cursor of a run of whole blocks, in a register
+        forEachBlock([&](int bx, int by, int x1, int y1) {
+            const uint32_t o = s_.blockObject[b++];
+            if (o == kEmpty) {
+                for (int py = by; py < y1; ++py)
+                    for (int px = bx; px < x1; ++px) pts_.pixelPoint[pixelAt(px, py)] = kNoPoint;
+                return;
+            }
+            if (o != kMixed) {
+                if (o != current) {
+                    if (current != kMixed) s_.cursor[current] = at;
+                    current = o, at = s_.cursor[o];
+                }
+                if (block_ == 1)
+                    placeWholePixel(bx, by, o, at++);
+                else
+                    placeWholeQuad(bx, by, o, at++);
+                return;
+            }
+            if (current != kMixed) s_.cursor[current] = at, current = kMixed;
+            const uint32_t end = s_.groupEnd[mixed++];
+            for (; group < end; ++group) {
+                const uint32_t to = s_.cursor[s_.unsortedObject[group]]++;
+                s_.permutation[group] = to;
+                write(to, s_.unsortedObject[group], s_.unsortedFacet[group], s_.unsortedX[group],
+                      s_.unsortedY[group]);
+            }
+            for (int py = by; py < y1; ++py)
+                for (int px = bx; px < x1; ++px) pts_.pixelPoint[pixelAt(px, py)] = kNoPoint;
+            forEachFragment(bx, by, x1, y1, [&](size_t smp, int l, size_t) {
+                uint32_t& point = pts_.fragmentPoint[smp * layers_ + l - r_.firstSlot];
+                point = s_.permutation[point];
+            });
+        });
+    }
+
+  private:
+    // Block states besides an object's index: several surfaces, or none at all.
+    static constexpr uint32_t kMixed = ~uint32_t{0}, kEmpty = ~uint32_t{0} - 1;
+
+    // Calls f(bx, by, x1, y1) for every block of the range, in order: rows of blocks, then
+    // columns; blocks at the range's right or bottom edge may be cut short.
+    template <typename F>
+    void forEachBlock(F&& f) const {
+        for (int by = r_.row0; by < r_.row1; by += block_) {
+            const int y1 = std::min(r_.row1, by + block_);
+            for (int bx = r_.col0; bx < r_.col1; bx += block_)
+                f(bx, by, std::min(r_.col1, bx + block_), y1);
+        }
+    }
+
+    // The pixel's state: the object of the one surface covering every sample in front,
+    // kEmpty if no sample sees anything, else kMixed.
+    uint32_t pixelState(int px, int py) const {
+        const size_t first = layout_.index(px, py, 0);
+        const uint8_t* count = vis_.count.data() + first;
+        if (count[0] == 0) {
+            for (int k = 1; k < spp_; ++k)
+                if (count[k] != 0) return kMixed;
+            return kEmpty;
+        }
+        if (count[0] != 1) return kMixed;
+        const uint32_t o = vis_.object[first * layers_];
+        for (int k = 1; k < spp_; ++k)
+            if (count[k] != 1 || vis_.object[(first + k) * layers_] != o) return kMixed;
+        return o;
+    }
+
+    // The block's state. A whole pixel, or a whole 2x2 block at even coordinates (inside
+    // the image), takes its point from the layout's precomputed centroid and nearest sample
+    // (placeWholePixel, placeWholeQuad): what groupFragments finds, without grouping.
+    uint32_t blockState(int bx, int by, int x1, int y1) const {
+        uint32_t state;
+        if (block_ == 1) {
+            state = pixelState(bx, by);
+        } else if (x1 - bx == 2 && y1 - by == 2 && by % 2 == 0 && bx % 2 == 0) {
+            state = pixelState(bx, by);
+            if (state == kMixed || pixelState(bx + 1, by) != state ||
+                pixelState(bx, by + 1) != state || pixelState(bx + 1, by + 1) != state)
+                return kMixed;
+        } else {
+            for (int py = by; py < y1; ++py)
+                for (int px = bx; px < x1; ++px)
+                    if (pixelState(px, py) != kEmpty) return kMixed;
+            return kEmpty;
+        }
+        return shortcut_ || state == kEmpty ? state : kMixed;
+    }
+
+    void placeWholePixel(int bx, int by, uint32_t o, uint32_t at) {
         // Not first / spp: a 64-bit division a pixel was a tenth of this step's time.
         const size_t pixel = static_cast<size_t>(by) * static_cast<size_t>(layout_.width()) +
                              static_cast<size_t>(bx);
-        const size_t nearest = first + static_cast<size_t>(layout_.nearestToCentroid(pixel));
-        pts_.pixelPoint[pixelAt(bx, by)] = add(o, vis_.facet[nearest * layers_],
-                                               layout_.centroidX(pixel), layout_.centroidY(pixel));
-        return true;
+        const size_t nearest = layout_.index(bx, by, layout_.nearestToCentroid(pixel));
+        write(at, o, vis_.facet[nearest * layers_], layout_.centroidX(pixel),
+              layout_.centroidY(pixel));
+        pts_.pixelPoint[pixelAt(bx, by)] = at;
     }
 
-    // The same for a whole 2x2 block (bx, by even, the block inside the image): its four
-    // pixels' samples all see one surface, in front.
-    bool wholeQuad(int bx, int by) {
-        const size_t firsts[4] = {layout_.index(bx, by, 0), layout_.index(bx + 1, by, 0),
-                                  layout_.index(bx, by + 1, 0), layout_.index(bx + 1, by + 1, 0)};
-        bool whole = vis_.count[firsts[0]] == 1;
-        const uint32_t o = whole ? vis_.object[firsts[0] * layers_] : 0;
-        for (int q = 0; q < 4 && whole; ++q)
-            for (int k = 0; k < spp_ && whole; ++k)
-                whole =
-                    vis_.count[firsts[q] + k] == 1 && vis_.object[(firsts[q] + k) * layers_] == o;
-        if (!whole) return false;
+    void placeWholeQuad(int bx, int by, uint32_t o, uint32_t at) {
         const size_t quad = static_cast<size_t>(by / 2) * (layout_.width() / 2) + bx / 2;
         const int m = layout_.nearestToQuadCentroid(quad);
-        const size_t nearest = firsts[m / spp_] + static_cast<size_t>(m % spp_);
-        const uint32_t point = add(o, vis_.facet[nearest * layers_], layout_.quadCentroidX(quad),
-                                   layout_.quadCentroidY(quad));
+        const size_t nearest = layout_.index(bx + (m / spp_) % 2, by + m / (2 * spp_), m % spp_);
+        write(at, o, vis_.facet[nearest * layers_], layout_.quadCentroidX(quad),
+              layout_.quadCentroidY(quad));
         for (int dy = 0; dy < 2; ++dy)
-            for (int dx = 0; dx < 2; ++dx) pts_.pixelPoint[pixelAt(bx + dx, by + dy)] = point;
-        return true;
+            for (int dx = 0; dx < 2; ++dx) pts_.pixelPoint[pixelAt(bx + dx, by + dy)] = at;
     }
 
     // The general case: the block's fragments grouped by surface (object and layer; past 64
     // surfaces the rest merge into the first), each group's point at its centroid on the
-    // facet of the member sample nearest to it.
+    // facet of the member sample nearest to it. The groups go to the unsorted arrays, and
+    // each fragment's point is its group's index there until place().
     void groupFragments(int bx, int by, int x1, int y1) {
         struct Group {
             uint32_t object;
@@ -223,51 +318,24 @@ class BlockPoints {
                 facet[g] = vis_.facet[smp * layers_ + l];
             }
         });
-        for (int g = 0; g < groupCount; ++g)
-            pointOf[g] = add(groups[g].object, facet[g], cx[g], cy[g]);
+        for (int g = 0; g < groupCount; ++g) {
+            pointOf[g] = static_cast<uint32_t>(s_.unsortedObject.size());
+            ++pts_.objectStart[groups[g].object + 1];
+            s_.unsortedObject.push_back(groups[g].object);
+            s_.unsortedFacet.push_back(facet[g]);
+            s_.unsortedX.push_back(cx[g]);
+            s_.unsortedY.push_back(cy[g]);
+        }
         forEachFragment(bx, by, x1, y1, [&](size_t smp, int l, size_t m) {
             pts_.fragmentPoint[smp * layers_ + l - r_.firstSlot] = pointOf[s_.member[m]];
         });
     }
 
-    // Groups the points by object (a counting sort); the fragments and pixels follow them.
-    void sortByObject(size_t objects) {
-        const size_t points = s_.unsortedObject.size();
-        for (uint32_t o : s_.unsortedObject) ++pts_.objectStart[o + 1];
-        sizePoints(pts_, objects);
-        s_.cursor.assign(pts_.objectStart.begin(), pts_.objectStart.end() - 1);
-        s_.permutation.resize(points);
-        for (size_t p = 0; p < points; ++p) {
-            const uint32_t at = s_.cursor[s_.unsortedObject[p]]++;
-            s_.permutation[p] = at;
-            pts_.object[at] = s_.unsortedObject[p];
-            pts_.facet[at] = s_.unsortedFacet[p];
-            pts_.x[at] = s_.unsortedX[p];
-            pts_.y[at] = s_.unsortedY[p];
-        }
-        const size_t width = static_cast<size_t>(layout_.width());
-        for (int py = r_.row0; py < r_.row1; ++py)
-            for (size_t pixel = py * width + r_.col0; pixel < py * width + r_.col1; ++pixel) {
-                uint32_t& whole = pts_.pixelPoint[pixel - r_.firstPixel];
-                if (whole != kNoPoint) {
-                    whole = s_.permutation[whole];
-                    continue;
-                }
-                for (size_t smp = pixel * spp_; smp < (pixel + 1) * spp_; ++smp)
-                    for (int l = 0; l < vis_.count[smp]; ++l) {
-                        uint32_t& point = pts_.fragmentPoint[smp * layers_ + l - r_.firstSlot];
-                        point = s_.permutation[point];
-                    }
-            }
-    }
-
-  private:
-    [[gnu::always_inline]] uint32_t add(uint32_t o, uint32_t f, float x, float y) {
-        s_.unsortedObject.push_back(o);
-        s_.unsortedFacet.push_back(f);
-        s_.unsortedX.push_back(x);
-        s_.unsortedY.push_back(y);
-        return static_cast<uint32_t>(s_.unsortedObject.size() - 1);
+    [[gnu::always_inline]] void write(uint32_t at, uint32_t o, uint32_t f, float x, float y) {
+        pts_.object[at] = o;
+        pts_.facet[at] = f;
+        pts_.x[at] = x;
+        pts_.y[at] = y;
     }
     size_t pixelAt(int px, int py) const {
         return static_cast<size_t>(py - r_.row0) * static_cast<size_t>(layout_.width()) +
@@ -290,6 +358,7 @@ class BlockPoints {
     const VisibilityBuffer& vis_;
     const BandRange& r_;
     const int block_, layers_, spp_;
+    const bool shortcut_;
     const size_t pixelSlots_;
     BandPoints& pts_;
     BandPointScratch& s_;
@@ -310,18 +379,9 @@ void buildBandPoints(const SampleLayout& layout, const VisibilityBuffer& vis,
             samplePoints(layout, vis, range, objects, pts, scratch);
     } else {
         const int block = options.rate == ShadingRate::Quad ? 2 : 1;
-        BlockPoints blocks(layout, vis, range, block, pts, scratch);
-        for (int by = range.row0; by < range.row1; by += block)
-            for (int bx = range.col0; bx < range.col1; bx += block) {
-                if (block == 1 && options.wholePixelShortcut && blocks.wholePixel(bx, by)) continue;
-                const int y1 = std::min(range.row1, by + block),
-                          x1 = std::min(range.col1, bx + block);
-                if (block == 2 && options.wholePixelShortcut && x1 - bx == 2 && y1 - by == 2 &&
-                    by % 2 == 0 && bx % 2 == 0 && blocks.wholeQuad(bx, by))
-                    continue;
-                blocks.groupFragments(bx, by, x1, y1);
-            }
-        blocks.sortByObject(objects);
+        BlockPoints blocks(layout, vis, range, block, options.wholePixelShortcut, pts, scratch);
+        blocks.classify();
+        blocks.place(objects);
     }
     const size_t points = pts.object.size();
     // One float beyond the last point's: the composite reads a point's three as four.

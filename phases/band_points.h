@@ -59,6 +59,9 @@ struct BandPointScratch {
     std::vector<uint32_t> unsortedObject, unsortedFacet;
     std::vector<float> unsortedX, unsortedY;
     std::vector<uint8_t> member;  // per fragment of a pixel block: its group
+    // Per block of a band shaded per pixel or 2x2 pixels: the object covering it whole, or
+    // none (~0); after each block covered by several surfaces, its groups' end.
+    std::vector<uint32_t> blockObject, groupEnd;
 };
 
 struct BandPointOptions {
