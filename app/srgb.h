@@ -9,9 +9,9 @@ namespace mpshade {
 // function (linear below 0.0031308, 1.055 c^(1/2.4) - 0.055 above), evaluated in float.
 uint8_t srgbCodeDirect(float c);
 
-// The same code, found among the 255 linear values where it steps (computed once from
-// srgbCodeDirect): eight comparisons instead of a pow per channel, which had been most of
-// the time spent writing a PNG frame. Equal to srgbCodeDirect for every float.
+// The same code from tables computed once from srgbCodeDirect (the 255 linear values where
+// it steps, and the code at the start of each of 3329 ranges of floats): a look-up and one
+// comparison instead of a pow per channel. Equal to srgbCodeDirect for every float.
 uint8_t srgbCode(float c);
 
 }  // namespace mpshade
