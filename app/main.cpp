@@ -200,6 +200,9 @@ int main(int argc, char** argv) {
     playCmd->add_flag("--no-background-fills", play.noBackgroundFills,
                       "Fill missing tiles only in frames' slack, on no worker thread alongside "
                       "them (for comparisons)");
+    playCmd->add_flag("--no-background-rebuilds", play.noBackgroundRebuilds,
+                      "Re-dice objects whose view left their range only within frames' time, on "
+                      "no worker thread alongside them (for comparisons)");
     playCmd
         ->add_option("--refine", play.refine,
                      "'on': each frame, once shaded at its step, refined by image tile at finer "

@@ -95,6 +95,17 @@ void printPlaySummary(const std::vector<PlaybackStep>& steps, const std::vector<
                  static_cast<unsigned long long>(prefetch.filled),
                  static_cast<unsigned long long>(prefetch.used),
                  static_cast<unsigned long long>(prefetch.wasted));
+    BackgroundStats background;
+    int builtInFrames = 0;
+    for (const FrameStats& s : played) {
+        background += s.background;
+        builtInFrames += s.staticWork.work.runs;
+    }
+    std::fprintf(stderr,
+                 "  static runs within frames %d; rebuilt on the background worker %d (%.1f ms "
+                 "of its CPU); tiles it filled %llu\n",
+                 builtInFrames, background.rebuilds, 1e3 * background.rebuildSeconds,
+                 static_cast<unsigned long long>(background.tilesFilled));
     std::vector<double> refined, estimated, refineMs;
     for (const FrameStats& s : played) {
         if (!s.refine.ran) continue;
@@ -157,6 +168,7 @@ PlaybackOptions playbackOptions(const PlayCommandOptions& options, const FrameRe
     po.cacheBytes = static_cast<size_t>(options.cacheMb) << 20;
     po.prefetch = !options.noPrefetch;
     po.backgroundFills = !options.noBackgroundFills;
+    po.backgroundRebuilds = !options.noBackgroundRebuilds;
     po.refine.enabled = options.refine == "on";
     po.refine.tileSize = options.refineTile;
     po.footprints.enabled = options.footprints == "measured";
@@ -212,6 +224,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
             {"cache_mb", options.cacheMb},
             {"prefetch", !options.noPrefetch},
             {"background_fills", !options.noBackgroundFills},
+            {"background_rebuilds", !options.noBackgroundRebuilds},
             {"preroll_seconds", prerollSeconds},
             {"frames_requested", po.last - po.first},
             {"frames_played", played},

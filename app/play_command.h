@@ -19,12 +19,13 @@ struct PlayCommandOptions {
     std::string size;    // "WxH"; empty = the scene's
     int spp = -1;        // -1 = the scene's; else 1..1024
     uint32_t seed = 0;
-    int64_t cacheMb = 256;           // shader-map tiles' memory budget, MB; >= 1
-    bool noWrite = false;            // measure without the disk: stats.json only
-    bool noPrefetch = false;         // no predicted or adjacent tiles filled ahead (comparisons)
-    bool noBackgroundFills = false;  // no worker thread filling deferred tiles (comparisons)
-    std::string refine = "on";       // "on" or "off": refinement by image tile (tile_refiner.h)
-    int refineTile = 16;             // refinement's tiles, pixels a side: even, 4..256
+    int64_t cacheMb = 256;              // shader-map tiles' memory budget, MB; >= 1
+    bool noWrite = false;               // measure without the disk: stats.json only
+    bool noPrefetch = false;            // no predicted or adjacent tiles filled ahead (comparisons)
+    bool noBackgroundFills = false;     // no worker thread filling deferred tiles (comparisons)
+    bool noBackgroundRebuilds = false;  // no worker thread rebuilding representations (same)
+    std::string refine = "on";          // "on" or "off": refinement by image tile (tile_refiner.h)
+    int refineTile = 16;                // refinement's tiles, pixels a side: even, 4..256
     std::string footprints = "measured";  // or "uniform": as render's --footprints
     // A folder of constant-quality frames (frame_NNNN.exr, as `render` writes them): each
     // played frame measured against its own there. Empty: none.

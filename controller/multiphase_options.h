@@ -82,7 +82,13 @@ struct MultiphaseOptions {
     bool backgroundFills = false;
     size_t backgroundQueue = 4096;
     bool backgroundDuringFrames = false;
-    // The worker at idle priority; false: normal priority (a caller that waits on it while
+    // With a frame budget: an object whose static phase is due again for a new view (its
+    // range left, its facets grown too long) and whose rebuild makes no shader map is
+    // rebuilt on a worker thread at idle priority while the frames draw its last
+    // representation, and swapped in at the start of a frame after (background_builder.h).
+    // Off: such rebuilds run in a frame only when their expected cost fits its time left.
+    bool backgroundRebuilds = false;
+    // The workers at idle priority; false: normal priority (a caller that waits on it while
     // other processes load the machine, as tests do).
     bool backgroundIdlePriority = true;
 };

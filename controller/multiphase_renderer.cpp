@@ -102,6 +102,7 @@ bool MultiphaseRenderer::viewAnimated() const {
 }
 
 void MultiphaseRenderer::discardStaticWork() {
+    if (builder_) builder_->cancel();
     if (filler_) {
         filler_->pause();
         filler_->submit({});
@@ -126,10 +127,13 @@ void MultiphaseRenderer::setFrameBudget(double seconds) {
 
 // A frame, at constant quality or within a frame budget, is these steps in order:
 //   beginFrame          the frame's state and sample layout; the background filler held.
+//   adoptRebuilt        within a budget: representations the background builder finished
+//                       replace those the frames drew meanwhile.
 //   planFrame           the objects in view, and of them those whose static phase is due,
 //                       with why (static_run_triggers.h). Nothing is done for an object
 //                       until a frame sees it.
-//   deferRebuilds       within a budget: rebuilds only as they fit the frame's time.
+//   deferRebuilds       within a budget: rebuilds to the background builder, or only as
+//                       they fit the frame's time.
 //   rendersSinglePhase  representations chosen for the due objects
 //                       (representation_planner.h); if that work would not pay for itself
 //                       over the frames it serves, the reference renderer draws the frame
@@ -151,6 +155,7 @@ void MultiphaseRenderer::render(int frame, const RenderOptions& options, FrameSt
     const auto start = Clock::now();
     beginFrame(frame, options, stats);
     const auto triggersStart = Clock::now();
+    if (builder_) adoptRebuilt(frame, stats);
     FramePlan plan = planFrame(frame, stats);
     if (plan.budgeted) deferRebuilds(plan, start, stats);
     stats.controllerSeconds += secondsSince(triggersStart);
@@ -263,15 +268,84 @@ MultiphaseRenderer::FramePlan MultiphaseRenderer::planFrame(int frame, FrameStat
     return plan;
 }
 
-// A frame budget: rebuilds only as they fit the time left after the dynamic phase (as long
-// as the last frame's) and the twentieth kept for the end of the frame.
+// The representations the background builder finished since the last frame replace those
+// the frames drew meanwhile, as if built now (recordBuild), their costs the builder's.
+void MultiphaseRenderer::adoptRebuilt(int frame, FrameStats& stats) {
+    for (RebuiltObject& done : builder_->takeFinished()) {
+        const size_t i = done.job.object;
+        const ScopedSpan span(options_.trace, "take up rebuilt", PhaseKind::Static, SpanLevel::Task,
+                              static_cast<int64_t>(i), frame);
+        ObjectSlot& slot = slots_[i];
+        std::unique_ptr<ObjectRepresentation> old = std::move(slot.representation);
+        slot.representation = std::move(done.representation);
+        // Its share of a map dropped here, so that a map is only ever freed on this thread.
+        if (old) {
+            old->map.reset();
+            builder_->discard(std::move(old));
+        }
+        slot.builtThisFrame = true;
+        recordBuild(i, done.job.kind, done.costs, done.job.ownUniforms());
+        ++stats.background.rebuilds;
+        stats.background.rebuildSeconds += done.costs.seconds;
+    }
+}
+
+// A frame budget. A rebuild for a new view that makes no shader map goes to the background
+// builder (MultiphaseOptions::backgroundRebuilds), and one already there waits for it; the
+// others run only as they fit the time left after the dynamic phase (as long as the last
+// frame's) and the twentieth kept for the end of the frame.
 void MultiphaseRenderer::deferRebuilds(FramePlan& plan, Clock::time_point start,
                                        FrameStats& stats) {
+    if (plan.due.empty()) return;
+    if (options_.backgroundRebuilds) sendRebuildsToBackground(plan, stats);
     if (plan.due.empty()) return;
     const double left =
         0.95 * options_.frameBudgetSeconds - secondsSince(start) - lastDynamicSeconds_;
     plan.due =
         admitRebuilds(plan.due, slots_, left, stats.staticWork.due, stats.budget.rebuildsDeferred);
+}
+
+// Takes out of plan.due the rebuilds for a new view that make no shader map, queued for the
+// background builder at this frame's view, and those it has under way already: each drawn
+// from its last representation meanwhile.
+void MultiphaseRenderer::sendRebuildsToBackground(FramePlan& plan, FrameStats& stats) {
+    std::vector<size_t> inFrame;
+    for (const size_t i : plan.due) {
+        ObjectSlot& slot = slots_[i];
+        StaticRunDue* due = nullptr;
+        for (StaticRunDue& d : stats.staticWork.due)
+            if (d.object == i) due = &d;
+        const bool forView =
+            due &&
+            (due->cause == StaticRunDue::ViewDirection || due->cause == StaticRunDue::Distance ||
+             due->cause == StaticRunDue::AngleAround || due->cause == StaticRunDue::FacetsTooLong);
+        const bool takes = forView && slot.representation &&
+                           !static_.buildMakesMap(i, slot.kind, slot.representation.get());
+        if (!takes && !(builder_ && builder_->pending(i))) {
+            inFrame.push_back(i);
+            continue;
+        }
+        if (takes) {
+            if (!builder_)
+                builder_ =
+                    std::make_unique<BackgroundBuilder>(static_, options_.backgroundIdlePriority);
+            RebuildJob job;
+            job.object = i;
+            job.kind = slot.kind;
+            job.frame = plan.frame;
+            job.state = frame_.objects[i];
+            job.camera = frame_.camera;
+            job.uniforms = frame_.uniforms[i];
+            job.params.assign(job.uniforms.params.begin(), job.uniforms.params.end());
+            job.lights.assign(job.uniforms.lights.begin(), job.uniforms.lights.end());
+            job.previous = slot.representation.get();
+            builder_->submit(std::move(job));
+        }
+        if (due) due->deferred = true;
+        ++stats.budget.rebuildsDeferred;
+        ++stats.budget.rebuildsInBackground;
+    }
+    plan.due = std::move(inFrame);
 }
 
 // 2b. Whether the due static work would not pay for itself, so the frame is rendered by the

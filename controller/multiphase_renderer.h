@@ -10,6 +10,7 @@
 #include <span>
 #include <vector>
 
+#include "controller/background_builder.h"
 #include "controller/background_filler.h"
 #include "controller/multiphase_options.h"
 #include "controller/object_slot.h"
@@ -84,6 +85,15 @@ class MultiphaseRenderer : public Renderer {
     // Whether the background filler can do nothing more before the next frame (true
     // without one): background_filler.h.
     bool backgroundSettled() const { return !filler_ || filler_->settled(); }
+    // Whether object's rebuild is with the background builder (queued, under way, or done
+    // and not yet taken up by a frame).
+    bool rebuildingInBackground(size_t object) const {
+        return builder_ && builder_->pending(object);
+    }
+    // Waits until the background builder has nothing queued or under way (tests).
+    void waitForBackgroundRebuilds() {
+        if (builder_) builder_->waitIdle();
+    }
     size_t objectCount() const { return slots_.size(); }
     // Per object, what the last frame cost it: ObjectSlot::frameStaticSeconds and
     // frameDynamic.
@@ -100,9 +110,11 @@ class MultiphaseRenderer : public Renderer {
     struct FramePlan;
     // The steps of a frame, in order (render()).
     void beginFrame(int frame, const RenderOptions& options, FrameStats& stats);
+    void adoptRebuilt(int frame, FrameStats& stats);
     FramePlan planFrame(int frame, FrameStats& stats);
     void deferRebuilds(FramePlan& plan, std::chrono::steady_clock::time_point start,
                        FrameStats& stats);
+    void sendRebuildsToBackground(FramePlan& plan, FrameStats& stats);
     bool rendersSinglePhase(FramePlan& plan);
     void buildDue(const FramePlan& plan, FrameStats& stats);
     void shadeAndFill(FramePlan& plan, FrameStats& stats, const ProgressFn& progress);
@@ -164,6 +176,9 @@ class MultiphaseRenderer : public Renderer {
     // the last frame. Last: destroyed (its worker joined) before anything it uses.
     BackgroundTotals fillerTotals_;
     std::unique_ptr<BackgroundFiller> filler_;
+    // The background builder (made at the first rebuild it takes); destroyed first, its
+    // worker joined before the representations it lends from and the static phase go.
+    std::unique_ptr<BackgroundBuilder> builder_;
 };
 
 }  // namespace mpshade

@@ -130,6 +130,7 @@ class Player {
         mo.mapMemoryBytes = options.cacheBytes;
         mo.backgroundFills = options.backgroundFills;
         mo.backgroundDuringFrames = options.backgroundDuringFrames;
+        mo.backgroundRebuilds = options.backgroundRebuilds;
         mo.trace = options.trace;
         mo.staticPhase.store = options.store;
         mo.refine = options.refine;

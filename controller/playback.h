@@ -74,6 +74,10 @@ struct PlaybackOptions {
     // cores (docs/playback.md), that cost a frame's deadline in about one run of two.
     bool backgroundFills = true;
     bool backgroundDuringFrames = false;
+    // An object whose view left its range is re-diced on a worker thread at idle priority
+    // while the frames draw its last representation (background_builder.h); off: only
+    // within a frame whose time left fits its expected cost.
+    bool backgroundRebuilds = true;
 };
 
 // One step of the quality regulator's ladder, as the pre-roll measured it.

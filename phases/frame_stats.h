@@ -103,6 +103,9 @@ struct BudgetStats {
     bool deadlineMet = true;
     uint64_t tilesDeferred = 0;
     int rebuildsDeferred = 0;
+    // Of rebuildsDeferred: queued for the background builder or under way there
+    // (MultiphaseOptions::backgroundRebuilds).
+    int rebuildsInBackground = 0;
     int builtAhead = 0;  // objects built in this frame's slack for frames ahead that see them
 };
 
@@ -166,11 +169,17 @@ struct PrefetchStats {
 struct BackgroundStats {
     uint64_t tilesFilled = 0, tilesEvicted = 0;
     double seconds = 0.0;
+    // The background builder's (MultiphaseOptions::backgroundRebuilds): representations it
+    // rebuilt that this frame took up, and their CPU time on its worker.
+    int rebuilds = 0;
+    double rebuildSeconds = 0.0;
 
     BackgroundStats& operator+=(const BackgroundStats& o) {
         tilesFilled += o.tilesFilled;
         tilesEvicted += o.tilesEvicted;
         seconds += o.seconds;
+        rebuilds += o.rebuilds;
+        rebuildSeconds += o.rebuildSeconds;
         return *this;
     }
 };

@@ -379,6 +379,13 @@ std::unique_ptr<ObjectRepresentation> StaticPhase::build(size_t index, Represent
     return rep;
 }
 
+bool StaticPhase::buildMakesMap(size_t index, Representation kind,
+                                const ObjectRepresentation* previous) const {
+    const ObjectShading& obj = *objects_[index];
+    return kind == Representation::ShaderMap && !obj.factored.staticPart.channelOutputs.empty() &&
+           !(previous && previous->map && !obj.staticReadsFrame);
+}
+
 // Whether object `index`'s static work is kept in the store: there is one, and the
 // geometry has a digest (objects made in code, not loaded, have none).
 bool StaticPhase::stores(size_t index) const {

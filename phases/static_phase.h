@@ -120,6 +120,11 @@ class StaticPhase {
                                                 const ObjectRepresentation* previous,
                                                 StaticCosts& costs) const;
 
+    // Whether build() would make a new shader map (and so fill tiles of its always-resident
+    // levels) rather than lend `previous`'s or need none.
+    bool buildMakesMap(size_t object, Representation kind,
+                       const ObjectRepresentation* previous) const;
+
     // The facets the combined representation of object `object` would have at this view
     // (the dicing survey's estimate, before any budget): for choosing a representation.
     double combinedFacets(size_t object, const ObjectState& state, const CameraState& camera) const;
