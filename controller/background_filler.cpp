@@ -61,9 +61,9 @@ void BackgroundFiller::retain(const std::function<bool(const BackgroundJob&)>& k
 void BackgroundFiller::pause() {
     std::unique_lock<std::mutex> lock(mutex_);
     paused_ = true;
-    abandon_.store(true, std::memory_order_relaxed);
+    abandon_.request();
     idle_.wait(lock, [&] { return !busy_; });
-    abandon_.store(false, std::memory_order_relaxed);
+    abandon_.clear();
 }
 
 void BackgroundFiller::resume(uint32_t stamp) {

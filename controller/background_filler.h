@@ -107,7 +107,7 @@ class BackgroundFiller {
     bool paused_ = true, busy_ = false, stop_ = false;
     // Set while pause() waits: the fill in progress drops its level and returns, so a
     // frame waits for at most a run of the static shader, not a whole tile.
-    std::atomic<bool> abandon_{false};
+    StopSignal abandon_;
     bool waitForReclaim_ = false;  // the cache is full: nothing more until the next frame
     uint32_t stamp_ = 0;
     BackgroundTotals totals_;

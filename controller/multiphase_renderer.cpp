@@ -479,6 +479,7 @@ void MultiphaseRenderer::countFills(const TileFillResult& fills, FrameStats& sta
     stats.staticWork.work += fills.costs;
     stats.controllerSeconds += fills.roomSeconds;
     stats.tiles.evicted += fills.evicted;
+    stats.budget.fillsStopped += fills.stopped;
     for (size_t i = 0; i < fills.objectTiles.size(); ++i) {
         const uint64_t loaded =
             i < fills.timing.objectTilesLoaded.size() ? fills.timing.objectTilesLoaded[i] : 0;

@@ -39,6 +39,7 @@ void TileFiller::fill(std::span<const TileRequest> tiles,
     result.timing.frame = limits.frame;
     result.objectTiles.resize(representations.size(), 0);
     FillPacer pacer(tileSeconds_);
+    const StopSignal stop(limits.deadline);
     size_t next = 0;
     bool started = false;
     while (next < tiles.size()) {
@@ -66,10 +67,25 @@ void TileFiller::fill(std::span<const TileRequest> tiles,
         }
         started = true;
         const auto began = Clock::now();
-        statics_.fill(batch_, representations, result.costs, &result.timing);
-        pacer.filled(secondsSince(began), batch_.size());
-        for (const TileRequest& r : batch_) ++result.objectTiles[r.object];
-        result.filled.insert(result.filled.end(), batch_.begin(), batch_.end());
+        statics_.fill(batch_, representations, result.costs, &result.timing,
+                      paced ? &stop : nullptr);
+        const double seconds = secondsSince(began);
+        size_t published = 0;
+        for (const TileRequest& r : batch_)
+            if (representations[r.object]->map->resident(r.key)) {
+                ++result.objectTiles[r.object];
+                result.filled.push_back(r);
+                ++published;
+            }
+        if (published < batch_.size() && paced && stop.stopped()) {
+            // Stopped at the deadline: what was published counts, and this chunk's requests
+            // are left (deferred) from its first on; its tiles now resident are skipped by
+            // whoever takes them up. Not a measure of a tile's cost.
+            ++result.stopped;
+            next = first;
+            break;
+        }
+        pacer.filled(seconds, batch_.size());
     }
     if (paced) tileSeconds_ = pacer.remembered();
     result.consumed += next;

@@ -35,8 +35,12 @@ enum class CacheRoom {
 };
 
 struct FillLimits {
-    // Chunks start only while they are expected to end by this moment (paced); the default,
-    // no deadline, fills everything asked in one chunk.
+    // Chunks start only while they are expected to end by this moment (paced), and a chunk
+    // still running then stops within one run of the static shader (its tiles under way
+    // dropped, left for later as if never started): a tile can cost many times the most
+    // one had cost lately (a marble column's first tiles at its finest level: 1-2 ms
+    // against 0.1-0.3), and such chunks had made locked-rate frames late. The default, no
+    // deadline, fills everything asked in one chunk.
     std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();
     CacheRoom room = CacheRoom::EvictAndExceed;
     // The maps' use stamp of the frame being rendered: tiles used at it are never dropped.
@@ -55,8 +59,9 @@ struct TileFillResult {
     std::vector<uint32_t> objectTiles;  // per object: tiles filled
     std::vector<TileRequest> filled;    // the requests filled, in order
     uint64_t evicted = 0;               // tiles dropped to make room
-    double seconds = 0.0;               // wall time, making room included
-    double roomSeconds = 0.0;           // of seconds: making room (the controller's work)
+    int stopped = 0;  // chunks stopped at the deadline (FillLimits::deadline), their tiles left
+    double seconds = 0.0;      // wall time, making room included
+    double roomSeconds = 0.0;  // of seconds: making room (the controller's work)
 };
 
 class TileFiller {

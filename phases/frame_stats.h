@@ -106,6 +106,9 @@ struct BudgetStats {
     // Of rebuildsDeferred: queued for the background builder or under way there
     // (MultiphaseOptions::backgroundRebuilds).
     int rebuildsInBackground = 0;
+    // Fill chunks stopped at the end of the frame's fill time (controller/tile_filler.h):
+    // their tiles under way dropped and left for later.
+    int fillsStopped = 0;
     int builtAhead = 0;  // objects built in this frame's slack for frames ahead that see them
 };
 

@@ -501,7 +501,7 @@ StoredTiles StaticPhase::storedTiles(size_t index, const ShadingUniforms& unifor
 
 void StaticPhase::fill(std::span<const TileRequest> requests,
                        std::span<const ObjectRepresentation* const> representations,
-                       StaticCosts& costs, FillTiming* timing) const {
+                       StaticCosts& costs, FillTiming* timing, const StopSignal* stop) const {
     if (timing) {
         timing->objectSeconds.resize(objects_.size(), 0.0);
         timing->objectInstructions.resize(objects_.size(), 0);
@@ -529,7 +529,7 @@ void StaticPhase::fill(std::span<const TileRequest> requests,
     std::vector<FillStats> done(work.size());
     tbb::parallel_for(size_t{0}, work.size(), [&](size_t w) {
         const auto began = Clock::now();
-        done[w] = work[w].map->fill(*work[w].keys);
+        done[w] = work[w].map->fill(*work[w].keys, stop);
         const auto ended = Clock::now();
         work[w].seconds = std::chrono::duration<double>(ended - began).count();
         if (timing && timing->trace)

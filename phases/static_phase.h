@@ -16,6 +16,7 @@
 #include "phases/phase_trace.h"
 #include "phases/scene_resources.h"
 #include "shading/factoring.h"
+#include "shading/stop_signal.h"
 
 namespace mpshade {
 
@@ -130,10 +131,11 @@ class StaticPhase {
     double combinedFacets(size_t object, const ObjectState& state, const CameraState& camera) const;
 
     // Fills the requested tiles missing from the representations' maps: each map's tiles
-    // in one batch (finest level first), maps in parallel.
+    // in one batch (finest level first), maps in parallel. `stop` (may be null): as
+    // ShaderMap::fill's; a map's pass under way when it says stop is dropped.
     void fill(std::span<const TileRequest> requests,
               std::span<const ObjectRepresentation* const> representations, StaticCosts& costs,
-              FillTiming* timing = nullptr) const;
+              FillTiming* timing = nullptr, const StopSignal* stop = nullptr) const;
 
   private:
     static DicingView dicingView(const ObjectState& state, const CameraState& camera);

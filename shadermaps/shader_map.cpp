@@ -105,8 +105,7 @@ void ShaderMap::store(int slot, size_t at, float value) {
 bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                          const PendingTiles& pending, ShadingBatch& scratch,
                          std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
-                         std::vector<float>& workspace, FillStats& stats,
-                         const std::atomic<bool>* abandon) {
+                         std::vector<float>& workspace, FillStats& stats, const StopSignal* stop) {
     const int res = resolution(key.level);
     const int T = options_.tileSize, border = options_.border;
     const int k = options_.prefilter == Prefilter::Box
@@ -188,7 +187,7 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
         }
         ShadingCounters counters;
         // A background fill stops within one run of the kernel's lanes when told to.
-        if (!kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters, abandon))
+        if (!kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters, stop))
             return false;
         float* const* channelOut = scratch.out.channels;
         const float inv = 1.0f / static_cast<float>(k * k);
@@ -267,7 +266,7 @@ void ShaderMap::copyBorders(const TileKey& key, int slot, const PendingTiles& pe
         }
 }
 
-FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>* abandon) {
+FillStats ShaderMap::fill(std::span<const TileKey> keys, const StopSignal* stop) {
     std::lock_guard<std::mutex> lock(fillMutex_);
     std::vector<TileKey> work;
     std::unordered_set<uint64_t> seen;
@@ -350,7 +349,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const std::atomic<bool>
             enableFlushToZero();
             FillScratch& s = scratch.local();
             if (fillTile(work[w], plan[w - begin].first, plan[w - begin].second, pending, s.batch,
-                         s.points, s.geometry, s.workspace, s.stats, abandon))
+                         s.points, s.geometry, s.workspace, s.stats, stop))
                 whole.fetch_add(1, std::memory_order_relaxed);
         });
         if (whole.load() < end - begin) {

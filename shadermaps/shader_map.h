@@ -52,6 +52,7 @@
 #include "shadermaps/tile_table.h"
 #include "shading/interpreter.h"
 #include "shading/shading_batch.h"
+#include "shading/stop_signal.h"
 
 namespace mpshade {
 
@@ -148,11 +149,12 @@ class ShaderMap {
     // tiles may be built from their children (Prefilter::Box with supersampleLimit >= 2)
     // starts a pass of its own, after the level below is published. One fill (or evict) of
     // a map runs at a time; others wait.
-    // `abandon` (may be null): checked between runs of the static shader of
-    // ShaderKernel::kLanes (128) points; once it is set, the pass under way is dropped
-    // unpublished (its slots freed) and the call returns, so whoever set it waits for a
-    // fraction of a tile.
-    FillStats fill(std::span<const TileKey> keys, const std::atomic<bool>* abandon = nullptr);
+    // `stop` (may be null): checked between runs of the static shader of
+    // ShaderKernel::kLanes (128) points; once it says stop (asked to, or its deadline
+    // passed), the pass under way is dropped unpublished (its slots freed) and the call
+    // returns, so whoever asked waits for a fraction of a tile, and a deadline is overrun
+    // by that much.
+    FillStats fill(std::span<const TileKey> keys, const StopSignal* stop = nullptr);
     // Fills every tile of the levels in [first, last] (inclusive) of every chart.
     void fillLevels(int first, int last);
     const FillStats& fillStats() const { return fillStats_; }
@@ -213,11 +215,11 @@ class ShaderMap {
     using PendingTiles = std::unordered_map<uint64_t, int>;
     const unsigned char* tileData(int slot) const { return pool_->data(slot); }
     unsigned char* tileData(int slot) { return pool_->data(slot); }
-    // False if `abandon` was set before the tile was whole.
+    // False if `stop` said stop before the tile was whole.
     bool fillTile(const TileKey& key, int slot, bool fromChildren, const PendingTiles& pending,
                   ShadingBatch& scratch, std::vector<ChartPoint>& points,
                   std::vector<SurfaceSample>& geometry, std::vector<float>& workspace,
-                  FillStats& stats, const std::atomic<bool>* abandon);
+                  FillStats& stats, const StopSignal* stop);
     void store(int slot, size_t at, float value);
     // The slots of the eight tiles around `key` in its chart and level (-1: not resident,
     // or beyond the level), found once per tile; a border (at most a tile wide) lies in

@@ -564,7 +564,7 @@ ShaderKernel::ShaderKernel(const IrProgram& source) : program_(source) {
 
 bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in, size_t n,
                        const ShadingOutputs& out, std::vector<float>& workspace,
-                       ShadingCounters& counters, const std::atomic<bool>* stop) const {
+                       ShadingCounters& counters, const StopSignal* stop) const {
     const size_t need = static_cast<size_t>(registerCount_) * kLanes;
     if (workspace.size() < need) workspace.resize(need);
     float* regs = workspace.data();
@@ -579,7 +579,7 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
     for (int32_t r = 0; r < registerCount_; ++r) S[r] = R(r);
 
     for (size_t start = 0; start < n; start += kLanes) {
-        if (stop && stop->load(std::memory_order_relaxed)) return false;
+        if (stop && stop->stopped()) return false;
         const int m = static_cast<int>(std::min<size_t>(kLanes, n - start));
         runBatch(code_, uniforms, in, start, m, regs, S, counters);
         const size_t bytes = sizeof(float) * static_cast<size_t>(m);

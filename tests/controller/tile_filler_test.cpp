@@ -139,6 +139,41 @@ TEST(TileFiller, ADeadlineAlreadyPastFillsNothing) {
     EXPECT_FALSE(f.map().resident(f.finest(1)[0].key));
 }
 
+TEST(TileFiller, AChunkStillRunningAtTheDeadlineStopsAndLeavesItsTiles) {
+    MapFixture f;
+    TileCache cache(size_t{1} << 30);
+    const int side = f.map().tilesPerSide(0);
+    ASSERT_GE(side, 8);
+    // Deadlines ever further off until one lands inside a chunk (a vase tile is a
+    // millisecond or so of occlusion rays; the first chunk is two tiles, unmeasured).
+    bool seen = false;
+    for (int attempt = 0; attempt < side && !seen; ++attempt) {
+        TileFiller filler(f.statics, cache);
+        std::vector<TileRequest> row;
+        for (int t = 0; t < side; ++t)
+            row.push_back(
+                {0, TileKey{0, 0, static_cast<uint16_t>(t), static_cast<uint16_t>(attempt)}});
+        FillLimits l = limits(CacheRoom::EvictWithin);
+        l.deadline = std::chrono::steady_clock::now() + std::chrono::microseconds(100 << attempt);
+        TileFillResult result;
+        filler.fill(row, f.reps, l, result);
+        if (result.stopped == 0) continue;
+        seen = true;
+        EXPECT_EQ(result.stopped, 1);
+        EXPECT_LT(result.consumed, row.size());  // the stopped chunk's tiles are left
+        // What was published counts, and only that; the tiles from `consumed` on are either
+        // resident (published before the stop) or not counted at all.
+        EXPECT_EQ(result.filled.size(), result.costs.tilesFilled);
+        for (const TileRequest& r : result.filled) EXPECT_TRUE(f.map().resident(r.key));
+        size_t resident = 0;
+        for (const TileRequest& r : row) resident += f.map().resident(r.key);
+        EXPECT_EQ(resident, result.filled.size());
+        for (size_t k = 0; k < result.consumed; ++k) EXPECT_TRUE(f.map().resident(row[k].key));
+        EXPECT_FALSE(f.map().resident(row.back().key));
+    }
+    EXPECT_TRUE(seen) << "no deadline landed inside a chunk";
+}
+
 TEST(BudgetedFills, CoarserLevelsFirstInTheOrderAskedWithinALevel) {
     std::vector<TileRequest> tiles;
     const uint16_t levels[] = {0, 3, 1, 3, 0, 5, 1};

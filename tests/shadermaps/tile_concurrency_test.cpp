@@ -143,19 +143,25 @@ TEST(TileConcurrency, AnAbandonedFillPublishesNothingAndKeepsNoStorage) {
         for (uint16_t tx = 0; tx < 4; ++tx) keys.push_back({0, 1, tx, ty});
 
     // Told before it starts: nothing at all.
-    const std::atomic<bool> stopNow{true};
+    StopSignal stopNow;
+    stopNow.request();
     EXPECT_EQ(map.fill(keys, &stopNow).tiles, 0u);
+    EXPECT_EQ(map.residentTiles(), pinnedResident);
+    EXPECT_EQ(map.pool()->tilesHeld(), pinnedHeld);
+    // A deadline already passed: nothing either.
+    const StopSignal late(StopSignal::Clock::now() - std::chrono::milliseconds(1));
+    EXPECT_EQ(map.fill(keys, &late).tiles, 0u);
     EXPECT_EQ(map.residentTiles(), pinnedResident);
     EXPECT_EQ(map.pool()->tilesHeld(), pinnedHeld);
 
     // Told while it runs (whenever that lands): the levels published are whole, the one
     // under way is gone, and every slot held is a resident tile's.
-    std::atomic<bool> stop{false};
+    StopSignal stop;
     std::thread stopper([&] {
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
-        stop = true;
+        stop.request();
     });
-    const uint64_t filled = map.fill(keys, &stop).tiles;
+    uint64_t filled = map.fill(keys, &stop).tiles;
     stopper.join();
     EXPECT_EQ(map.residentTiles(), pinnedResident + filled);
     EXPECT_EQ(map.pool()->tilesHeld(), pinnedHeld + filled);
@@ -169,6 +175,14 @@ TEST(TileConcurrency, AnAbandonedFillPublishesNothingAndKeepsNoStorage) {
             ASSERT_NEAR(texel[0], (i + 0.5f) / res, 1e-5f);
             ASSERT_NEAR(texel[1], (j + 0.5f) / res, 1e-5f);
         }
+
+    // A deadline 2 ms ahead, with the rest to do: the same, from where the last one stopped.
+    const StopSignal soon(StopSignal::Clock::now() + std::chrono::milliseconds(2));
+    const uint64_t before = filled;
+    filled += map.fill(keys, &soon).tiles;
+    EXPECT_EQ(map.residentTiles(), pinnedResident + filled);
+    EXPECT_EQ(map.pool()->tilesHeld(), pinnedHeld + filled);
+    EXPECT_TRUE(filled == before || filled == 1024 || filled == keys.size()) << filled;
 
     // Not told: all of it.
     EXPECT_EQ(map.fill(keys).tiles, keys.size() - filled);
