@@ -58,8 +58,15 @@ nlohmann::json renderFrameJson(const Scene& scene, const FrameStats& stats, bool
                             {"shader_instructions", stats.shaderInstructions},
                             {"nonfinite_samples", stats.nonFiniteSamples}};
     if (!multiphase) return entry;
-    double covered = 0.0;
-    for (size_t p = 3; p < image.rgba.size(); p += 4) covered += image.rgba[p];
+    // Four running sums, not one: a chain of dependent additions over a 1280x720 frame's
+    // alphas had been 1.4% of a render's CPU.
+    double part[4] = {0.0, 0.0, 0.0, 0.0};
+    const size_t pixels = image.rgba.size() / 4;
+    size_t p = 0;
+    for (; p + 4 <= pixels; p += 4)
+        for (int k = 0; k < 4; ++k) part[k] += image.rgba[4 * (p + k) + 3];
+    for (; p < pixels; ++p) part[0] += image.rgba[4 * p + 3];
+    const double covered = (part[0] + part[1]) + (part[2] + part[3]);
     entry["single_phase"] = stats.singlePhase;
     addMultiphaseFrameJson(scene, stats, entry);
     entry["static_instructions"] = stats.staticWork.work.instructions;
