@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 
@@ -57,11 +58,18 @@ void printPlaySummary(const std::vector<PlaybackStep>& steps, const std::vector<
                  1e3 / fps);
     for (const PlaybackStep& p : steps) {
         const std::string name = describeStep(p.step, spp);
+        // A step measured with probes falling back (a cache too small for its tiles) is
+        // priced high: the fallback path is slower.
+        const std::string fell =
+            p.probeFallbacks > 0 ? fmt::format("  ({} probes fell back)",
+                                               static_cast<unsigned long long>(p.probeFallbacks))
+                                 : std::string();
         if (p.frames > 0)
-            std::fprintf(stderr, "    %-34s %7.1f ms  %d frame(s)\n", name.c_str(),
-                         1e3 * p.dynamicSeconds, p.frames);
+            std::fprintf(stderr, "    %-34s %7.1f ms  %d frame(s)%s\n", name.c_str(),
+                         1e3 * p.dynamicSeconds, p.frames, fell.c_str());
         else
-            std::fprintf(stderr, "    %-34s %7.1f ms\n", name.c_str(), 1e3 * p.dynamicSeconds);
+            std::fprintf(stderr, "    %-34s %7.1f ms%s\n", name.c_str(), 1e3 * p.dynamicSeconds,
+                         fell.c_str());
     }
     auto med = [&](auto field) {
         std::vector<double> v;
@@ -211,6 +219,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
                  {"footprint_scale", q.footprintScale},
                  {"samples_per_pixel", q.samplesPerPixel > 0 ? q.samplesPerPixel : spp},
                  {"preroll_dynamic_seconds", steps[k].dynamicSeconds},
+                 {"preroll_probe_fallbacks", steps[k].probeFallbacks},
                  {"frames", steps[k].frames}});
         }
         const nlohmann::json doc = {

@@ -85,6 +85,9 @@ struct PlaybackStep {
     QualityStep step;
     double dynamicSeconds = 0.0;  // the first frame's dynamic phase at this step, warm
     int frames = 0;               // frames played at this step
+    // Of the frame measured, the probes that fell back to a coarser level: 0 unless the
+    // cache could not hold the tiles the step reads.
+    uint64_t probeFallbacks = 0;
 };
 
 struct PlaybackSummary {

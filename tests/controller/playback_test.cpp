@@ -249,6 +249,26 @@ TEST(Playback, ThePrerollMeasuresFootprintsAndTheFramesPlayAtThem) {
     EXPECT_LT(compareImages(played, uniform.renderFrame(2, small(), cs)).psnr, 60.0);
 }
 
+TEST(Playback, TheLadderIsMeasuredWithTheTilesOfEachStepFilled) {
+    // A floor seen at grazing angles reads levels far finer than the always-resident ones:
+    // each coarser step reads a level the steps before it had not filled, and measured at
+    // once its probes fell back (a slower path: per pixel at 1280x720 had been priced
+    // above per 2x2 pixels).
+    const Scene scene = loadScene(test::sourcePath("examples/hard/grazing_floor.json"));
+    PlaybackOptions options;
+    options.render = small();
+    options.render.width = 192;
+    options.render.height = 108;
+    options.first = 0;
+    options.last = 1;
+    options.prefetch = false;
+    const PlaybackSummary summary =
+        playScene(scene, options,
+                  [&](const FrameStats&, const Image&, const PlaybackQuality&) { return true; });
+    ASSERT_GE(summary.steps.size(), 5u);
+    for (const PlaybackStep& p : summary.steps) EXPECT_EQ(p.probeFallbacks, 0u);
+}
+
 TEST(Playback, PlaysEveryFrameAndRegulatesItsQuality) {
     const Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
     PlaybackOptions options;
@@ -284,6 +304,8 @@ TEST(Playback, PlaysEveryFrameAndRegulatesItsQuality) {
     EXPECT_EQ(summary.steps[0].step.rate, ShadingRate::Sample);
     EXPECT_EQ(summary.steps[6].step.samplesPerPixel, 1);
     for (const PlaybackStep& p : summary.steps) EXPECT_GT(p.dynamicSeconds, 0.0);
+    // Each measured with the tiles its footprints read filled, none falling back.
+    for (const PlaybackStep& p : summary.steps) EXPECT_EQ(p.probeFallbacks, 0u);
     EXPECT_EQ(summary.steps[6].frames, 4);
     for (size_t k = 0; k < 6; ++k) EXPECT_EQ(summary.steps[k].frames, 0);
 }
