@@ -106,6 +106,10 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                          const PendingTiles& pending, ShadingBatch& scratch,
                          std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
                          std::vector<float>& workspace, FillStats& stats, const StopSignal* stop) {
+    // A tile not begun when told to stop is not begun at all: its surface evaluation alone
+    // can take a millisecond (a gallery statue's), and every tile of the pass left to start
+    // had run it before reaching the kernel's check.
+    if (stop && stop->stopped()) return false;
     const int res = resolution(key.level);
     const int T = options_.tileSize, border = options_.border;
     const int k = options_.prefilter == Prefilter::Box
@@ -178,6 +182,7 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
     if (n > 0) {
         geometry.resize(n);
         evaluateBatch(surface_, points, geometry);
+        if (stop && stop->stopped()) return false;
         scratch.resize(n, channels);
         for (size_t p = 0; p < n; ++p) {
             const glm::vec3 toP = geometry[p].P - uniforms_.eye;
