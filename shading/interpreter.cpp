@@ -49,7 +49,8 @@ constexpr float kNoOperand[ShaderKernel::kLanes] = {};
 // contracted and both clones give the same bits.
 __attribute__((target_clones("avx2", "default"))) void runBatch(
     std::span<const ExecInst> code, const ShadingUniforms& uniforms, const ShadingInputs& in,
-    size_t start, int m, float* regs, const float** S, ShadingCounters& counters) {
+    size_t start, int m, float* regs, const float** S, ShadingCounters& counters,
+    const StopSignal* stop) {
     auto R = [&](int32_t r) { return regs + static_cast<size_t>(r) * ShaderKernel::kLanes; };
     for (const ExecInst& e : code) {
         float* o = R(e.out[0]);
@@ -235,8 +236,8 @@ __attribute__((target_clones("avx2", "default"))) void runBatch(
             case Op::Occlusion: {
                 const float* arg[6];
                 for (int k = 0; k < 6; ++k) arg[k] = S[e.in[k]];
-                counters.occlusionRays +=
-                    occlusionLanes(uniforms.occluder, uniforms.occlusionBias, e.imm, arg, o, m);
+                counters.occlusionRays += occlusionLanes(uniforms.occluder, uniforms.occlusionBias,
+                                                         e.imm, arg, o, m, stop);
                 break;
             }
             case Op::Const:
@@ -581,7 +582,10 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
     for (size_t start = 0; start < n; start += kLanes) {
         if (stop && stop->stopped()) return false;
         const int m = static_cast<int>(std::min<size_t>(kLanes, n - start));
-        runBatch(code_, uniforms, in, start, m, regs, S, counters);
+        runBatch(code_, uniforms, in, start, m, regs, S, counters, stop);
+        // Stopped within the batch (an occlusion op's rays cut short): its results are not
+        // whole.
+        if (stop && stop->stopped()) return false;
         const size_t bytes = sizeof(float) * static_cast<size_t>(m);
         for (int k = 0; k < 3; ++k) {
             if (ci_[k] >= 0) std::memcpy(out.Ci[k] + start, S[ci_[k]], bytes);

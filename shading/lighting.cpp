@@ -135,7 +135,7 @@ void shadeLightBaseline(Op op, const LightSample& light, const float* const* arg
 }
 
 uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,
-                        const float* const* args, float* out, int m) {
+                        const float* const* args, float* out, int m, const StopSignal* stop) {
     if (!occluder) {
         for (int l = 0; l < m; ++l) out[l] = 1.0f;
         return 0;
@@ -173,6 +173,7 @@ uint64_t occlusionLanes(const SurfaceRayScene* occluder, float bias, int rays,
             }
         }
         for (int i = 0; i < rays && active > 0; ++i) {
+            if (stop && stop->stopped()) return traced;
             // Hammersley point -> cosine-weighted direction (Malley's method).
             const float u1 = (static_cast<float>(i) + 0.5f) / static_cast<float>(rays);
             const float u2 = radicalInverse2(static_cast<uint32_t>(i));

@@ -1,6 +1,7 @@
 // Noise is deterministic with documented ranges; lighting and occlusion match their
 // formulas and simple analytic cases.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -294,6 +295,16 @@ TEST(Occlusion, EveryLaneOfALongRunCountsItsOwnRays) {
     for (int k = 0; k < 6; ++k) args[k] = &in[static_cast<size_t>(k) * m];
     std::vector<float> open(m, -1.0f);
     EXPECT_EQ(occlusionLanes(&rays, 0.0f, 64, args, open.data(), m), 64u * usable);
+    for (int l = 0; l < m; ++l) EXPECT_EQ(open[l], expected[l]) << "lane " << l;
+    // Told to stop, or past a deadline, before it starts: no ray traced at all. Not told,
+    // a deadline far off: every ray, the same counts.
+    StopSignal told;
+    told.request();
+    EXPECT_EQ(occlusionLanes(&rays, 0.0f, 64, args, open.data(), m, &told), 0u);
+    const StopSignal late(StopSignal::Clock::now() - std::chrono::milliseconds(1));
+    EXPECT_EQ(occlusionLanes(&rays, 0.0f, 64, args, open.data(), m, &late), 0u);
+    const StopSignal later(StopSignal::Clock::now() + std::chrono::hours(1));
+    EXPECT_EQ(occlusionLanes(&rays, 0.0f, 64, args, open.data(), m, &later), 64u * usable);
     for (int l = 0; l < m; ++l) EXPECT_EQ(open[l], expected[l]) << "lane " << l;
 }
 
