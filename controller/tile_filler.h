@@ -36,9 +36,9 @@ enum class CacheRoom {
 
 struct FillLimits {
     // Chunks start only while they are expected to end by this moment (paced), and a chunk
-    // still running then stops within one run of the static shader (its tiles under way
+    // still running then stops at its next check (ShaderMap::fill's; its tiles under way
     // dropped, left for later as if never started): a tile can cost many times the most
-    // one had cost lately (a marble column's first tiles at its finest level: 1-2 ms
+    // one had cost lately (some of a marble column's tiles in the courtyard: 1-2 ms
     // against 0.1-0.3), and such chunks had made locked-rate frames late. The default, no
     // deadline, fills everything asked in one chunk.
     std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max();

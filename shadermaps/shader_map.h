@@ -149,11 +149,11 @@ class ShaderMap {
     // tiles may be built from their children (Prefilter::Box with supersampleLimit >= 2)
     // starts a pass of its own, after the level below is published. One fill (or evict) of
     // a map runs at a time; others wait.
-    // `stop` (may be null): checked between runs of the static shader of
-    // ShaderKernel::kLanes (128) points; once it says stop (asked to, or its deadline
-    // passed), the pass under way is dropped unpublished (its slots freed) and the call
-    // returns, so whoever asked waits for a fraction of a tile, and a deadline is overrun
-    // by that much.
+    // `stop` (may be null): checked before each tile begins, after its surface evaluation,
+    // between runs of the static shader over ShaderKernel::kLanes (128) points and between
+    // streams of occlusion rays; once it says stop (asked to, or its deadline passed), the
+    // pass under way is dropped unpublished (its slots freed) and the call returns, so
+    // whoever asked waits for a fraction of a tile, and a deadline is overrun by that much.
     FillStats fill(std::span<const TileKey> keys, const StopSignal* stop = nullptr);
     // Fills every tile of the levels in [first, last] (inclusive) of every chart.
     void fillLevels(int first, int last);
