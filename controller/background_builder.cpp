@@ -1,19 +1,14 @@
 #include "controller/background_builder.h"
 
+#include "controller/idle_priority.h"
+
 #include <algorithm>
 #include <ctime>
 
-#include <sched.h>
-#include <sys/resource.h>
 #include <tbb/task_arena.h>
 
 namespace mpshade {
 namespace {
-
-void lowerPriority() {
-    sched_param param{};
-    if (sched_setscheduler(0, SCHED_IDLE, &param) != 0) setpriority(PRIO_PROCESS, 0, 19);
-}
 
 double threadCpuSeconds() {
     timespec t{};
@@ -93,7 +88,7 @@ void BackgroundBuilder::waitIdle() {
 }
 
 void BackgroundBuilder::run() {
-    if (idlePriority_) lowerPriority();
+    if (idlePriority_) lowerToIdlePriority();
     // The builds run on this thread alone: none of the frame's workers join them.
     tbb::task_arena arena(1);
     std::vector<std::unique_ptr<ObjectRepresentation>> discarded;

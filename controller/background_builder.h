@@ -27,12 +27,12 @@
 
 namespace mpshade {
 
-// One object's rebuild for the view of frame `frame`. Owns copies of the frame's animated
-// parameters and lights, which the frame's own state does not keep past the frame.
+// One object's rebuild for the view of the frame that found it due. Owns copies of the
+// frame's animated parameters and lights, which the frame's own state does not keep past
+// the frame.
 struct RebuildJob {
     size_t object = 0;
     Representation kind = Representation::Auto;
-    int frame = 0;
     ObjectState state;
     CameraState camera;
     ShadingUniforms uniforms;  // its params and lights spans are re-pointed at the copies

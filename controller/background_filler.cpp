@@ -1,9 +1,9 @@
 #include "controller/background_filler.h"
 
+#include "controller/idle_priority.h"
+
 #include <chrono>
 
-#include <sched.h>
-#include <sys/resource.h>
 #include <tbb/task_arena.h>
 
 namespace mpshade {
@@ -12,11 +12,6 @@ namespace {
 // Tiles taken at once: pause() waits for at most this many (the dearest tiles seen cost
 // about 1 ms each; two a batch had held a frame up to 5 ms).
 constexpr size_t kBatch = 1;
-
-void lowerPriority() {
-    sched_param param{};
-    if (sched_setscheduler(0, SCHED_IDLE, &param) != 0) setpriority(PRIO_PROCESS, 0, 19);
-}
 
 }  // namespace
 
@@ -105,7 +100,7 @@ void BackgroundFiller::makeRoom(size_t wanted, uint32_t stamp, uint64_t& evicted
 }
 
 void BackgroundFiller::run() {
-    if (idlePriority_) lowerPriority();
+    if (idlePriority_) lowerToIdlePriority();
     // The worker's fills run on this thread alone: none of the frame's workers join them.
     tbb::task_arena arena(1);
     std::vector<TileKey> keys;

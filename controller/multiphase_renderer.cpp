@@ -332,7 +332,6 @@ void MultiphaseRenderer::sendRebuildsToBackground(FramePlan& plan, FrameStats& s
             RebuildJob job;
             job.object = i;
             job.kind = slot.kind;
-            job.frame = plan.frame;
             job.state = frame_.objects[i];
             job.camera = frame_.camera;
             job.uniforms = frame_.uniforms[i];

@@ -182,7 +182,6 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
     if (n > 0) {
         geometry.resize(n);
         evaluateBatch(surface_, points, geometry);
-        if (stop && stop->stopped()) return false;
         scratch.resize(n, channels);
         for (size_t p = 0; p < n; ++p) {
             const glm::vec3 toP = geometry[p].P - uniforms_.eye;
@@ -191,7 +190,8 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                              len > 0.0f ? toP / len : glm::vec3(0.0f, 0.0f, -1.0f));
         }
         ShadingCounters counters;
-        // A background fill stops within one run of the kernel's lanes when told to.
+        // A stopped fill ends here, before the kernel's first run (just after the surface
+        // evaluation) or within one of its runs.
         if (!kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters, stop))
             return false;
         float* const* channelOut = scratch.out.channels;

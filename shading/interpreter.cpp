@@ -579,12 +579,12 @@ bool ShaderKernel::run(const ShadingUniforms& uniforms, const ShadingInputs& in,
     const float** S = sources.data();
     for (int32_t r = 0; r < registerCount_; ++r) S[r] = R(r);
 
+    if (stop && stop->stopped()) return false;
     for (size_t start = 0; start < n; start += kLanes) {
-        if (stop && stop->stopped()) return false;
         const int m = static_cast<int>(std::min<size_t>(kLanes, n - start));
         runBatch(code_, uniforms, in, start, m, regs, S, counters, stop);
-        // Stopped within the batch (an occlusion op's rays cut short): its results are not
-        // whole.
+        // Stopped within the batch (an occlusion op's rays cut short, its results not
+        // whole) or at its end: either way the next batch does not run.
         if (stop && stop->stopped()) return false;
         const size_t bytes = sizeof(float) * static_cast<size_t>(m);
         for (int k = 0; k < 3; ++k) {

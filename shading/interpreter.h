@@ -121,8 +121,8 @@ class ShaderKernel {
 
     // Runs the program on n points. `workspace` is scratch owned by the caller (one per
     // thread); it is sized on first use and then reused without allocation. `stop` (may
-    // be null) is checked before each run of kLanes points: once it says stop, the rest
-    // are not run and the call returns false.
+    // be null) is checked before the first run of kLanes points and after each: once it
+    // says stop, the rest are not run and the call returns false.
     bool run(const ShadingUniforms& uniforms, const ShadingInputs& in, size_t n,
              const ShadingOutputs& out, std::vector<float>& workspace, ShadingCounters& counters,
              const StopSignal* stop = nullptr) const;
