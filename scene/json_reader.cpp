@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -190,6 +191,9 @@ void checkNesting(const std::string& path, const std::string& text) {
 }  // namespace
 
 nlohmann::json parseJsonFile(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw InputError({path, 0, 0, {}}, "is a folder, not a scene file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError({path, 0, 0, {}}, "cannot open scene file");
     std::ostringstream buffer;

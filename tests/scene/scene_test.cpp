@@ -128,6 +128,24 @@ TEST(BadScenes, GoldenErrors) {
     EXPECT_EQ(files, checked);
 }
 
+TEST(BadScenes, AFolderOrAMissingFileIsNamedAsSuch) {
+    const std::filesystem::path folder =
+        std::filesystem::path(::testing::TempDir()) / "mpshade_scene_folder.json";
+    std::filesystem::create_directories(folder);
+    const std::pair<std::string, std::string> cases[] = {
+        {folder.string(), "is a folder, not a scene file"},
+        {(folder / "absent.json").string(), "cannot open scene file"}};
+    for (const auto& [path, message] : cases) {
+        try {
+            loadScene(path);
+            ADD_FAILURE() << path << " was accepted";
+        } catch (const InputError& e) {
+            EXPECT_EQ(e.where().file, path);
+            EXPECT_EQ(e.message(), message);
+        }
+    }
+}
+
 TEST(BadScenes, JsonNestingStopsJustPastItsLimit) {
     // 64 levels (the object and 63 arrays, brackets inside a string not counted) are read
     // and judged as a scene; one more is the nesting error at that bracket.
