@@ -149,6 +149,8 @@ class SceneLoader {
         if (rel.empty()) node.fail("expected a file path, found an empty string");
         const std::string full = resolve(rel);
         std::error_code ec;
+        if (fs::is_directory(full, ec))
+            node.fail("'" + rel + "' is a folder, not a file (" + full + ")");
         if (!fs::is_regular_file(full, ec))
             node.fail("file '" + rel + "' not found (looked for " + full + ")");
         return full;

@@ -37,6 +37,7 @@ const BadScene kBadScenes[] = {
      "expected a positive number, found -1"},
     {"missing_obj", "", "objects[0].geometry.file", 0, 0,
      "file '../meshes/nope.obj' not found (looked for "},
+    {"folder_obj", "", "objects[0].geometry.file", 0, 0, "'../meshes' is a folder, not a file ("},
     {"malformed_obj", "tests/data/meshes/bad_number.obj", "", 2, 7,
      "expected a number, found 'zero' (loading objects[0].geometry of "},
     {"bad_obj_index", "tests/data/meshes/bad_index.obj", "", 4, 7,
