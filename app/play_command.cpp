@@ -280,7 +280,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
             footprints[scene.objects[i].name] = s.objectFootprints[i];
     });
     if (tty) std::fprintf(stderr, "\n");
-    cleanUpStore(po.store, options.run);
+    cleanUpStore(po.store, options.run, scene);
     writeStats(summary.prerollSeconds);
     if (interrupted()) {
         std::fprintf(stderr,

@@ -38,7 +38,7 @@ int runProfileCommand(const ProfileCommandOptions& options) {
     const std::filesystem::path dir(options.outDir);
     writeTextFile(dir / "profile.md", profileMarkdown(profile));
     writeTextFile(dir / "trace.json", trace.chromeTraceJson());
-    cleanUpStore(store, options.run);
+    cleanUpStore(store, options.run, scene);
     if (!options.quiet) {
         double staticSeconds = 0.0, wall = 0.0;
         for (const FrameStats& s : profile.frames) {

@@ -315,7 +315,7 @@ int runRenderCommand(const RenderCommandOptions& options) {
         std::fprintf(stderr, "mpshade: %d frame(s) already in %s were not written again\n", skipped,
                      options.outDir.c_str());
     bar.finish();
-    cleanUpStore(store, options.run);
+    cleanUpStore(store, options.run, scene);
     if (interrupted()) {
         std::fprintf(stderr,
                      "mpshade: stopped by the user after %zu frame(s); stats.json "

@@ -1,13 +1,17 @@
 #include "app/run_options.h"
 
+#include <cstdio>
 #include <cstdlib>
+#include <set>
 #include <string_view>
 
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 #include <CLI/CLI.hpp>
 
+#include "geometry/content_digest.h"
 #include "geometry/error.h"
+#include "scene/scene.h"
 #include "shadermaps/tile_store.h"
 
 namespace mpshade {
@@ -52,9 +56,26 @@ nlohmann::json storeReport(const std::shared_ptr<TileStore>& store) {
             {"write_failures", c.writeFailures.load()}};
 }
 
-void cleanUpStore(const std::shared_ptr<TileStore>& store, const RunOptions& options) {
+void cleanUpStore(const std::shared_ptr<TileStore>& store, const RunOptions& options,
+                  const Scene& scene) {
     if (!store) return;
     const TileStoreCounters& c = store->counters();
+    if (c.loaded.load() == 0 && c.written.load() > 0) {
+        // Before clean-up, which may remove those maps as the ones unused longest.
+        std::set<std::string> names;
+        for (const SceneObject& o : scene.objects) names.insert(o.name);
+        const std::string engine = engineDigest().hex();
+        size_t others = 0;
+        for (const StoredMapSummary& m : store->maps())
+            others +=
+                names.count(m.info.object) && !m.info.engine.empty() && m.info.engine != engine;
+        if (others > 0)
+            std::fprintf(stderr,
+                         "mpshade: note: the store %s holds %zu map(s) of this scene's objects "
+                         "that another build of mpshade filled; this build reads none of them "
+                         "(tiles are keyed by the engine that filled them) and stored its own\n",
+                         store->root().c_str(), others);
+    }
     if (c.written.load() > 0)
         store->gc(static_cast<uint64_t>(options.storeMb > 0 ? options.storeMb : 8192) << 20);
     if (c.damaged.load() > 0)

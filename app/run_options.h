@@ -17,6 +17,7 @@ class App;
 namespace mpshade {
 
 class TileStore;
+struct Scene;
 
 struct RunOptions {
     // The store's folder; empty: defaultStoreFolder() (tile_store.h).
@@ -40,9 +41,12 @@ std::shared_ptr<TileStore> openStore(const RunOptions& options);
 // read, written, damaged (found, removed and filled again) and writes that failed.
 nlohmann::json storeReport(const std::shared_ptr<TileStore>& store);
 
-// After a run: if it wrote to the store, removes maps unused longest
-// while the store is over its budget; warns of damaged tiles found.
-void cleanUpStore(const std::shared_ptr<TileStore>& store, const RunOptions& options);
+// After a run of `scene`: if it wrote to the store, removes maps unused longest while the
+// store is over its budget; warns of damaged tiles found. A run that read no tile but
+// stored some, where the store holds maps of the scene's objects that another build of
+// mpshade filled, says so on stderr (they are never read: a tile is keyed by its engine).
+void cleanUpStore(const std::shared_ptr<TileStore>& store, const RunOptions& options,
+                  const Scene& scene);
 
 // Runs `command` with at most options.threads threads (every core when 0). Throws
 // InputError naming --threads when it is not in 0..1024.

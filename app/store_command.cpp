@@ -11,6 +11,7 @@
 #include "app/output_files.h"
 #include "app/store_export.h"
 #include "controller/multiphase_renderer.h"
+#include "geometry/content_digest.h"
 #include "geometry/error.h"
 #include "shadermaps/tile_store.h"
 
@@ -56,6 +57,11 @@ int storeInfo(const StoreCommandOptions& options) {
         tiles += m.tiles;
         bytes += m.bytes;
     }
+    // Which build filled a map: only this one's are read ("?": not recorded).
+    const std::string engine = engineDigest().hex();
+    auto build = [&](const StoredMapSummary& m) {
+        return m.info.engine.empty() ? "?" : m.info.engine == engine ? "this" : "other";
+    };
     if (options.json) {
         nlohmann::json list = nlohmann::json::array();
         for (const StoredMapSummary& m : maps)
@@ -65,7 +71,9 @@ int storeInfo(const StoreCommandOptions& options) {
                             {"channels", m.info.channelNames},
                             {"half", m.info.halfPrecision},
                             {"tiles", m.tiles},
-                            {"bytes", m.bytes}});
+                            {"bytes", m.bytes},
+                            {"engine", m.info.engine},
+                            {"build", build(m)}});
         const nlohmann::json doc = {
             {"folder", store->root().string()}, {"maps", list}, {"tiles", tiles}, {"bytes", bytes}};
         std::printf("%s\n", doc.dump(2).c_str());
@@ -74,14 +82,14 @@ int storeInfo(const StoreCommandOptions& options) {
     std::printf("store %s: %zu map(s), %llu tile(s), %s\n", store->root().c_str(), maps.size(),
                 static_cast<unsigned long long>(tiles), megabytes(bytes).c_str());
     if (maps.empty()) return 0;
-    std::printf("\n%-12s %-16s %-16s %8s %8s %10s  %s\n", "map", "object", "shader", "channels",
-                "tiles", "size", "last used");
+    std::printf("\n%-12s %-16s %-16s %8s %8s %10s %6s  %s\n", "map", "object", "shader", "channels",
+                "tiles", "size", "build", "last used");
     // Most recently used first.
     for (auto it = maps.rbegin(); it != maps.rend(); ++it)
-        std::printf("%-12.12s %-16.16s %-16.16s %8zu %8llu %10s  %s\n", it->digest.hex().c_str(),
-                    it->info.object.c_str(), it->info.shader.c_str(), it->info.channelNames.size(),
-                    static_cast<unsigned long long>(it->tiles), megabytes(it->bytes).c_str(),
-                    ago(it->lastUsed).c_str());
+        std::printf("%-12.12s %-16.16s %-16.16s %8zu %8llu %10s %6s  %s\n",
+                    it->digest.hex().c_str(), it->info.object.c_str(), it->info.shader.c_str(),
+                    it->info.channelNames.size(), static_cast<unsigned long long>(it->tiles),
+                    megabytes(it->bytes).c_str(), build(*it), ago(it->lastUsed).c_str());
     return 0;
 }
 
@@ -170,7 +178,7 @@ int runBakeCommand(const BakeCommandOptions& options) {
     if (tty) std::fprintf(stderr, "\n");
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    cleanUpStore(store, options.run);
+    cleanUpStore(store, options.run, request.scene);
     if (!options.quiet) {
         std::printf("baked frames %d:%d of %s into %s in %.2f s\n", request.first, request.last,
                     options.scene.c_str(), store->root().c_str(), seconds);

@@ -495,6 +495,7 @@ StoredTiles StaticPhase::storedTiles(size_t index, const ShadingUniforms& unifor
     info.tileSize = map.tileSize;
     info.border = map.border;
     info.halfPrecision = map.halfPrecision;
+    info.engine = engineDigest().hex();
     options_.store->useMap(stored.digest, info);
     return stored;
 }

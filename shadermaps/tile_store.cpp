@@ -423,7 +423,8 @@ void TileStore::useMap(const Digest128& map, const StoredMapInfo& info) {
         const nlohmann::json j = {{"object", info.object},         {"shader", info.shader},
                                   {"channels", info.channelNames}, {"charts", info.charts},
                                   {"resolution", info.resolution}, {"tile_size", info.tileSize},
-                                  {"border", info.border},         {"half", info.halfPrecision}};
+                                  {"border", info.border},         {"half", info.halfPrecision},
+                                  {"engine", info.engine}};
         const std::string text = j.dump(1) + "\n";
         const std::span<const unsigned char> piece = bytesOf(text.data(), text.size());
         writeAtomically(folder / "map.json", {&piece, 1});
@@ -470,6 +471,7 @@ std::vector<StoredMapSummary> TileStore::maps() const {
                 m.info.tileSize = j.value("tile_size", 0);
                 m.info.border = j.value("border", 0);
                 m.info.halfPrecision = j.value("half", false);
+                m.info.engine = j.value("engine", "");
             }
         } catch (const nlohmann::json::exception&) {
             m.info = {};

@@ -54,6 +54,9 @@ struct StoredMapInfo {
     std::vector<std::string> channelNames;
     int charts = 0, resolution = 0, tileSize = 0, border = 0;
     bool halfPrecision = false;
+    // The engine that filled it (engineDigest(), hex): another build of mpshade reads none
+    // of its tiles. Empty when unknown (written before it was recorded).
+    std::string engine;
 };
 
 struct TileStoreCounters {

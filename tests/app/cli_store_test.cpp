@@ -233,6 +233,15 @@ TEST(CliStore, InfoGcAndExport) {
     ASSERT_EQ(info.exitCode, 0) << info.output;
     EXPECT_NE(info.output.find("2 map(s)"), std::string::npos) << info.output;
     EXPECT_NE(info.output.find("marble"), std::string::npos) << info.output;
+    // Both filled by this build.
+    const CliRun json = mpshade("store info --json --store " + store);
+    ASSERT_EQ(json.exitCode, 0) << json.output;
+    const nlohmann::json listed = nlohmann::json::parse(json.output);
+    ASSERT_EQ(listed["maps"].size(), 2u);
+    for (const nlohmann::json& m : listed["maps"]) {
+        EXPECT_EQ(m["build"], "this") << m.dump();
+        EXPECT_EQ(m["engine"].get<std::string>().size(), 32u) << m.dump();
+    }
 
     const CliRun exported = mpshade("store export examples/vase/scene.json --object floor --out " +
                                     out + " --max-size 256 --store " + store);
@@ -409,7 +418,8 @@ TEST(CliStore, DamagedMapDescriptionsAreReportedNotTrusted) {
 namespace {
 
 // Another build never reads what this one stored: the same binary with one byte more
-// (still runnable) finds nothing in the store and fills every tile itself.
+// (still runnable) finds nothing in the store, fills every tile itself and says why; this
+// build, finding its own maps, says nothing.
 TEST(CliStore, AnotherBuildReadsNothingThisOneStored) {
     const std::string store = tempDir("build_store"), a = tempDir("build_a"),
                       b = tempDir("build_b"), copy = tempDir("build_bin");
@@ -419,10 +429,23 @@ TEST(CliStore, AnotherBuildReadsNothingThisOneStored) {
     std::ofstream(other, std::ios::app | std::ios::binary) << '\n';
     const std::string args =
         " render examples/vase/scene.json --frames 0:1" + kSmall + " --store " + store + " --out ";
-    ASSERT_EQ(mpshade(args.substr(1) + a).exitCode, 0);
+    const CliRun first = mpshade(args.substr(1) + a);
+    ASSERT_EQ(first.exitCode, 0);
+    const char* note = "map(s) of this scene's objects that another build of mpshade filled";
+    EXPECT_EQ(first.output.find(note), std::string::npos) << first.output;
     const std::string command =
         "cd '" MPSHADE_SOURCE_DIR "' && '" + other + "'" + args + b + " 2>&1";
-    ASSERT_EQ(std::system(command.c_str()), 0);
+    std::string output;
+    FILE* pipe = popen(command.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    char buffer[4096];
+    while (fgets(buffer, sizeof buffer, pipe)) output += buffer;
+    ASSERT_EQ(pclose(pipe), 0) << output;
+    // The vase and its floor: two maps of this scene's objects, each made by the first build.
+    EXPECT_NE(output.find("holds 2 " + std::string(note)), std::string::npos) << output;
+    // The first build again: it reads its own tiles; the other build's maps go unmentioned.
+    const CliRun again = mpshade(args.substr(1) + tempDir("build_again"));
+    EXPECT_EQ(again.output.find(note), std::string::npos) << again.output;
     const nlohmann::json mine = readJson(a + "/stats.json"), theirs = readJson(b + "/stats.json");
     EXPECT_GT(sum(theirs["frames"], "tiles_filled"), 0u);
     EXPECT_EQ(sum(theirs["frames"], "tiles_from_store"), 0u);
