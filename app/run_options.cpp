@@ -66,7 +66,7 @@ void cleanUpStore(const std::shared_ptr<TileStore>& store, const RunOptions& opt
         for (const SceneObject& o : scene.objects) names.insert(o.name);
         const std::string engine = engineDigest().hex();
         size_t others = 0;
-        for (const StoredMapSummary& m : store->maps())
+        for (const StoredMapSummary& m : store->maps(false))
             others +=
                 names.count(m.info.object) && !m.info.engine.empty() && m.info.engine != engine;
         if (others > 0)

@@ -435,7 +435,7 @@ void TileStore::useMap(const Digest128& map, const StoredMapInfo& info) {
     fs::last_write_time(folder / "used", fs::file_time_type::clock::now(), ec);
 }
 
-std::vector<StoredMapSummary> TileStore::maps() const {
+std::vector<StoredMapSummary> TileStore::maps(bool countPacks) const {
     std::vector<StoredMapSummary> out;
     std::error_code ec;
     for (const fs::directory_entry& folder : fs::directory_iterator(root_ / kTilesFolder, ec)) {
@@ -443,19 +443,20 @@ std::vector<StoredMapSummary> TileStore::maps() const {
         if (!folder.is_directory(ec) ||
             !Digest128::fromHex(folder.path().filename().string(), m.digest))
             continue;
-        for (const fs::directory_entry& f : fs::directory_iterator(folder.path(), ec)) {
-            if (f.path().extension() != ".pack") continue;
-            const uint64_t size = f.file_size(ec);
-            ++m.packs;
-            m.bytes += size;
-            const int fd = ::open(f.path().c_str(), O_RDONLY | O_CLOEXEC);
-            PackFooter footer{};
-            if (fd >= 0 && size >= sizeof footer &&
-                readAt(fd, &footer, sizeof footer, size - sizeof footer) &&
-                std::memcmp(footer.magic, kPackMagic, sizeof kPackMagic) == 0)
-                m.tiles += footer.count;
-            if (fd >= 0) ::close(fd);
-        }
+        if (countPacks)
+            for (const fs::directory_entry& f : fs::directory_iterator(folder.path(), ec)) {
+                if (f.path().extension() != ".pack") continue;
+                const uint64_t size = f.file_size(ec);
+                ++m.packs;
+                m.bytes += size;
+                const int fd = ::open(f.path().c_str(), O_RDONLY | O_CLOEXEC);
+                PackFooter footer{};
+                if (fd >= 0 && size >= sizeof footer &&
+                    readAt(fd, &footer, sizeof footer, size - sizeof footer) &&
+                    std::memcmp(footer.magic, kPackMagic, sizeof kPackMagic) == 0)
+                    m.tiles += footer.count;
+                if (fd >= 0) ::close(fd);
+            }
         m.lastUsed = fs::last_write_time(folder.path() / "used", ec);
         if (ec) m.lastUsed = fs::last_write_time(folder.path(), ec);
         // What the map is, if its description reads as one (a damaged one leaves it blank).

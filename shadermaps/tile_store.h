@@ -123,8 +123,10 @@ class TileStore {
 
     const TileStoreCounters& counters() const { return counters_; }
 
-    // Every map in the store, by last use, oldest first.
-    std::vector<StoredMapSummary> maps() const;
+    // Every map in the store, by last use, oldest first. With countPacks false only what
+    // each map is and when it was last used are read (map.json), not its packs: tiles,
+    // bytes and packs are left 0 (opening every pack of a large store takes a while).
+    std::vector<StoredMapSummary> maps(bool countPacks = true) const;
     // Removes maps and records, least recently used first, until the store holds at most
     // `budgetBytes`,
     // and temporary files older than an hour (left by a process that was killed). Returns

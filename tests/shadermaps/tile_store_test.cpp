@@ -123,7 +123,10 @@ TEST(TileStore, CleanUpRemovesTheMapsUnusedLongestFirst) {
     const auto now = fs::file_time_type::clock::now();
     for (uint64_t m = 0; m < 3; ++m) {
         const Digest128 map{m, 0};
-        store.useMap(map, {});
+        StoredMapInfo info;
+        info.object = "object" + std::to_string(m);
+        info.engine = "engine" + std::to_string(m);
+        store.useMap(map, info);
         writePack(store, map, {0, 1, 2, 3}, tile);
         // Map 0 used three hours ago, map 1 two, map 2 one.
         fs::last_write_time(root / TileStore::kTilesFolder / map.hex() / "used",
@@ -138,6 +141,21 @@ TEST(TileStore, CleanUpRemovesTheMapsUnusedLongestFirst) {
     // Four tiles with their headers, their index entries and the footer.
     const uint64_t perMap = 4 * (48 + tile.size()) + 4 * 16 + 32;
     EXPECT_EQ(store.bytes(), 3 * perMap);
+    // Listed oldest first, with or without their packs counted.
+    const std::vector<StoredMapSummary> counted = store.maps(), described = store.maps(false);
+    ASSERT_EQ(counted.size(), 3u);
+    ASSERT_EQ(described.size(), 3u);
+    for (uint64_t m = 0; m < 3; ++m) {
+        EXPECT_EQ(counted[m].digest, (Digest128{m, 0}));
+        EXPECT_EQ(counted[m].tiles, 4u);
+        EXPECT_EQ(counted[m].packs, 1u);
+        EXPECT_EQ(counted[m].bytes, perMap);
+        EXPECT_EQ(described[m].digest, counted[m].digest);
+        EXPECT_EQ(described[m].info.object, "object" + std::to_string(m));
+        EXPECT_EQ(described[m].info.engine, "engine" + std::to_string(m));
+        EXPECT_EQ(described[m].lastUsed, counted[m].lastUsed);
+        EXPECT_EQ(described[m].tiles + described[m].packs + described[m].bytes, 0u);
+    }
     // Room for two maps and a half: only the oldest goes.
     EXPECT_EQ(store.gc(2 * perMap + perMap / 2), perMap);
     std::vector<unsigned char> out(tile.size());
