@@ -1,8 +1,10 @@
 // stop_signal.h -- when long work (a shader-map fill, the static shader's runs over its
 // texels) should stop early: a request from another thread (a frame taking its core back
 // from the background filler), or a deadline on the steady clock (a locked-rate frame's fills
-// must end within its budget), whichever comes first. Checked between runs of a kernel's
-// lanes (ShaderKernel::kLanes points), so stopping costs at most one run.
+// must end within its budget), whichever comes first. A fill checks it before each tile, a
+// kernel before its first run of ShaderKernel::kLanes points and after each, and occlusion
+// between streams of rays (ShaderMap::fill): stopping costs at most a tile's surface
+// evaluation or one stream of rays.
 #pragma once
 
 #include <atomic>
