@@ -20,11 +20,13 @@ std::vector<TileRequest> MultiphaseRenderer::adjacentTiles() const {
         const ObjectRepresentation* rep = slots_[r.object].representation.get();
         if (!rep || !rep->map) continue;
         const ShaderMap& map = *rep->map;
-        const int side = map.tilesPerSide(r.key.level);
+        const int across = map.tilesU(r.key.chart, r.key.level);
+        const int down = map.tilesV(r.key.chart, r.key.level);
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
                 const int tx = r.key.tx + dx, ty = r.key.ty + dy;
-                if ((dx == 0 && dy == 0) || tx < 0 || ty < 0 || tx >= side || ty >= side) continue;
+                if ((dx == 0 && dy == 0) || tx < 0 || ty < 0 || tx >= across || ty >= down)
+                    continue;
                 const TileKey key{r.key.chart, r.key.level, static_cast<uint16_t>(tx),
                                   static_cast<uint16_t>(ty)};
                 if (!map.resident(key)) out.push_back({r.object, key});

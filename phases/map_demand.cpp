@@ -8,15 +8,19 @@
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
 
+#include "shadermaps/chart_aspect.h"
+
 namespace mpshade {
 namespace {
 
 // A grid of cells over an object's charts (k x k a chart; past the budget, every
-// `stride`-th chart), with the surface at each centre.
+// `stride`-th chart), with the surface at each centre, and each chart's shifts (the map's
+// texels along u are R >> shift.u[chart] at level 0, chart_aspect.h).
 struct ChartCells {
     int k = 1, stride = 1;
     std::vector<ChartPoint> at;
     std::vector<SurfaceSample> geometry;
+    ChartShifts shift;
 };
 
 ChartCells chartCells(const Surface& surface, int budget) {
@@ -94,7 +98,6 @@ FrameDemand frameDemand(const Surface& surface, const ChartCells& cells, const M
     const CameraState& camera = frame.camera;
     const glm::mat3 linear(state.objectToWorld);
     const double ppu = 0.5 * camera.height / camera.tanHalfFovY;
-    const double R = d.resolution;
     asked.clear();
     FrameDemand out;
     out.finest = maxLevel;
@@ -139,8 +142,13 @@ FrameDemand frameDemand(const Surface& surface, const ChartCells& cells, const M
         const double det = ju.x * jv.y - ju.y * jv.x;
         if (!(std::fabs(det) > 1e-30) || hidden(world, camera.eye, P)) continue;
         out.covered += std::fabs(det) * cells.stride * size * size;
-        const double s = footprint * R / det;
-        const double la = std::hypot(jv.y * s, ju.y * s), lb = std::hypot(jv.x * s, ju.x * s);
+        // Level-0 texels a side along each chart axis.
+        const auto chart = static_cast<size_t>(cell.at.chart);
+        const double Ru = std::ldexp(double(d.resolution), -int(cells.shift.u[chart]));
+        const double Rv = std::ldexp(double(d.resolution), -int(cells.shift.v[chart]));
+        const double s = footprint / det;
+        const double la = std::hypot(jv.y * Ru * s, ju.y * Rv * s),
+                     lb = std::hypot(jv.x * Ru * s, ju.x * Rv * s);
         const double major = std::max(la, lb);
         double minor = std::min(la, lb);
         // The level the probe reads (probe_batch.h footprintOf): the minor axis, widened.
@@ -165,19 +173,22 @@ FrameDemand frameDemand(const Surface& surface, const ChartCells& cells, const M
         // cell (a tile is filled when any probe lands in it, and the cell's box would count
         // every tile it grazes), or the cell's area where it is many tiles wide.
         for (int l = level; l <= last; ++l) {
-            const double side = (R / double(1 << l)) / tile;  // tiles a chart side
-            const double extent = side * size;                // the cell's, in tiles
-            if (extent > 4.0) {
-                out.tiles += extent * extent * cells.stride;
+            // Tiles a chart side along u and v; at least one texel an axis.
+            const double sideU = std::max(1.0, Ru / double(1 << l)) / tile;
+            const double sideV = std::max(1.0, Rv / double(1 << l)) / tile;
+            const double extentU = sideU * size, extentV = sideV * size;  // the cell's, in tiles
+            if (extentU * extentV > 16.0) {
+                out.tiles += std::max(extentU, 1.0) * std::max(extentV, 1.0) * cells.stride;
                 continue;
             }
-            const int m = std::max(1, static_cast<int>(std::ceil(2.0 * extent)));
+            const int mu = std::max(1, static_cast<int>(std::ceil(2.0 * extentU)));
+            const int mv = std::max(1, static_cast<int>(std::ceil(2.0 * extentV)));
             const double u0 = cell.at.u - 0.5 * size, v0 = cell.at.v - 0.5 * size;
-            for (int j = 0; j < m; ++j)
-                for (int i = 0; i < m; ++i) {
-                    const double u = u0 + (i + 0.5) * size / m, v = v0 + (j + 0.5) * size / m;
-                    asked.insert(tileId(cell.at.chart, l, static_cast<int64_t>(u * side),
-                                        static_cast<int64_t>(v * side)));
+            for (int j = 0; j < mv; ++j)
+                for (int i = 0; i < mu; ++i) {
+                    const double u = u0 + (i + 0.5) * size / mu, v = v0 + (j + 0.5) * size / mv;
+                    asked.insert(tileId(cell.at.chart, l, static_cast<int64_t>(u * sideU),
+                                        static_cast<int64_t>(v * sideV)));
                 }
         }
     }
@@ -209,8 +220,14 @@ std::vector<MapDemand> estimateMapDemands(const SceneResources& resources,
         tiles[n] = std::min(options.tileSize, d.resolution);
         d.tileTexels = (tiles[n] + 2 * options.border) * (tiles[n] + 2 * options.border);
         while ((d.resolution >> maxLevels[n]) > 1) ++maxLevels[n];
-        d.pinnedTiles = 9.0 * chartCount(*obj.surface);
         cells[n] = chartCells(*obj.surface, options.points);
+        const auto charts = static_cast<size_t>(chartCount(*obj.surface));
+        cells[n].shift =
+            options.chartAspect
+                ? chartShifts(*obj.surface, chartShiftRoom(d.resolution, tiles[n]))
+                : ChartShifts{std::vector<uint8_t>(charts, 0), std::vector<uint8_t>(charts, 0)};
+        d.pinnedTiles = coarseLevelTiles(cells[n].shift, d.resolution, tiles[n],
+                                         ShaderMapOptions{}.alwaysResidentLevels);
     }
 
     const int first = std::max(0, options.firstFrame);

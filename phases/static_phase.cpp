@@ -483,7 +483,8 @@ StoredTiles StaticPhase::storedTiles(size_t index, const ShadingUniforms& unifor
         .addI32(map.halfPrecision)
         .addI32(static_cast<int32_t>(map.prefilter))
         .addI32(map.supersampleLimit)
-        .addI32(map.seamless);
+        .addI32(map.seamless)
+        .addI32(map.chartAspect);
     StoredTiles stored{options_.store, hasher.finish()};
     StoredMapInfo info;
     info.object = sceneObject.name;

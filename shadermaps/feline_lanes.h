@@ -118,10 +118,10 @@ int felineLanes(const Prober<C, Texels>& p, const FelineSetup& setup, const Prob
     // them with the sums below), each tens of cycles to start for a few hundred bytes.
     struct Line {
         int level;
-        float scale, fres, dx, dy;
-        int tx0, ty0;             // the tile of the first query's first tap
-        const Storage* tiles[9];  // tiles tx0 - 1 .. tx0 + 1 by ty0 - 1 .. ty0 + 1: only
-                                  // those a probed lane reads are set
+        float scale, fu, fv, dx, dy;  // texels along u and v (chart_aspect.h)
+        int tx0, ty0;                 // the tile of the first query's first tap
+        const Storage* tiles[9];      // tiles tx0 - 1 .. tx0 + 1 by ty0 - 1 .. ty0 + 1: only
+                                      // those a probed lane reads are set
     };
     Line lines[2];
     int count = 0;
@@ -132,16 +132,16 @@ int felineLanes(const Prober<C, Texels>& p, const FelineSetup& setup, const Prob
     const int shift = p.tileShift;
     for (int l = 0; l < count; ++l) {
         Line& line = lines[l];
-        line.fres = p.levelRes[line.level];
-        line.dx = setup.du * line.fres, line.dy = setup.dv * line.fres;
-        const LaneFloats x0 = u0 * line.fres - 0.5f, y0 = v0 * line.fres - 0.5f;
+        line.fu = p.resU(setup.chart, line.level), line.fv = p.resV(setup.chart, line.level);
+        line.dx = setup.du * line.fu, line.dy = setup.dv * line.fv;
+        const LaneFloats x0 = u0 * line.fu - 0.5f, y0 = v0 * line.fv - 0.5f;
         const LaneFloats xe = x0 + static_cast<float>(n - 1) * line.dx,
                          ye = y0 + static_cast<float>(n - 1) * line.dy;
         // Inside the level and away from its last texel (lineInTile's test): no tap is
         // clamped, and each floor is a truncation.
-        const float last = line.fres - 1.0f;
+        const float lastU = line.fu - 1.0f, lastV = line.fv - 1.0f;
         const LaneInts inside = (x0 >= 0.0f) & (xe >= 0.0f) & (y0 >= 0.0f) & (ye >= 0.0f) &
-                                (x0 < last) & (xe < last) & (y0 < last) & (ye < last);
+                                (x0 < lastU) & (xe < lastU) & (y0 < lastV) & (ye < lastV);
         line.tx0 = static_cast<int>(x0[0]) >> shift, line.ty0 = static_cast<int>(y0[0]) >> shift;
         // Each tap's tile among the 3x3 around (tx0, ty0), as a bit per lane: the tiles the
         // lanes read are then looked up once each, whether the lanes' taps stay in one tile
@@ -189,7 +189,7 @@ int felineLanes(const Prober<C, Texels>& p, const FelineSetup& setup, const Prob
     const int border = p.border;
     for (int l = 0; l < count; ++l) {
         const Line& line = lines[l];
-        LaneFloats x = u0 * line.fres - 0.5f, y = v0 * line.fres - 0.5f;
+        LaneFloats x = u0 * line.fu - 0.5f, y = v0 * line.fv - 0.5f;
         Float4 acc[kLanes][kVectors];
         for (int i0 = 0; i0 < n; i0 += kTapsAtOnce) {
             const int taps = std::min(kTapsAtOnce, n - i0);

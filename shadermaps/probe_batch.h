@@ -16,19 +16,20 @@ namespace mpshade {
 // NOLINTNEXTLINE(cert-dcl59-cpp,google-build-namespaces): internal linkage on purpose (prober.h)
 namespace {
 
-// The footprint's axes in level-0 texels, major first; false if it is degenerate.
+// The footprint's axes in level-0 texels of the chart's axes (resU0 along u, resV0 along v:
+// chart_aspect.h), major first.
 struct Footprint {
     float ax, ay, bx, by;  // major and minor axis vectors (texels)
     float major, minor;
 };
 
-Footprint footprintOf(const ProbeQuery& q, float resolution, float maxAnisotropy, AnisotropyCap cap,
-                      float levelAnisotropy) {
+Footprint footprintOf(const ProbeQuery& q, float resU0, float resV0, float maxAnisotropy,
+                      AnisotropyCap cap, float levelAnisotropy) {
     float d[4] = {q.dudx, q.dvdx, q.dudy, q.dvdy};
     bool finite = true;
-    for (float& x : d) {
-        finite = finite && std::isfinite(x);
-        x *= resolution;
+    for (int i = 0; i < 4; ++i) {
+        finite = finite && std::isfinite(d[i]);
+        d[i] *= (i & 1) ? resV0 : resU0;
     }
     Footprint f;
     if (!finite) {
@@ -95,7 +96,6 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
               std::span<const ProbeQuery> queries, ProbeOutput out, ProbeResidency* residency) {
     const int channels = C > 0 ? C : std::min(map.channels(), kMaxChannels);
     const Prober<C, Texels> p(map, residency, channels, map.levels() - 1);
-    const float res0 = static_cast<float>(map.resolution(0));
     FelineSetup setup;  // the last one, for the queries after it with the same footprint
     auto one = [&](ProbeQuery q, float* o) {
         if (!std::isfinite(q.u)) q.u = 0.0f;
@@ -107,8 +107,9 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
         // differences are compared at once: |d| <= tolerance is -tolerance <= d <= tolerance,
         // false for a NaN either way.
         const bool sameFeline = options.filter == ProbeFilter::Feline && sharesSetup(setup, q);
+        const float resU0 = p.resU(q.chart, 0), resV0 = p.resV(q.chart, 0);
         const Footprint f = sameFeline ? Footprint{}
-                                       : footprintOf(q, res0,
+                                       : footprintOf(q, resU0, resV0,
                                                      options.filter == ProbeFilter::Trilinear
                                                          ? 1e30f
                                                          : options.maxAnisotropy,
@@ -163,8 +164,8 @@ void probeAll(const ShaderMap& map, const ProbeOptions& options,
             // Several taps only along a real major axis (n > 1 means major > minor > 0).
             const float half = n > 1 ? f.major - minor : 0.0f;
             const float step = n > 1 ? 2.0f * half / static_cast<float>(n - 1) : 0.0f;
-            const float dirU = n > 1 ? f.ax / (f.major * res0) : 0.0f;
-            const float dirV = n > 1 ? f.ay / (f.major * res0) : 0.0f;
+            const float dirU = n > 1 ? f.ax / (f.major * resU0) : 0.0f;
+            const float dirV = n > 1 ? f.ay / (f.major * resV0) : 0.0f;
             setup.offsetU = -half * dirU, setup.offsetV = -half * dirV;
             setup.du = step * dirU, setup.dv = step * dirV;
             const float gk = -2.0f / (f.major * f.major);

@@ -117,10 +117,12 @@ struct Prober {
     mutable const Storage* cachedTile[2] = {nullptr, nullptr};  // cachedSlot's storage
     mutable uint64_t fastProbes = 0;  // bilinear probes on the fast path, for residency
     mutable bool missed = false;      // the current query found a tile missing
-    // The fast path's constants: per level its width and its tiles per side; the tile's
-    // geometry; storage as Texels reads it, with no recency to report.
-    float levelRes[32] = {};
-    int levelTiles[32] = {};
+    // The fast path's constants: texels and tiles along an axis kLevelSlots levels down from
+    // level 0, so that an axis shifted by its chart (chart_aspect.h) reads entry level + shift;
+    // the tile's geometry; storage as Texels reads it, with no recency to report.
+    static constexpr int kLevelSlots = 32 + kMaxChartShift;
+    float levelRes[kLevelSlots] = {};
+    int levelTiles[kLevelSlots] = {};
     int tileShift = 0, border = 1;
     size_t rowValues = 0;  // channel values per tile row, borders included
     size_t tileBytes = 0;
@@ -143,11 +145,12 @@ struct Prober {
 
     Prober(const ShaderMap& m, ProbeResidency* r, int channels, int top)
         : map(m), residency(r), runtimeChannels(channels), maxLevel(top) {
-        for (int level = 0; level <= maxLevel && level < 32; ++level) {
-            levelRes[level] = static_cast<float>(map.resolution(level));
-            levelTiles[level] = map.tilesPerSide(level);
-        }
         while ((1 << tileShift) < map.options().tileSize) ++tileShift;
+        for (int level = 0; level < kLevelSlots; ++level) {
+            const int res = level < 31 ? std::max(1, map.options().resolution >> level) : 1;
+            levelRes[level] = static_cast<float>(res);
+            levelTiles[level] = (res + (1 << tileShift) - 1) >> tileShift;
+        }
         border = map.options().border;
         rowValues = static_cast<size_t>(map.stride()) * static_cast<size_t>(runtimeChannels);
         tileBytes = map.tileBytes();
@@ -155,6 +158,12 @@ struct Prober {
         std::fill(std::begin(reported), std::end(reported), ~uint64_t{0});
         fast = map.options().halfPrecision == Texels::kHalf && !(residency && residency->touched);
     }
+
+    // Chart `chart`'s texels along u (resU) and v (resV) at `level` (chart_aspect.h).
+    int shiftU(int chart) const { return map.shiftU(static_cast<uint32_t>(chart)); }
+    int shiftV(int chart) const { return map.shiftV(static_cast<uint32_t>(chart)); }
+    float resU(int chart, int level) const { return levelRes[level + shiftU(chart)]; }
+    float resV(int chart, int level) const { return levelRes[level + shiftV(chart)]; }
 
     // The fast path's tile lookup: the storage of tile (tx, ty) of `level`, or null if it is
     // not resident. Neighbouring lookups mostly find the last tile of their level's parity.
@@ -248,12 +257,13 @@ struct Prober {
     // coordinates (x, y) of `level` (texel centres at integers) to sum, if the tile is
     // resident in float storage; returns false (nothing added) otherwise.
     bool tap(int chart, int level, float x, float y, float w, float* sum) const {
-        const float res = levelRes[level];
-        x = std::clamp(x, -0.5f, res - 0.5f);
-        y = std::clamp(y, -0.5f, res - 0.5f);
-        const int n = levelTiles[level] - 1;
-        const int tx = std::min(std::max(static_cast<int>(floorOf(x)), 0) >> tileShift, n);
-        const int ty = std::min(std::max(static_cast<int>(floorOf(y)), 0) >> tileShift, n);
+        const int lu = level + shiftU(chart), lv = level + shiftV(chart);
+        x = std::clamp(x, -0.5f, levelRes[lu] - 0.5f);
+        y = std::clamp(y, -0.5f, levelRes[lv] - 0.5f);
+        const int tx =
+            std::min(std::max(static_cast<int>(floorOf(x)), 0) >> tileShift, levelTiles[lu] - 1);
+        const int ty =
+            std::min(std::max(static_cast<int>(floorOf(y)), 0) >> tileShift, levelTiles[lv] - 1);
         const Storage* t = tileAt(chart, level, tx, ty);
         if (!t) return false;
         ++fastProbes;
@@ -291,9 +301,12 @@ struct Prober {
     void bilinear(int chart, int level, float u, float v, float* out) const {
         const int channels = kFixed ? kChannels : runtimeChannels;
         for (;; ++level) {
-            const int res = map.resolution(level);
-            const float x = std::clamp(u * res - 0.5f, -0.5f, res - 0.5f);
-            const float y = std::clamp(v * res - 0.5f, -0.5f, res - 0.5f);
+            const auto ru =
+                static_cast<float>(map.resolutionU(static_cast<uint32_t>(chart), level));
+            const auto rv =
+                static_cast<float>(map.resolutionV(static_cast<uint32_t>(chart), level));
+            const float x = std::clamp(u * ru - 0.5f, -0.5f, ru - 0.5f);
+            const float y = std::clamp(v * rv - 0.5f, -0.5f, rv - 0.5f);
             const float fx0 = floorOf(x), fy0 = floorOf(y);
             const int i0 = static_cast<int>(fx0), j0 = static_cast<int>(fy0);
             int li, lj;
@@ -378,13 +391,13 @@ struct Prober {
     [[gnu::always_inline]] bool lineInTile(int chart, int level, float u0, float v0, float du,
                                            float dv, int n, const float* weight, float scale,
                                            float* sum) const {
-        const float fres = levelRes[level];
-        const float x0 = u0 * fres - 0.5f, y0 = v0 * fres - 0.5f;
-        const float dx = du * fres, dy = dv * fres;
+        const float fu = resU(chart, level), fv = resV(chart, level);
+        const float x0 = u0 * fu - 0.5f, y0 = v0 * fv - 0.5f;
+        const float dx = du * fu, dy = dv * fv;
         const float xe = x0 + static_cast<float>(n - 1) * dx,
                     ye = y0 + static_cast<float>(n - 1) * dy;
         if (!(std::min(x0, xe) >= 0.0f && std::min(y0, ye) >= 0.0f &&
-              std::max(x0, xe) < fres - 1.0f && std::max(y0, ye) < fres - 1.0f))
+              std::max(x0, xe) < fu - 1.0f && std::max(y0, ye) < fv - 1.0f))
             return false;
         TileWindow& w = window[level & 1];
         if (w.chart != chart || w.level != level) {
@@ -441,22 +454,22 @@ struct Prober {
                                                           const float* weight, float scale,
                                                           float* sum) const {
         const int channels = kFixed ? kChannels : runtimeChannels;
-        const float fres = levelRes[level];
-        const float x0 = u0 * fres - 0.5f, y0 = v0 * fres - 0.5f;
-        const float dx = du * fres, dy = dv * fres;
+        const int lu = level + shiftU(chart), lv = level + shiftV(chart);
+        const float fu = levelRes[lu], fv = levelRes[lv];
+        const float x0 = u0 * fu - 0.5f, y0 = v0 * fv - 0.5f;
+        const float dx = du * fu, dy = dv * fv;
         if (fast) {
             const float xe = x0 + static_cast<float>(n - 1) * dx,
                         ye = y0 + static_cast<float>(n - 1) * dy;
             // Every tap's texels in one tile (the common case: taps span a few texels):
             // one lookup for the line.
-            const float lo = -0.5f, hi = fres - 0.5f;
-            const int ix0 = static_cast<int>(floorOf(std::clamp(std::min(x0, xe), lo, hi)));
-            const int ix1 = static_cast<int>(floorOf(std::clamp(std::max(x0, xe), lo, hi)));
-            const int iy0 = static_cast<int>(floorOf(std::clamp(std::min(y0, ye), lo, hi)));
-            const int iy1 = static_cast<int>(floorOf(std::clamp(std::max(y0, ye), lo, hi)));
-            const int last = levelTiles[level] - 1;
-            const int tx = std::min(std::max(ix0, 0) >> tileShift, last);
-            const int ty = std::min(std::max(iy0, 0) >> tileShift, last);
+            const float lo = -0.5f, hiU = fu - 0.5f, hiV = fv - 0.5f;
+            const int ix0 = static_cast<int>(floorOf(std::clamp(std::min(x0, xe), lo, hiU)));
+            const int ix1 = static_cast<int>(floorOf(std::clamp(std::max(x0, xe), lo, hiU)));
+            const int iy0 = static_cast<int>(floorOf(std::clamp(std::min(y0, ye), lo, hiV)));
+            const int iy1 = static_cast<int>(floorOf(std::clamp(std::max(y0, ye), lo, hiV)));
+            const int tx = std::min(std::max(ix0, 0) >> tileShift, levelTiles[lu] - 1);
+            const int ty = std::min(std::max(iy0, 0) >> tileShift, levelTiles[lv] - 1);
             const int ox = tx << tileShift, oy = ty << tileShift;
             const int size = 1 << tileShift;
             // Texels ix0 .. ix1 + 1 must lie in the tile with its border.
@@ -464,7 +477,7 @@ struct Prober {
                 iy1 + 1 < oy + size + border) {
                 if (const Storage* t = tileAt(chart, level, tx, ty)) {
                     sumLine(n, x0, y0, dx, dy, sum, [&](int i, float x, float y, auto* acc) {
-                        accumulate(t, ox, oy, std::clamp(x, lo, hi), std::clamp(y, lo, hi),
+                        accumulate(t, ox, oy, std::clamp(x, lo, hiU), std::clamp(y, lo, hiV),
                                    weight[i] * scale, acc);
                         return true;
                     });
@@ -495,7 +508,7 @@ struct Prober {
             if (fast && tap(chart, level, x, y, ws, sum)) continue;
             // Missing tiles, half storage, or recency to report: the general path.
             float value[kArr];
-            bilinear(chart, level, (x + 0.5f) / fres, (y + 0.5f) / fres, value);
+            bilinear(chart, level, (x + 0.5f) / fu, (y + 0.5f) / fv, value);
             for (int c = 0; c < channels; ++c) sum[c] += ws * value[c];
         }
     }
@@ -510,9 +523,10 @@ struct Prober {
         if (t == 0.0f) return bilinear(chart, l0, u, v, out);
         if (fast) {
             float sum[kArr] = {};
-            if (tap(chart, l0, u * levelRes[l0] - 0.5f, v * levelRes[l0] - 0.5f, 1.0f - t, sum) &&
-                tap(chart, l0 + 1, u * levelRes[l0 + 1] - 0.5f, v * levelRes[l0 + 1] - 0.5f, t,
-                    sum)) {
+            if (tap(chart, l0, u * resU(chart, l0) - 0.5f, v * resV(chart, l0) - 0.5f, 1.0f - t,
+                    sum) &&
+                tap(chart, l0 + 1, u * resU(chart, l0 + 1) - 0.5f, v * resV(chart, l0 + 1) - 0.5f,
+                    t, sum)) {
                 for (int c = 0; c < channels; ++c) out[c] = sum[c];
                 return;
             }
@@ -525,25 +539,27 @@ struct Prober {
 
     // One texel of a level for EWA, clamped to the chart; missing tiles fall back.
     void texelAt(int chart, int level, int i, int j, float* out) const {
-        const int res = map.resolution(level);
-        i = std::clamp(i, 0, res - 1);
-        j = std::clamp(j, 0, res - 1);
+        const int ru = map.resolutionU(static_cast<uint32_t>(chart), level);
+        const int rv = map.resolutionV(static_cast<uint32_t>(chart), level);
+        i = std::clamp(i, 0, ru - 1);
+        j = std::clamp(j, 0, rv - 1);
         const TileKey key = map.tileOf(static_cast<uint32_t>(chart), level, i, j);
         const int slot = map.slotOf(key);
         if (slot >= 0) {
             map.markUsed(slot);
             return map.texel(key, slot, i, j, out);
         }
-        bilinear(chart, level, (i + 0.5f) / res, (j + 0.5f) / res, out);
+        bilinear(chart, level, (i + 0.5f) / ru, (j + 0.5f) / rv, out);
     }
 
     void ewaLevel(int chart, int level, float u, float v, float ax, float ay, float bx, float by,
                   float* out) const {
         const int channels = kFixed ? kChannels : runtimeChannels;
-        const int res = map.resolution(level);
-        const float scale = static_cast<float>(res) / static_cast<float>(map.resolution(0));
-        ax *= scale, ay *= scale, bx *= scale, by *= scale;
-        const float s = u * res - 0.5f, t = v * res - 0.5f;
+        // The axes come in level-0 texels of each chart axis.
+        const float ru = resU(chart, level), rv = resV(chart, level);
+        const float scaleU = ru / resU(chart, 0), scaleV = rv / resV(chart, 0);
+        ax *= scaleU, ay *= scaleV, bx *= scaleU, by *= scaleV;
+        const float s = u * ru - 0.5f, t = v * rv - 0.5f;
         // The implicit ellipse A s^2 + B s t + C t^2 = 1, widened by one texel.
         float A = ay * ay + by * by + 1.0f, B = -2.0f * (ax * ay + bx * by),
               C = ax * ax + bx * bx + 1.0f;

@@ -62,8 +62,12 @@ ShaderMap::ShaderMap(const Surface& surface, const ShaderKernel& staticPart,
     while ((1 << tileShift_) < options.tileSize) ++tileShift_;
     stride_ = options.tileSize + 2 * options.border;
     tileValues_ = static_cast<size_t>(stride_) * stride_ * static_cast<size_t>(channels_);
-    for (int level = 0; level < levels_; ++level)
-        tilesPerSide_.push_back((resolution(level) + options.tileSize - 1) / options.tileSize);
+    if (options.chartAspect) {
+        ChartShifts shifts =
+            chartShifts(surface, chartShiftRoom(options.resolution, options.tileSize));
+        shiftU_ = std::move(shifts.u);
+        shiftV_ = std::move(shifts.v);
+    }
     pool_ = pool ? std::move(pool) : std::make_shared<TilePool>(tileBytesFor(options, channels_));
     MPSHADE_CHECK(pool_->tileBytes() == tileBytesFor(options, channels_));
     if (options.alwaysResidentLevels > 0 && options.fillPinnedUpFront)
@@ -110,15 +114,17 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
     // can take a millisecond (a gallery statue's), and every tile of the pass left to start
     // had run it before reaching the kernel's check.
     if (stop && stop->stopped()) return false;
-    const int res = resolution(key.level);
+    const int resU = resolutionU(key.chart, key.level), resV = resolutionV(key.chart, key.level);
     const int T = options_.tileSize, border = options_.border;
-    const int k = options_.prefilter == Prefilter::Box
-                      ? std::min(1 << std::min<int>(key.level, 20), options_.supersampleLimit)
-                      : 1;
+    // ku x kv samples a texel, at the level-0 texel centres it covers along each axis (fewer
+    // along an axis whose level has bottomed out at one texel).
+    const bool box = options_.prefilter == Prefilter::Box;
+    const int ku = box ? std::min(resolutionU(key.chart, 0) / resU, options_.supersampleLimit) : 1;
+    const int kv = box ? std::min(resolutionV(key.chart, 0) / resV, options_.supersampleLimit) : 1;
     // Only the texels this level has, plus the border: a level smaller than a tile leaves
     // the rest of the tile unused (probes clamp to the level).
-    const int validW = std::min(stride_, res - key.tx * T + 2 * border);
-    const int validH = std::min(stride_, res - key.ty * T + 2 * border);
+    const int validW = std::min(stride_, resU - key.tx * T + 2 * border);
+    const int validH = std::min(stride_, resV - key.ty * T + 2 * border);
     const size_t channels = static_cast<size_t>(channels_);
     auto texelAt = [&](int li, int lj) {
         return (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) * channels;
@@ -126,8 +132,8 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
     // Interior texels from the four children where they are resident: the mean of the
     // 2 x 2 texels of the level below each covers.
     auto interior = [&](int i, int j) {
-        return fromChildren && i >= key.tx * T && i < (key.tx + 1) * T && i < res &&
-               j >= key.ty * T && j < (key.ty + 1) * T && j < res;
+        return fromChildren && i >= key.tx * T && i < (key.tx + 1) * T && i < resU &&
+               j >= key.ty * T && j < (key.ty + 1) * T && j < resV;
     };
     // Border texels a resident neighbour holds are copied after the batch (copyBorders).
     const Neighbours around = neighboursOf(key, &pending);
@@ -165,12 +171,12 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
         for (int li = 0; li < validW; ++li) {
             const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
             if (skipped(i, j)) continue;
-            for (int sj = 0; sj < k; ++sj)
-                for (int si = 0; si < k; ++si) {
+            for (int sj = 0; sj < kv; ++sj)
+                for (int si = 0; si < ku; ++si) {
                     const float u =
-                        (static_cast<float>(i) + (static_cast<float>(si) + 0.5f) / k) / res;
+                        (static_cast<float>(i) + (static_cast<float>(si) + 0.5f) / ku) / resU;
                     const float v =
-                        (static_cast<float>(j) + (static_cast<float>(sj) + 0.5f) / k) / res;
+                        (static_cast<float>(j) + (static_cast<float>(sj) + 0.5f) / kv) / resV;
                     points.push_back(adjacency_
                                          ? adjacency_->resolve(static_cast<int>(key.chart), u, v)
                                          : ChartPoint{static_cast<int>(key.chart),
@@ -195,7 +201,8 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
         if (!kernel_.run(uniforms_, scratch.in, n, scratch.out, workspace, counters, stop))
             return false;
         float* const* channelOut = scratch.out.channels;
-        const float inv = 1.0f / static_cast<float>(k * k);
+        const int k = ku * kv;
+        const float inv = 1.0f / static_cast<float>(k);
         size_t first = 0;
         for (int lj = 0; lj < validH; ++lj)
             for (int li = 0; li < validW; ++li) {
@@ -204,11 +211,11 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                 const size_t at = texelAt(li, lj);
                 for (size_t c = 0; c < channels; ++c) {
                     float sum = 0.0f;
-                    for (int s = 0; s < k * k; ++s)
+                    for (int s = 0; s < k; ++s)
                         sum += channelOut[c][first + static_cast<size_t>(s)];
                     store(slot, at + c, sum * inv);
                 }
-                first += static_cast<size_t>(k * k);
+                first += static_cast<size_t>(k);
             }
     }
     ++stats.tiles;
@@ -217,14 +224,33 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
     return true;
 }
 
+bool ShaderMap::childrenResident(const TileKey& key) const {
+    // From the children only where that is exactly what evaluating it would give (their
+    // texel centres are its k x k samples), so what a tile holds does not depend on which
+    // tiles happened to be resident; not where an axis has bottomed out at one texel (its
+    // texel is not the mean of a 2 x 2 block there).
+    const int below = key.level - 1;
+    if (resolutionU(key.chart, below) != 2 * resolutionU(key.chart, key.level) ||
+        resolutionV(key.chart, below) != 2 * resolutionV(key.chart, key.level))
+        return false;
+    for (int q = 0; q < 4; ++q) {
+        const int ctx = std::min(2 * key.tx + (q & 1), tilesU(key.chart, below) - 1);
+        const int cty = std::min(2 * key.ty + (q >> 1), tilesV(key.chart, below) - 1);
+        if (slotOf({key.chart, static_cast<uint16_t>(below), static_cast<uint16_t>(ctx),
+                    static_cast<uint16_t>(cty)}) < 0)
+            return false;
+    }
+    return true;
+}
+
 ShaderMap::Neighbours ShaderMap::neighboursOf(const TileKey& key,
                                               const PendingTiles* pending) const {
     Neighbours around;
-    const int n = tilesPerSide(key.level);
+    const int nu = tilesU(key.chart, key.level), nv = tilesV(key.chart, key.level);
     for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
             const int tx = key.tx + dx, ty = key.ty + dy;
-            const bool other = (dx || dy) && tx >= 0 && ty >= 0 && tx < n && ty < n;
+            const bool other = (dx || dy) && tx >= 0 && ty >= 0 && tx < nu && ty < nv;
             const uint64_t packed =
                 TileKey{key.chart, key.level, static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)}
                     .packed();
@@ -239,15 +265,15 @@ ShaderMap::Neighbours ShaderMap::neighboursOf(const TileKey& key,
 }
 
 int ShaderMap::neighbourSlot(const Neighbours& around, const TileKey& key, int i, int j) const {
-    const int res = resolution(key.level);
-    if (i < 0 || j < 0 || i >= res || j >= res) return -1;  // beyond the chart: evaluated
+    if (i < 0 || j < 0 || i >= resolutionU(key.chart, key.level) ||
+        j >= resolutionV(key.chart, key.level))
+        return -1;  // beyond the chart: evaluated
     return around.slot[(j >> tileShift_) - key.ty + 1][(i >> tileShift_) - key.tx + 1];
 }
 
 void ShaderMap::copyBorders(const TileKey& key, int slot, const PendingTiles& pending,
                             FillStats& stats) {
     const int T = options_.tileSize, border = options_.border;
-    const int res = resolution(key.level);
     const Neighbours around = neighboursOf(key, &pending);
     // Both tiles store the same type: the texel's channels are copied as they are.
     const size_t texelBytes = tileBytes() / (static_cast<size_t>(stride_) * stride_);
@@ -255,8 +281,10 @@ void ShaderMap::copyBorders(const TileKey& key, int slot, const PendingTiles& pe
         return tileData(s) +
                (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) * texelBytes;
     };
-    const int validW = std::min(stride_, res - key.tx * T + 2 * border);
-    const int validH = std::min(stride_, res - key.ty * T + 2 * border);
+    const int validW =
+        std::min(stride_, resolutionU(key.chart, key.level) - key.tx * T + 2 * border);
+    const int validH =
+        std::min(stride_, resolutionV(key.chart, key.level) - key.ty * T + 2 * border);
     for (int lj = 0; lj < validH; ++lj)
         for (int li = 0; li < validW; ++li) {
             // Only the frame of the tile can lie in a neighbour.
@@ -277,7 +305,8 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const StopSignal* stop)
     std::unordered_set<uint64_t> seen;
     for (const TileKey& key : keys) {
         MPSHADE_CHECK(key.chart < static_cast<uint32_t>(charts_) && key.level < levels_ &&
-                      key.tx < tilesPerSide(key.level) && key.ty < tilesPerSide(key.level));
+                      key.tx < tilesU(key.chart, key.level) &&
+                      key.ty < tilesV(key.chart, key.level));
         if (table_.find(key.packed()) >= 0 || !seen.insert(key.packed()).second) continue;
         work.push_back(key);
     }
@@ -306,16 +335,7 @@ FillStats ShaderMap::fill(std::span<const TileKey> keys, const StopSignal* stop)
         std::vector<std::pair<int, bool>> plan(end - begin);
         for (size_t w = begin; w < end; ++w) {
             const TileKey& key = work[w];
-            // From the children only where that is exactly what evaluating it would give
-            // (their texel centres are its k x k samples), so what a tile holds does not
-            // depend on which tiles happened to be resident.
-            bool children = buildsFromChildren(key.level);
-            for (int q = 0; q < 4 && children; ++q) {
-                const int ctx = std::min(2 * key.tx + (q & 1), tilesPerSide(key.level - 1) - 1);
-                const int cty = std::min(2 * key.ty + (q >> 1), tilesPerSide(key.level - 1) - 1);
-                children = slotOf({key.chart, static_cast<uint16_t>(key.level - 1),
-                                   static_cast<uint16_t>(ctx), static_cast<uint16_t>(cty)}) >= 0;
-            }
+            const bool children = buildsFromChildren(key.level) && childrenResident(key);
             const bool pinned = key.level >= levels_ - options_.alwaysResidentLevels;
             const int slot = pool_->allocate(this, key.packed(), pinned, useStamp());
             plan[w - begin] = {slot, children};
@@ -425,9 +445,9 @@ void ShaderMap::fillLevels(int first, int last) {
     std::vector<TileKey> keys;
     for (int chart = 0; chart < charts_; ++chart)
         for (int level = first; level <= last; ++level) {
-            const int n = tilesPerSide(level);
-            for (int ty = 0; ty < n; ++ty)
-                for (int tx = 0; tx < n; ++tx)
+            const auto c = static_cast<uint32_t>(chart);
+            for (int ty = 0; ty < tilesV(c, level); ++ty)
+                for (int tx = 0; tx < tilesU(c, level); ++tx)
                     keys.push_back({static_cast<uint32_t>(chart), static_cast<uint16_t>(level),
                                     static_cast<uint16_t>(tx), static_cast<uint16_t>(ty)});
         }

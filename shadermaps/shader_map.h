@@ -2,12 +2,15 @@
 // charts (patent FIG. 5, claims 5-9): the static part of the factored shader evaluated at
 // texel centres, populated on demand, one tile at a time.
 //
-// Layout. Every chart of the surface is a square of R x R texels at level 0 (R a power of
+// Layout. Every chart of the surface is a grid of R x R texels at level 0 (R a power of
 // two up to 2^20), with its own pyramid down to 1 x 1, so coarse levels never mix charts.
 // Level L is R / 2^L texels wide, cut into square tiles of `tileSize` texels; each tile
 // also stores a `border` of texels around it, so a bilinear lookup anywhere in the tile
 // reads one tile. Texel (i, j) of level L covers chart coordinates [i, i + 1] / (R / 2^L)
-// (likewise j); its value is the static program at the texel centre.
+// (likewise j); its value is the static program at the texel centre. A chart whose
+// parameterization is stretched has fewer texels along its longer-texelled axis
+// (chart_aspect.h, with `chartAspect`): R >> (L + shift) along that axis, at least one,
+// so its texels are about square on the surface.
 //
 // Virtual resolution: R is large enough for the finest footprint any frame asks (by
 // default the limit, 2^20, where a float chart coordinate still places a lookup within
@@ -48,6 +51,7 @@
 #include "geometry/chart_adjacency.h"
 #include "geometry/content_digest.h"
 #include "geometry/surface.h"
+#include "shadermaps/chart_aspect.h"
 #include "shadermaps/tile_pool.h"
 #include "shadermaps/tile_table.h"
 #include "shading/interpreter.h"
@@ -75,6 +79,9 @@ struct ShaderMapOptions {
     // find missing before it shades (constant quality, `render`), which never falls back.
     bool fillPinnedUpFront = true;
     bool seamless = true;  // borders from the neighbouring chart; false: clamp to edge
+    // Texels about square on the surface (chart_aspect.h): a stretched chart's longer axis
+    // gets fewer. false: every chart R x R at level 0.
+    bool chartAspect = true;
 };
 
 // A tile: chart, level, and tile column and row within the level.
@@ -137,8 +144,25 @@ class ShaderMap {
     int channels() const { return channels_; }
     int charts() const { return charts_; }
     int levels() const { return levels_; }
+    // The texels a side of `level` of a chart without a shift (chart_aspect.h).
     int resolution(int level) const { return options_.resolution >> level; }
-    int tilesPerSide(int level) const { return tilesPerSide_[static_cast<size_t>(level)]; }
+    // Chart `chart`'s texels along u (resolutionU) and v (resolutionV) at `level`, and the
+    // tiles they make: at least one each.
+    int resolutionU(uint32_t chart, int level) const {
+        return std::max(1, options_.resolution >> (level + shiftU(chart)));
+    }
+    int resolutionV(uint32_t chart, int level) const {
+        return std::max(1, options_.resolution >> (level + shiftV(chart)));
+    }
+    int tilesU(uint32_t chart, int level) const {
+        return (resolutionU(chart, level) + options_.tileSize - 1) >> tileShift_;
+    }
+    int tilesV(uint32_t chart, int level) const {
+        return (resolutionV(chart, level) + options_.tileSize - 1) >> tileShift_;
+    }
+    // Each chart's shifts (chart_aspect.h); 0 for a chart id beyond the surface's.
+    int shiftU(uint32_t chart) const { return chart < shiftU_.size() ? shiftU_[chart] : 0; }
+    int shiftV(uint32_t chart) const { return chart < shiftV_.size() ? shiftV_[chart] : 0; }
     const ShaderMapOptions& options() const { return options_; }
 
     bool resident(const TileKey& key) const { return slotOf(key) >= 0; }
@@ -178,10 +202,9 @@ class ShaderMap {
 
     // The tile holding texel (i, j) of a level (clamped to the level).
     TileKey tileOf(uint32_t chart, int level, int i, int j) const {
-        const int n = tilesPerSide(level);
         return {chart, static_cast<uint16_t>(level),
-                static_cast<uint16_t>(std::clamp(i >> tileShift_, 0, n - 1)),
-                static_cast<uint16_t>(std::clamp(j >> tileShift_, 0, n - 1))};
+                static_cast<uint16_t>(std::clamp(i >> tileShift_, 0, tilesU(chart, level) - 1)),
+                static_cast<uint16_t>(std::clamp(j >> tileShift_, 0, tilesV(chart, level) - 1))};
     }
 
     // Reads the channels of texel (i, j), which must lie in the tile `key` or its border:
@@ -232,6 +255,9 @@ class ShaderMap {
     // it must be evaluated (no such tile resident, or beyond the chart's edge).
     int neighbourSlot(const Neighbours& around, const TileKey& key, int i, int j) const;
     void copyBorders(const TileKey& key, int slot, const PendingTiles& pending, FillStats& stats);
+    // Whether tile `key` (level > 0) can be built as the mean of its four children, all of
+    // them resident.
+    bool childrenResident(const TileKey& key) const;
     // Writes a pass's filled tiles (work[begin, end) with their plan, those not read from
     // the store) to it, as one pack (holding the map's fill lock).
     void storeFilled(std::span<const TileKey> work, size_t begin, size_t end,
@@ -246,10 +272,10 @@ class ShaderMap {
     ShadingUniforms uniforms_;
     ShaderMapOptions options_;
     int charts_ = 0, channels_ = 0, levels_ = 0;
-    int stride_ = 0;         // texels per tile side with borders
-    int tileShift_ = 4;      // log2(tileSize)
-    size_t tileValues_ = 0;  // floats (or halves) per tile
-    std::vector<int> tilesPerSide_;
+    int stride_ = 0;                        // texels per tile side with borders
+    int tileShift_ = 4;                     // log2(tileSize)
+    size_t tileValues_ = 0;                 // floats (or halves) per tile
+    std::vector<uint8_t> shiftU_, shiftV_;  // per chart (chart_aspect.h); empty: none
     TileTable table_;
     std::shared_ptr<TilePool> pool_;  // tile storage
     std::atomic<size_t> residentTiles_{0};

@@ -56,7 +56,7 @@ TEST(TileFiller, EachRoomPolicyFillsAtTheBudgetExactlyAndStopsOneByteUnder) {
     for (CacheRoom room : {CacheRoom::EvictWithin, CacheRoom::RoomLeft}) {
         for (size_t under : {size_t{0}, size_t{1}}) {
             MapFixture f;
-            ASSERT_GE(f.map().tilesPerSide(0), 4);
+            ASSERT_GE(f.map().tilesU(0, 0), 4);
             const std::vector<TileRequest> tiles = f.finest(3);
             TileCache cache(f.held() + 3 * f.map().tileBytes() - under);
             TileFiller filler(f.statics, cache);
@@ -142,7 +142,7 @@ TEST(TileFiller, ADeadlineAlreadyPastFillsNothing) {
 TEST(TileFiller, AChunkStillRunningAtTheDeadlineStopsAndLeavesItsTiles) {
     MapFixture f;
     TileCache cache(size_t{1} << 30);
-    const int side = f.map().tilesPerSide(0);
+    const int side = std::min(f.map().tilesU(0, 0), f.map().tilesV(0, 0));
     ASSERT_GE(side, 8);
     // Deadlines ever further off until one lands inside a chunk (a vase tile is a
     // millisecond or so of occlusion rays; the first chunk is two tiles, unmeasured).

@@ -81,8 +81,8 @@ TEST(TilePrefetch, ATileNoFrameReadsIsWastedAfterThePatience) {
     // The finest level's corner tile of the vase's first chart: no 96x54 frame reads it.
     const size_t vase = scene.objects[0].name == "vase" ? 0 : 1;
     const ShaderMap& map = *renderer.representation(vase)->map;
-    const TileKey corner{0, 0, static_cast<uint16_t>(map.tilesPerSide(0) - 1),
-                         static_cast<uint16_t>(map.tilesPerSide(0) - 1)};
+    const TileKey corner{0, 0, static_cast<uint16_t>(map.tilesU(0, 0) - 1),
+                         static_cast<uint16_t>(map.tilesV(0, 0) - 1)};
     const TileRequest unread{static_cast<uint32_t>(vase), corner};
     FrameStats slack;
     renderer.prefetch(std::span<const TileRequest>(&unread, 1), 60.0, slack);
@@ -167,8 +167,8 @@ TEST(TilePrefetch, NeighboursOfMissingTilesAreAdjacentAndNotResident) {
     for (const TileRequest& r : adjacent) {
         const ShaderMap& map = *renderer.representation(r.object)->map;
         EXPECT_FALSE(map.resident(r.key));
-        EXPECT_LT(r.key.tx, map.tilesPerSide(r.key.level));
-        EXPECT_LT(r.key.ty, map.tilesPerSide(r.key.level));
+        EXPECT_LT(r.key.tx, map.tilesU(r.key.chart, r.key.level));
+        EXPECT_LT(r.key.ty, map.tilesV(r.key.chart, r.key.level));
     }
     for (size_t k = 1; k < adjacent.size(); ++k)
         EXPECT_FALSE(adjacent[k].object == adjacent[k - 1].object &&

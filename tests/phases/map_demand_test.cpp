@@ -20,13 +20,13 @@ namespace {
 // pixel). The chart spans 2 * 240 / distance pixels, so a pixel step is distance / 480 of
 // it, and the probe's footprint 2^20 * distance / 960 level-0 texels: level log2 of that.
 // `occluder`: a second square in front hiding x < 0 of the first, as the eye sees it.
-Scene squareScene(const std::string& name, double lod, bool occluder) {
+Scene squareScene(const std::string& name, double lod, bool occluder,
+                  const std::string& size = "[2, 2]") {
     const double distance = std::exp2(lod) * 960.0 / double(1 << 20);
     const std::string dir = test::testFolder("mpshade_map_demand");
     std::ofstream(dir + "s.sl") << "surface s() { Ci = color(noise(P * 40)); }";
-    std::string objects =
-        R"({"name": "square", "geometry": {"type": "plane", "size": [2, 2]}, "shader": "s",
-            "transform": {"rotate": [1, 0, 0, 90]}})";
+    std::string objects = R"({"name": "square", "geometry": {"type": "plane", "size": )" + size +
+                          R"(}, "shader": "s", "transform": {"rotate": [1, 0, 0, 90]}})";
     if (occluder)
         // Half as far from the eye as the square, so it hides x in [-1, 0] there if it
         // spans x in [-0.5, 0] (and all of y) at its own depth.
@@ -61,6 +61,27 @@ TEST(MapDemand, ASquareFacingTheCameraAsksForTheLevelItsFootprintMatches) {
     EXPECT_DOUBLE_EQ(d.bytes(3, false), 4096.0 * 18 * 18 * 3 * 4);
     EXPECT_DOUBLE_EQ(d.bytes(3, true), 4096.0 * 18 * 18 * 3 * 2);
     EXPECT_DOUBLE_EQ(d.pinnedTiles, 9.0);
+}
+
+TEST(MapDemand, AStretchedRectangleAsksForSquareTexels) {
+    // 2 x 0.5: v spans a quarter of u's length, so its chart has a quarter of the texels
+    // along v (chart_aspect.h): 2^18 a side at level 0, where a sample's step is a quarter of
+    // the chart's v instead of u's -- the same 2^20 * distance / 960 texels both ways, level
+    // 10: 64 x 16 tiles. The always-resident levels: 32 x 8 texels is two tiles, the five
+    // below one each. Square texels (chartAspect off): the level of u, 64 x 64 tiles.
+    const Scene scene = squareScene("g.json", 10.25, false, "[2, 0.5]");
+    const MapDemand d = demandOf(scene);
+    EXPECT_EQ(d.finestLevel, 10);
+    EXPECT_DOUBLE_EQ(d.tiles, 64.0 * 16.0);
+    EXPECT_DOUBLE_EQ(d.pinnedTiles, 7.0);
+    const SceneResources resources(scene, SceneResources::RayScenes::All);
+    const size_t square = 0;
+    MapDemandOptions squareTexels;
+    squareTexels.chartAspect = false;
+    const MapDemand s =
+        estimateMapDemands(resources, std::span<const size_t>(&square, 1), squareTexels)[0];
+    EXPECT_DOUBLE_EQ(s.tiles, 64.0 * 64.0);
+    EXPECT_DOUBLE_EQ(s.pinnedTiles, 9.0);
 }
 
 TEST(MapDemand, LevelsAreReadWhereTheirBlendWeightIsNotZero) {

@@ -1,5 +1,6 @@
 // noise_maps.h -- a float and a half-precision shader map of `channels` noise values (the
-// static part of a test shader, stored however cheap), over a 4 x 4 plane, every level
+// static part of a test shader, stored however cheap), over a 4 x 4 plane (or the plane
+// given: a 4 x 1 one has a quarter of the texels along v, chart_aspect.h), every level
 // filled: what the probe tests read.
 #pragma once
 
@@ -20,7 +21,7 @@ struct NoiseMaps {
     std::unique_ptr<ShaderKernel> kernel;
     std::unique_ptr<ShaderMap> full, half;
 
-    explicit NoiseMaps(int channels) {
+    explicit NoiseMaps(int channels, Plane plane = Plane{4.0f, 4.0f}) : surface(plane) {
         std::string body;
         for (int c = 0; c < channels; ++c)
             body += "  float a" + std::to_string(c) + " = noise(P * " + std::to_string(3 + c) +

@@ -88,6 +88,26 @@ TEST_P(ProbeLanes, EachQueryGetsWhatItGetsAlone) {
             }
 }
 
+// Charts with fewer texels along one axis (chart_aspect.h): 4 x 1 (v a quarter of u's) and
+// 1 x 4 planes, where the lanes and the one-at-a-time path each scale u and v apart.
+TEST_P(ProbeLanes, StretchedChartsGetWhatEachQueryGetsAlone) {
+    for (Plane plane : {Plane{4.0f, 1.0f}, Plane{1.0f, 4.0f}}) {
+        const NoiseMaps maps(GetParam(), plane);
+        ASSERT_NE(maps.full->resolutionU(0, 0), maps.full->resolutionV(0, 0));
+        for (const ProbeOptions& o : felineOptions())
+            for (const std::vector<ProbeQuery>& qs : rows()) {
+                expectAloneEqualsBatch(*maps.full, o, qs, probeShaderMapPortable);
+                if (!probeAvx2Available()) continue;
+                expectAloneEqualsBatch(*maps.full, o, qs, probeShaderMapAvx2);
+                const size_t channels = static_cast<size_t>(GetParam());
+                std::vector<float> a(qs.size() * channels), b(a.size());
+                probeShaderMapAvx2(*maps.full, o, qs, ProbeOutput{a.data()}, nullptr);
+                probeShaderMapPortable(*maps.full, o, qs, ProbeOutput{b.data()}, nullptr);
+                ASSERT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(float)));
+            }
+    }
+}
+
 TEST_P(ProbeLanes, Avx2AndPortableAgreeOnRows) {
     if (!probeAvx2Available()) GTEST_SKIP() << "no AVX2 and F16C on this processor";
     const NoiseMaps maps(GetParam());
