@@ -83,23 +83,14 @@ ObjectCostInputs RepresentationPlanner::costInputs(size_t i, const ObjectSlot& s
     const int tile = mapOptions.tileSize + 2 * mapOptions.border;
     ObjectCostInputs in;
     in.charts = chartCount(*obj.surface);
-    // The map's always-resident levels (StaticPhase::makeShaderMap's resolution and tiles):
-    // at 16-texel tiles the 32 x 32 level is four tiles and the five below one each, fewer
-    // where a chart's texels are fewer along an axis (chart_aspect.h).
-    {
-        const int cap =
-            obj.shadermapResolution > 0 ? obj.shadermapResolution : mapOptions.resolution;
-        int resolution = 1;
-        while (resolution < cap && resolution < (1 << 20)) resolution *= 2;
-        const int tileSize = std::min(mapOptions.tileSize, resolution);
-        const ChartShifts shifts =
-            mapOptions.chartAspect
-                ? chartShifts(*obj.surface, chartShiftRoom(resolution, tileSize))
-                : ChartShifts{std::vector<uint8_t>(static_cast<size_t>(in.charts), 0),
-                              std::vector<uint8_t>(static_cast<size_t>(in.charts), 0)};
-        in.pinnedTiles =
-            coarseLevelTiles(shifts, resolution, tileSize, mapOptions.alwaysResidentLevels);
-    }
+    // The map's always-resident levels: at 16-texel tiles the 32 x 32 level is four tiles
+    // and the five below one each, fewer where a chart's texels are fewer along an axis
+    // (chart_aspect.h).
+    const ShaderMapOptions map = statics_.mapOptions(i);
+    const ChartShifts shifts = chartShifts(
+        *obj.surface, map.chartAspect ? chartShiftRoom(map.resolution, map.tileSize) : 0);
+    in.pinnedTiles =
+        coarseLevelTiles(shifts, map.resolution, map.tileSize, map.alwaysResidentLevels);
     in.pinnedBytes = in.pinnedTiles * tile * tile *
                      static_cast<double>(shading.factored.staticPart.channelOutputs.size()) *
                      (mapOptions.halfPrecision || obj.shadermapHalf ? 2.0 : 4.0);

@@ -221,11 +221,8 @@ std::vector<MapDemand> estimateMapDemands(const SceneResources& resources,
         d.tileTexels = (tiles[n] + 2 * options.border) * (tiles[n] + 2 * options.border);
         while ((d.resolution >> maxLevels[n]) > 1) ++maxLevels[n];
         cells[n] = chartCells(*obj.surface, options.points);
-        const auto charts = static_cast<size_t>(chartCount(*obj.surface));
-        cells[n].shift =
-            options.chartAspect
-                ? chartShifts(*obj.surface, chartShiftRoom(d.resolution, tiles[n]))
-                : ChartShifts{std::vector<uint8_t>(charts, 0), std::vector<uint8_t>(charts, 0)};
+        cells[n].shift = chartShifts(
+            *obj.surface, options.chartAspect ? chartShiftRoom(d.resolution, tiles[n]) : 0);
         d.pinnedTiles = coarseLevelTiles(cells[n].shift, d.resolution, tiles[n],
                                          ShaderMapOptions{}.alwaysResidentLevels);
     }

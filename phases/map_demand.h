@@ -9,14 +9,15 @@
 // major / maxAnisotropy otherwise), and the level above it where the narrow level blend
 // gives that weight. So over a grid of cells on each chart, at frames spread over the scene:
 // the screen Jacobian of the chart coordinates gives the footprint in texels (each chart
-// axis at its own resolution, chart_aspect.h), hence the level; points two a tile side within the
-// cell give the tiles it reads there. A cell wider than a few pixels as seen from the eye is split
-// in four until it is not (a floor seen at a grazing angle from close by). Cells outside the image,
-// behind the near plane, facing away on a closed surface or hidden behind another surface (a ray
-// from the eye, through the frame's world) ask for nothing; a transparent surface in front counts
-// as hiding. The always-resident coarse levels (nine tiles a chart), which `play` fills up front
-// and `render` only where asked, are counted apart. Checked against the tiles a render of that
-// frame fills (tests/phases).
+// axis at its own resolution, chart_aspect.h), hence the level; points two a tile side
+// within the cell give the tiles it reads there. A cell wider than a few pixels as seen
+// from the eye is split in four until it is not (a floor seen at a grazing angle from close
+// by). Cells outside the image, behind the near plane, facing away on a closed surface or
+// hidden behind another surface (a ray from the eye, through the frame's world) ask for
+// nothing; a transparent surface in front counts as hiding. The always-resident coarse
+// levels (nine tiles a chart, fewer where its texels are fewer along an axis), which `play`
+// fills up front and `render` only where asked, are counted apart. Checked against the
+// tiles a render of that frame fills (tests/phases).
 #pragma once
 
 #include <cstddef>

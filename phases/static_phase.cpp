@@ -444,21 +444,26 @@ Digest128 StaticPhase::representationKey(size_t index, bool combined, bool direc
     return h.finish();
 }
 
-// A new map at the object's resolution (its own cap, else the options', rounded up to a
-// power of two), its tiles in the pool for its tile size.
+ShaderMapOptions StaticPhase::mapOptions(size_t object) const {
+    const SceneObject& sceneObject = scene_.objects[object];
+    ShaderMapOptions map = options_.shaderMap;
+    const int cap =
+        sceneObject.shadermapResolution > 0 ? sceneObject.shadermapResolution : map.resolution;
+    int resolution = 1;
+    while (resolution < cap && resolution < (1 << 20)) resolution *= 2;
+    map.resolution = resolution;
+    map.tileSize = std::min(map.tileSize, resolution);
+    map.halfPrecision = map.halfPrecision || sceneObject.shadermapHalf;
+    return map;
+}
+
+// A new map with the object's options (mapOptions), its tiles in the pool for its tile size.
 std::shared_ptr<ShaderMap> StaticPhase::makeShaderMap(size_t index,
                                                       const ShadingUniforms& uniforms) const {
     const ObjectShading& obj = *objects_[index];
     const SceneObject& sceneObject = scene_.objects[index];
     const size_t channels = obj.factored.staticPart.channelOutputs.size();
-    ShaderMapOptions mapOptions = options_.shaderMap;
-    const int cap = sceneObject.shadermapResolution > 0 ? sceneObject.shadermapResolution
-                                                        : mapOptions.resolution;
-    int resolution = 1;
-    while (resolution < cap && resolution < (1 << 20)) resolution *= 2;
-    mapOptions.resolution = resolution;
-    mapOptions.tileSize = std::min(mapOptions.tileSize, resolution);
-    mapOptions.halfPrecision = mapOptions.halfPrecision || sceneObject.shadermapHalf;
+    const ShaderMapOptions mapOptions = this->mapOptions(index);
     return std::make_shared<ShaderMap>(
         *sceneObject.surface, *obj.staticKernel, uniforms, mapOptions,
         pools_.forTileBytes(ShaderMap::tileBytesFor(mapOptions, static_cast<int>(channels))),

@@ -111,6 +111,10 @@ class StaticPhase {
     // Where every map this static phase makes keeps its tiles.
     TilePools& tilePools() const { return pools_; }
     const StaticPhaseOptions& options() const { return options_; }
+    // The options object `object`'s shader map is made with: the options' but for its
+    // resolution (the object's cap, else the options', rounded up to a power of two), a
+    // tile no larger than that, and half precision where the object asks for it.
+    ShaderMapOptions mapOptions(size_t object) const;
 
     // Object `object`'s representation for the view of `camera` (its representative view).
     // `previous` (may be null) lends its shader map when the static part does not read the
