@@ -39,7 +39,7 @@ ChartShifts chartShifts(const Surface& surface, int maxShift) {
         if (!(weight > 0.0)) continue;
         const double mean = sum / weight;
         const int shift = static_cast<int>(
-            std::clamp(std::round(std::fabs(mean)), 0.0, static_cast<double>(maxShift)));
+            std::clamp(std::floor(std::fabs(mean)), 0.0, static_cast<double>(maxShift)));
         // u longer on the surface than v: v needs fewer texels, and the other way round.
         (mean > 0.0 ? s.v : s.u)[static_cast<size_t>(c)] = static_cast<uint8_t>(shift);
     }

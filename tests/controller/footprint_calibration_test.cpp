@@ -235,11 +235,9 @@ TEST(FootprintCalibration, ASmoothObjectWidensAndAFinelyTexturedOneDoesNot) {
     const ObjectReport& fine = measured.report(1);
     ASSERT_GT(smooth.footprint.pixels, 256u);
     ASSERT_GT(fine.footprint.pixels, 256u);
-    // Bisection over the six candidates: up to 1.78 for the smooth one (at 2 its baked
-    // lighting changes 1.2 times what is allowed: a sphere's latitude has half the texels
-    // of its longitude, chart_aspect.h, so neither axis has texels to spare), down past the
-    // smallest for the fine one.
-    EXPECT_EQ(smooth.footprintScale, 1.78f);
+    // Bisection over the six candidates: up to the largest for the smooth one, down past
+    // the smallest for the fine one.
+    EXPECT_EQ(smooth.footprintScale, 2.0f);
     EXPECT_EQ(smooth.footprint.scales, (std::vector<float>{1.41f, 1.78f, 2.0f}));
     EXPECT_EQ(fine.footprintScale, 1.0f);
     EXPECT_EQ(fine.footprint.scales, (std::vector<float>{1.41f, 1.12f}));

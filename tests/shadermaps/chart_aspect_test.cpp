@@ -27,15 +27,17 @@ Shift shiftOf(const Surface& surface, int maxShift = kMaxChartShift) {
 }
 
 TEST(ChartAspect, ShiftsFollowTheParameterizationsStretch) {
-    // A plane's u spans its width, v its depth: log2(width / depth), rounded.
+    // A plane's u spans its width, v its depth: log2(width / depth), rounded down.
     EXPECT_EQ(shiftOf(Plane{4.0f, 4.0f}).u + shiftOf(Plane{4.0f, 4.0f}).v, 0);
     EXPECT_EQ(shiftOf(Plane{4.0f, 1.0f}).v, 2);
     EXPECT_EQ(shiftOf(Plane{4.0f, 1.0f}).u, 0);
     EXPECT_EQ(shiftOf(Plane{1.0f, 4.0f}).u, 2);
     EXPECT_EQ(shiftOf(Plane{1.0f, 4.0f}).v, 0);
-    // Either side of 2^1.5 = 2.83.
-    EXPECT_EQ(shiftOf(Plane{2.8f, 1.0f}).v, 1);
-    EXPECT_EQ(shiftOf(Plane{2.9f, 1.0f}).v, 2);
+    // Either side of 2 and of 4.
+    EXPECT_EQ(shiftOf(Plane{1.9f, 1.0f}).v, 0);
+    EXPECT_EQ(shiftOf(Plane{2.1f, 1.0f}).v, 1);
+    EXPECT_EQ(shiftOf(Plane{3.9f, 1.0f}).v, 1);
+    EXPECT_EQ(shiftOf(Plane{4.1f, 1.0f}).v, 2);
     // 64:1 is capped: at kMaxChartShift, or what the map's resolution leaves room for.
     EXPECT_EQ(shiftOf(Plane{64.0f, 1.0f}).v, kMaxChartShift);
     EXPECT_EQ(shiftOf(Plane{64.0f, 1.0f}, 1).v, 1);
@@ -43,10 +45,13 @@ TEST(ChartAspect, ShiftsFollowTheParameterizationsStretch) {
     // A torus: |dP/du| = 2 pi (R + r cos 2 pi v), |dP/dv| = 2 pi r, the area their product.
     // Over the 4 x 4 grid's rows cos = +-0.7071: R 1, r 0.25 weighs log2 4.707 = 2.235 by
     // 1.177 and log2 3.293 = 1.719 by 0.823, mean 2.02; r 0.5 gives 1.437 by 1.354 and 0.371
-    // by 0.646, mean 1.09.
+    // by 0.646, mean 1.09; a sphere's rows (sin of latitude 0.383 and 0.924 weigh log2 of
+    // twice that) 0.51.
     EXPECT_EQ(shiftOf(Torus{1.0f, 0.25f}).v, 2);
     EXPECT_EQ(shiftOf(Torus{1.0f, 0.5f}).v, 1);
     EXPECT_EQ(shiftOf(Torus{1.0f, 0.5f}).u, 0);
+    EXPECT_EQ(shiftOf(Sphere{1.0f}).v, 0);
+    EXPECT_EQ(shiftOf(Sphere{1.0f}).u, 0);
 }
 
 TEST(ChartAspect, ManyChartsKeepSquareGrids) {
@@ -60,9 +65,10 @@ TEST(ChartAspect, ManyChartsKeepSquareGrids) {
     ASSERT_EQ(s.u.size(), cloud.centers.size());
     for (size_t c = 0; c < s.u.size(); ++c) ASSERT_EQ(s.u[c] + s.v[c], 0) << c;
     // One disc less and they are measured: a disc's u runs out from its centre, so a polar
-    // chart's rings are longer than its spokes (the area-weighted mean of log2(1 / 2 pi u)).
+    // chart's rings are longer than its spokes (the area-weighted mean of log2(1 / 2 pi u),
+    // -1.9 over the grid).
     cloud.centers.pop_back(), cloud.normals.pop_back(), cloud.radii.pop_back();
-    EXPECT_EQ(chartShifts(cloud).u[0], 2);
+    EXPECT_EQ(chartShifts(cloud).u[0], 1);
 }
 
 TEST(ChartAspect, CoarseLevelTilesCountEachAxis) {
