@@ -17,6 +17,7 @@
 
 #include "phases/facet_rasterizer.h"
 #include "phases/image.h"
+#include "phases/sample_depth_test.h"
 #include "phases/sample_pattern.h"
 
 namespace mpshade {
@@ -92,6 +93,63 @@ BENCHMARK_CAPTURE(rasterGrid, cell4_spp4, 4, 4.0f)
     ->Name("Raster/640x360/4spp/facets_4px")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// The sample test alone, by kernel: rows of `n` samples (a facet n / 4 pixels across at 4
+// spp), 8 rows a call, facets alternating between one that covers about half the samples
+// and one behind it, over a 32 x 32-pixel tile's worth of rows. Items: samples.
+void depthTest(benchmark::State& state, DepthTestKernel kernel, size_t n) {
+    if (!depthTestKernelAvailable(kernel)) {
+        state.SkipWithError("not available on this processor");
+        return;
+    }
+    const size_t stride = 128 * 4, rows = 32;
+    std::vector<int32_t> fx(rows * stride), fy(rows * stride);
+    for (size_t r = 0; r < rows; ++r)
+        for (size_t i = 0; i < stride; ++i) {
+            fx[r * stride + i] = static_cast<int32_t>(64 * i + 37 * (i % 4));
+            fy[r * stride + i] = static_cast<int32_t>(256 * r + 91 * (i % 4));
+        }
+    std::vector<float> inv(rows * stride, 0.0f);
+    std::vector<uint32_t> object(rows * stride), facet(rows * stride);
+    FacetEdges near{}, far{};
+    // near: inside where lx > ly / 2 (half the box); far: everywhere, at a smaller 1 / depth.
+    near.c[0] = 1.0, near.a[0] = 2.0, near.b[0] = -1.0;
+    near.c[1] = near.c[2] = 1e9;
+    near.zc = 0.5, near.zx = 1e-6, near.zy = -1e-6;
+    far = near;
+    far.c[0] = 1e9, far.zc = 0.25;
+    uint32_t inside = 0, id = 0;
+    for (auto _ : state) {
+        for (size_t r = 0; r + 8 <= rows; r += 8) {
+            const size_t at = r * stride;
+            const SampleRows sr{fx.data() + at,
+                                fy.data() + at,
+                                inv.data() + at,
+                                object.data() + at,
+                                facet.data() + at,
+                                8,
+                                n,
+                                stride};
+            inside += depthTestRowsWith(kernel, sr, {(++id & 1) ? &near : &far, 0, 0, true, 1, id});
+        }
+        benchmark::DoNotOptimize(inside);
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * rows * n));
+}
+
+void registerDepthTests() {
+    const std::pair<const char*, DepthTestKernel> kernels[] = {
+        {"compiled", DepthTestKernel::Compiled},
+        {"avx2", DepthTestKernel::Avx2},
+        {"avx512", DepthTestKernel::Avx512}};
+    for (const auto& [name, kernel] : kernels)
+        for (size_t n : {4, 8, 16, 64, 128, 512})
+            benchmark::RegisterBenchmark(
+                ("DepthTest/" + std::string(name) + "/row_" + std::to_string(n)).c_str(),
+                [kernel = kernel, n](benchmark::State& s) { depthTest(s, kernel, n); });
+}
+const int depthTestsRegistered = (registerDepthTests(), 0);
 
 // A run's sample layout made from nothing, as its first frame makes it: positions, filter
 // taps and the per-pixel and per-block weights, their memory first touched.

@@ -3,13 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
-
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "phases/sample_depth_test.h"
 #include "phases/work_deadline.h"
 
 namespace mpshade {
@@ -71,16 +68,8 @@ inline ScreenTriangle screenTriangle(const WarpedVertices& w, const uint32_t* p)
     return t;
 }
 
-// A facet's edge functions and depth relative to a tile's origin (ox, oy), in 1/256
-// pixels: e_i(lx, ly) = c_i + a_i lx + b_i ly, inside when every e_i > 0 (the tie rule
-// folded into c_i: e_i are integers, so e_i >= 0 becomes e_i + 1 > 0); 1 / depth =
-// zc + zx lx + zy ly. Every value below 2^53 is an exact integer in double.
-struct Setup {
-    double c[3], a[3], b[3];
-    double zc, zx, zy;
-};
-
-void setUp(const ScreenTriangle& tri, int64_t ox, int64_t oy, Setup& s) {
+// A facet's edge functions and depth relative to a tile's origin (ox, oy), in 1/256 pixels.
+void setUp(const ScreenTriangle& tri, int64_t ox, int64_t oy, FacetEdges& s) {
     int64_t x[3] = {tri.x[0], tri.x[1], tri.x[2]}, y[3] = {tri.y[0], tri.y[1], tri.y[2]};
     float w[3] = {tri.invDepth[0], tri.invDepth[1], tri.invDepth[2]};
     int64_t area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
@@ -105,137 +94,6 @@ void setUp(const ScreenTriangle& tri, int64_t ox, int64_t oy, Setup& s) {
         s.zy += w[i] * static_cast<double>(dx) * invArea;
     }
 }
-
-// Rows of samples against one facet, single layer: a depth test where the sample is
-// inside. `rows` runs of n samples, `stride` apart in every array. Returns the samples
-// inside. The hot loop of the rasterizer: plain arithmetic on doubles that GCC vectorizes,
-// compiled for AVX-512, AVX2 and the baseline, chosen at run time; one call per facet and tile,
-// since facets a few pixels across made the call per row cost as much as its work.
-__attribute__((target_clones("avx512f", "avx2", "default"))) uint32_t boxDepthTest(
-    const int32_t* fx, const int32_t* fy, size_t rows, size_t n, size_t stride, int32_t ox,
-    int32_t oy, const Setup& s, bool edges, float* inv, uint32_t* object, uint32_t* facet,
-    uint32_t o, uint32_t f) {
-    const double c0 = s.c[0], c1 = s.c[1], c2 = s.c[2];
-    const double a0 = s.a[0], a1 = s.a[1], a2 = s.a[2];
-    const double b0 = s.b[0], b1 = s.b[1], b2 = s.b[2];
-    const double zc = s.zc, zx = s.zx, zy = s.zy;
-    uint32_t inside = 0;
-    for (size_t r = 0; r < rows;
-         ++r, fx += stride, fy += stride, inv += stride, object += stride, facet += stride) {
-        if (edges) {
-            for (size_t i = 0; i < n; ++i) {
-                const double lx = fx[i] - ox, ly = fy[i] - oy;
-                const bool in = (c0 + a0 * lx + b0 * ly > 0.0) & (c1 + a1 * lx + b1 * ly > 0.0) &
-                                (c2 + a2 * lx + b2 * ly > 0.0);
-                const float z = static_cast<float>(zc + zx * lx + zy * ly);
-                const bool hit = in & (z > inv[i]);
-                inside += in;
-                inv[i] = hit ? z : inv[i];
-                object[i] = hit ? o : object[i];
-                facet[i] = hit ? f : facet[i];
-            }
-        } else {
-            for (size_t i = 0; i < n; ++i) {
-                const double lx = fx[i] - ox, ly = fy[i] - oy;
-                const float z = static_cast<float>(zc + zx * lx + zy * ly);
-                const bool hit = z > inv[i];
-                inv[i] = hit ? z : inv[i];
-                object[i] = hit ? o : object[i];
-                facet[i] = hit ? f : facet[i];
-            }
-            inside += static_cast<uint32_t>(n);
-        }
-    }
-    return inside;
-}
-
-// Rows of up to this many samples go to boxDepthTestAvx512; longer ones (facets wider than
-// 16 pixels at 4 spp: a floor covering whole tiles) to GCC's clones, which are faster
-// there. One thread: the grazing floor's rasterizing 0.28 ms a frame either way, against
-// 0.37 ms with every row by hand; `Raster/640x360/4spp/facets_4px` 4.7 ms against 7.0 ms
-// with rows of up to 16 by hand.
-constexpr size_t kShortRow = 64;
-
-#if defined(__x86_64__)
-// boxDepthTest by hand in AVX-512: a row's samples eight at a time in double lanes, the
-// last eight masked rather than a scalar tail, the count by a population count of masks.
-// Facets a pixel or two across give rows of 4-16 samples, where GCC's vectorized loop
-// spent most of its time on its tail and on summing its count lane by lane (42% of
-// rasterizing 1-pixel facets went to boxDepthTest). The same arithmetic in the same order
-// as boxDepthTest (edge values exact integers in double; the depth plane unfused), so the
-// same bits. (GCC 12's conversion intrinsics start from an undefined vector, which
-// -Wmaybe-uninitialized reports inside the header.)
-#pragma GCC diagnostic push
-#if !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-__attribute__((target("avx512f,avx512vl"))) uint32_t boxDepthTestAvx512(
-    const int32_t* fx, const int32_t* fy, size_t rows, size_t n, size_t stride, int32_t ox,
-    int32_t oy, const Setup& s, bool edges, float* inv, uint32_t* object, uint32_t* facet,
-    uint32_t o, uint32_t f) {
-    const __m512d c0 = _mm512_set1_pd(s.c[0]), c1 = _mm512_set1_pd(s.c[1]),
-                  c2 = _mm512_set1_pd(s.c[2]);
-    const __m512d a0 = _mm512_set1_pd(s.a[0]), a1 = _mm512_set1_pd(s.a[1]),
-                  a2 = _mm512_set1_pd(s.a[2]);
-    const __m512d b0 = _mm512_set1_pd(s.b[0]), b1 = _mm512_set1_pd(s.b[1]),
-                  b2 = _mm512_set1_pd(s.b[2]);
-    const __m512d zc = _mm512_set1_pd(s.zc), zx = _mm512_set1_pd(s.zx), zy = _mm512_set1_pd(s.zy);
-    const __m512d zero = _mm512_setzero_pd();
-    const __m256i ox8 = _mm256_set1_epi32(ox), oy8 = _mm256_set1_epi32(oy);
-    const __m256i o8 = _mm256_set1_epi32(static_cast<int>(o)),
-                  f8 = _mm256_set1_epi32(static_cast<int>(f));
-    uint32_t inside = 0;
-    for (size_t r = 0; r < rows;
-         ++r, fx += stride, fy += stride, inv += stride, object += stride, facet += stride) {
-        for (size_t i = 0; i < n; i += 8) {
-            const size_t left = n - i;
-            const __mmask8 lanes =
-                left >= 8 ? __mmask8(0xFF) : static_cast<__mmask8>((1u << left) - 1u);
-            const __m512d lx =
-                _mm512_cvtepi32_pd(_mm256_sub_epi32(_mm256_maskz_loadu_epi32(lanes, fx + i), ox8));
-            const __m512d ly =
-                _mm512_cvtepi32_pd(_mm256_sub_epi32(_mm256_maskz_loadu_epi32(lanes, fy + i), oy8));
-            __mmask8 in = lanes;
-            if (edges) {
-                const __m512d e0 =
-                    _mm512_add_pd(_mm512_add_pd(c0, _mm512_mul_pd(a0, lx)), _mm512_mul_pd(b0, ly));
-                const __m512d e1 =
-                    _mm512_add_pd(_mm512_add_pd(c1, _mm512_mul_pd(a1, lx)), _mm512_mul_pd(b1, ly));
-                const __m512d e2 =
-                    _mm512_add_pd(_mm512_add_pd(c2, _mm512_mul_pd(a2, lx)), _mm512_mul_pd(b2, ly));
-                in = _mm512_mask_cmp_pd_mask(in, e0, zero, _CMP_GT_OQ);
-                in = _mm512_mask_cmp_pd_mask(in, e1, zero, _CMP_GT_OQ);
-                in = _mm512_mask_cmp_pd_mask(in, e2, zero, _CMP_GT_OQ);
-            }
-            const __m256 z = _mm512_cvtpd_ps(
-                _mm512_add_pd(_mm512_add_pd(zc, _mm512_mul_pd(zx, lx)), _mm512_mul_pd(zy, ly)));
-            const __mmask8 hit =
-                _mm256_mask_cmp_ps_mask(in, z, _mm256_maskz_loadu_ps(in, inv + i), _CMP_GT_OQ);
-            _mm256_mask_storeu_ps(inv + i, hit, z);
-            _mm256_mask_storeu_epi32(object + i, hit, o8);
-            _mm256_mask_storeu_epi32(facet + i, hit, f8);
-            inside += static_cast<uint32_t>(__builtin_popcount(in));
-        }
-    }
-    return inside;
-}
-#pragma GCC diagnostic pop
-
-bool boxDepthTestAvx512Available() {
-    static const bool available =
-        __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
-    return available;
-}
-#else
-bool boxDepthTestAvx512Available() {
-    return false;
-}
-uint32_t boxDepthTestAvx512(const int32_t* fx, const int32_t* fy, size_t rows, size_t n,
-                            size_t stride, int32_t ox, int32_t oy, const Setup& s, bool edges,
-                            float* inv, uint32_t* object, uint32_t* facet, uint32_t o, uint32_t f) {
-    return boxDepthTest(fx, fy, rows, n, stride, ox, oy, s, edges, inv, object, facet, o, f);
-}
-#endif
 
 // Per thread: one tile's samples, `layers` slots each, local while the tile is drawn.
 struct TileScratch {
@@ -452,7 +310,6 @@ class TileRasterizer {
           ty1_(std::min(grid.height, ty0_ + grid.tile) - 1),
           rowSamples_(static_cast<size_t>(tx1_ - tx0_ + 1) * grid.spp),
           direct_(grid.layers == 1),
-          avx512_(boxDepthTestAvx512Available()),
           ox_(tx0_ << kSub),
           oy_(ty0_ << kSub),
           cornerX_{0.0, static_cast<double>((tx1_ - tx0_ + 1) << kSub)},
@@ -482,7 +339,7 @@ class TileRasterizer {
 
     void draw(const ScreenTriangle& tri, uint32_t object, uint32_t facet, bool opaque,
               const std::vector<uint8_t>& objectOpaque) {
-        Setup su;
+        FacetEdges su;
         setUp(tri, ox_, oy_, su);
         const int32_t minX = std::min({tri.x[0], tri.x[1], tri.x[2]}),
                       maxX = std::max({tri.x[0], tri.x[1], tri.x[2]});
@@ -518,11 +375,15 @@ class TileRasterizer {
         const int spp = grid_.spp;
         if (direct_) {
             const size_t g = samples_.index(bx0, by0, 0);
-            const size_t n = static_cast<size_t>(bx1 - bx0 + 1) * spp;
-            s_.fragments += (avx512_ && n <= kShortRow ? boxDepthTestAvx512 : boxDepthTest)(
-                fx_ + g, fy_ + g, static_cast<size_t>(by1 - by0 + 1), n,
-                static_cast<size_t>(grid_.width) * spp, ox_, oy_, su, !whole, &out_.invDepth[g],
-                &out_.object[g], &out_.facet[g], object, facet);
+            const SampleRows rows{fx_ + g,
+                                  fy_ + g,
+                                  &out_.invDepth[g],
+                                  &out_.object[g],
+                                  &out_.facet[g],
+                                  static_cast<size_t>(by1 - by0 + 1),
+                                  static_cast<size_t>(bx1 - bx0 + 1) * spp,
+                                  static_cast<size_t>(grid_.width) * spp};
+            s_.fragments += depthTestRows(rows, {&su, ox_, oy_, !whole, object, facet});
             return;
         }
         for (int py = by0; py <= by1; ++py) {
@@ -575,7 +436,6 @@ class TileRasterizer {
     const int tx0_, ty0_, tx1_, ty1_;
     const size_t rowSamples_;
     const bool direct_;
-    const bool avx512_;  // boxDepthTestAvx512 for the sample tests
     const int32_t ox_, oy_;
     const double cornerX_[2], cornerY_[2];
 };
