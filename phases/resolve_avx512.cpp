@@ -1,4 +1,4 @@
-#include "phases/resolve_avx512.h"
+#include "phases/resolve_builds.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 

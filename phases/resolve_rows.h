@@ -1,10 +1,10 @@
 // resolve_rows.h -- a band of SampleLayout::resolve (sample_pattern.h): the per-sample
 // colors of the rows in the filter's reach added, weighted, to the band's pixels. Included
-// by sample_pattern.cpp (the baseline build) and resolve_avx512.cpp (built for AVX-512 and
-// chosen at run time); internal linkage, so each file has its own copy for its own
-// instruction set. Both files build with contraction off, and the AVX-512 sum of a pixel's
-// samples does per lane the very multiplications and additions of the baseline's, in the
-// same order: the two builds give the same bits.
+// by sample_pattern.cpp (the baseline build), resolve_avx512.cpp and resolve_avx2.cpp
+// (built for AVX-512 and AVX2 and chosen at run time); internal linkage, so each file has its
+// own copy for its own instruction set. The files build with contraction off, and the wider
+// builds' sum of a pixel's samples does per lane the very multiplications and additions of
+// the baseline's, in the same order: every build gives the same bits.
 #pragma once
 
 #include <algorithm>
@@ -15,7 +15,7 @@
 #include "geometry/float4.h"
 #include "phases/resolve_frame.h"
 
-#if defined(MPSHADE_RESOLVE_AVX512)
+#if defined(MPSHADE_RESOLVE_AVX512) || defined(MPSHADE_RESOLVE_AVX2)
 #include <immintrin.h>
 #endif
 
@@ -69,6 +69,32 @@ template <int columns>
             o + 4, _mm_add_ps(_mm_loadu_ps(o + 4), _mm512_maskz_extractf32x4_ps(0xF, sum[r], 1)));
         _mm_storeu_ps(
             o + 8, _mm_add_ps(_mm_loadu_ps(o + 8), _mm512_maskz_extractf32x4_ps(0xF, sum[r], 2)));
+    }
+#elif defined(MPSHADE_RESOLVE_AVX2)
+    // Two columns' products side by side, (w0 c | w1 c), and the third alone: ten
+    // multiplications and additions a sample against the baseline's twenty-one, the same
+    // products in each lane.
+    const __m256i pair = _mm256_setr_epi32(0, 0, 0, 0, 1, 1, 1, 1);
+    __m256 sum01[3] = {_mm256_setzero_ps(), _mm256_setzero_ps(), _mm256_setzero_ps()};
+    __m128 sum2[3] = {_mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps()};
+    for (size_t s = first; s < last; ++s) {
+        const float* w = weights + s * 6;
+        const __m128 c = _mm_loadu_ps(rgba + 4 * s);
+        const __m256 w01 = _mm256_permutevar8x32_ps(_mm256_castps128_ps256(_mm_loadu_ps(w)), pair);
+        const __m256 cw01 = _mm256_mul_ps(w01, _mm256_set_m128(c, c));
+        const __m128 cw2 = _mm_mul_ps(_mm_set1_ps(w[2]), c);
+        for (int r = 0; r < 3; ++r) {
+            sum01[r] = _mm256_add_ps(sum01[r], _mm256_mul_ps(_mm256_set1_ps(w[3 + r]), cw01));
+            sum2[r] = _mm_add_ps(sum2[r], _mm_mul_ps(_mm_set1_ps(w[3 + r]), cw2));
+        }
+    }
+    for (int r = 0; r < 3; ++r) {
+        const int py = qy - 1 + r;
+        if (py < py0 || py > py1) continue;
+        float* o = pixels + (static_cast<size_t>(py) * width + qx - 1) * 4;
+        _mm_storeu_ps(o, _mm_add_ps(_mm_loadu_ps(o), _mm256_castps256_ps128(sum01[r])));
+        _mm_storeu_ps(o + 4, _mm_add_ps(_mm_loadu_ps(o + 4), _mm256_extractf128_ps(sum01[r], 1)));
+        _mm_storeu_ps(o + 8, _mm_add_ps(_mm_loadu_ps(o + 8), sum2[r]));
     }
 #else
     Float4 sum[3][3];

@@ -13,7 +13,7 @@
 
 #include "geometry/error.h"
 #include "geometry/float4.h"
-#include "phases/resolve_avx512.h"
+#include "phases/resolve_builds.h"
 #include "phases/resolve_rows.h"
 
 namespace mpshade {
@@ -28,7 +28,41 @@ uint32_t mix32(uint32_t h) {
     return h;
 }
 
+using ResolveRows = void (*)(const ResolveFrame&, int, int);
+
+void resolveRowsPortable(const ResolveFrame& frame, int r0, int r1) {
+    resolveRowsOf(frame, r0, r1);
+}
+
+// The rows of `build` (Fastest: the widest the processor runs).
+ResolveRows resolveRowsFor(ResolveBuild build) {
+    if (build == ResolveBuild::Fastest)
+        build = resolveAvx512Available() ? ResolveBuild::Avx512
+                : resolveAvx2Available() ? ResolveBuild::Avx2
+                                         : ResolveBuild::Portable;
+    MPSHADE_CHECK(resolveBuildAvailable(build));
+    switch (build) {
+        case ResolveBuild::Avx512:
+            return resolveRowsAvx512;
+        case ResolveBuild::Avx2:
+            return resolveRowsAvx2;
+        default:
+            return resolveRowsPortable;
+    }
+}
+
 }  // namespace
+
+bool resolveBuildAvailable(ResolveBuild build) {
+    switch (build) {
+        case ResolveBuild::Avx512:
+            return resolveAvx512Available();
+        case ResolveBuild::Avx2:
+            return resolveAvx2Available();
+        default:
+            return true;
+    }
+}
 
 void* SampleLayout::allocateLarge(size_t bytes) {
     constexpr size_t kHuge = size_t{2} << 20;
@@ -293,14 +327,11 @@ void SampleLayout::resolve(const float* rgba, const uint8_t* uniform, Image& out
     // costs more than it finds).
     ResolveFrame f = resolveFrame(rgba, uniform, quads);
     f.pixels = out.rgba.data();
-    const bool avx512 = build == ResolveBuild::Fastest && resolveAvx512Available();
+    const auto rows = resolveRowsFor(build);
     constexpr int kBand = 8;
     tbb::parallel_for(0, (height_ + kBand - 1) / kBand, [&](int band) {
         const int r0 = band * kBand, r1 = std::min(height_, r0 + kBand);
-        if (avx512)
-            resolveRowsAvx512(f, r0, r1);
-        else
-            resolveRowsOf(f, r0, r1);
+        rows(f, r0, r1);
     });
 }
 
@@ -326,7 +357,7 @@ void SampleLayout::resolveRects(const float* rgba, const uint8_t* uniform, Image
                                 ResolveBuild build) const {
     MPSHADE_CHECK(out.width == width_ && out.height == height_);
     const ResolveFrame frame = resolveFrame(rgba, uniform, quads);
-    const bool avx512 = build == ResolveBuild::Fastest && resolveAvx512Available();
+    const auto rows = resolveRowsFor(build);
     tbb::enumerable_thread_specific<std::vector<float>> windows;
     tbb::parallel_for(size_t{0}, rects.size(), [&](size_t i) {
         const PixelRect& r = rects[i];
@@ -345,10 +376,7 @@ void SampleLayout::resolveRects(const float* rgba, const uint8_t* uniform, Image
         std::vector<float>& window = windows.local();
         window.resize(static_cast<size_t>(f.stride) * static_cast<size_t>(r.y1 - r.y0) * 4);
         f.pixels = window.data();
-        if (avx512)
-            resolveRowsAvx512(f, r.y0, r.y1);
-        else
-            resolveRowsOf(f, r.y0, r.y1);
+        rows(f, r.y0, r.y1);
         const size_t columns = static_cast<size_t>(r.x1 - r.x0) * 4;
         for (int y = r.y0; y < r.y1; ++y)
             std::copy_n(

@@ -20,8 +20,10 @@ namespace mpshade {
 // (seed, px, py, k). Returns image coordinates in pixels (continuous, y down).
 void samplePosition(uint32_t seed, int px, int py, int k, int spp, float& x, float& y);
 
-// Which build of the resolve runs (SampleLayout::resolve).
-enum class ResolveBuild { Fastest, Portable };
+// Which build of the resolve runs (SampleLayout::resolve): the fastest the processor has, the
+// baseline, or one for a wider instruction set (only where resolveBuildAvailable()).
+enum class ResolveBuild { Fastest, Portable, Avx2, Avx512 };
+bool resolveBuildAvailable(ResolveBuild build);
 
 // The pixel reconstruction filter: a truncated Gaussian (pbrt-v4's GaussianFilter),
 // f(d) = max(0, exp(-d^2 / (2 sigma^2)) - exp(-r^2 / (2 sigma^2))) separably in x and y.

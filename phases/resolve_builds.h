@@ -1,5 +1,6 @@
-// resolve_avx512.h -- SampleLayout::resolve's bands (resolve_rows.h) built for AVX-512,
-// chosen at run time where the processor has it: the same bits as the baseline build.
+// resolve_builds.h -- SampleLayout::resolve's bands (resolve_rows.h) built for wider
+// instruction sets, chosen at run time where the processor has them: the same bits as the
+// baseline build (resolve_avx512.cpp, resolve_avx2.cpp).
 #pragma once
 
 #include "phases/resolve_frame.h"
@@ -10,5 +11,9 @@ namespace mpshade {
 bool resolveAvx512Available();
 // Output rows [r0, r1) of `frame` (resolve_rows.h). Only where resolveAvx512Available().
 void resolveRowsAvx512(const ResolveFrame& frame, int r0, int r1);
+
+// The same for AVX2.
+bool resolveAvx2Available();
+void resolveRowsAvx2(const ResolveFrame& frame, int r0, int r1);
 
 }  // namespace mpshade
