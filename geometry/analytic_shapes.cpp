@@ -52,17 +52,6 @@ Bounds3 Torus::bounds() const {
     return {glm::vec3(-r, -minor, -r), glm::vec3(r, minor, r)};
 }
 
-SurfaceSample Plane::evaluate(int, float u, float v) const {
-    SurfaceSample s;
-    s.P = glm::vec3((u - 0.5f) * width, 0.0f, (0.5f - v) * depth);
-    s.dPdu = glm::vec3(width, 0.0f, 0.0f);
-    s.dPdv = glm::vec3(0.0f, 0.0f, -depth);
-    s.N = s.Ng = glm::vec3(0.0f, 1.0f, 0.0f);
-    s.s = u;
-    s.t = v;
-    return s;
-}
-
 Bounds3 Plane::bounds() const {
     return {glm::vec3(-0.5f * width, 0.0f, -0.5f * depth),
             glm::vec3(0.5f * width, 0.0f, 0.5f * depth)};

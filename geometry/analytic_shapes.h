@@ -34,7 +34,18 @@ struct Plane {
     float width = 1.0f;  // extent along x, > 0
     float depth = 1.0f;  // extent along z, > 0
     int chartCount() const { return 1; }
-    SurfaceSample evaluate(int chart, float u, float v) const;
+    // Inline: a floor's map fills evaluate it at every texel, where the call and the copy
+    // of its result out of line had been a tenth of the fill (evaluateBatch's loop).
+    SurfaceSample evaluate(int /*chart*/, float u, float v) const {
+        SurfaceSample s;
+        s.P = glm::vec3((u - 0.5f) * width, 0.0f, (0.5f - v) * depth);
+        s.dPdu = glm::vec3(width, 0.0f, 0.0f);
+        s.dPdv = glm::vec3(0.0f, 0.0f, -depth);
+        s.N = s.Ng = glm::vec3(0.0f, 1.0f, 0.0f);
+        s.s = u;
+        s.t = v;
+        return s;
+    }
     Bounds3 bounds() const;
     int tessellationRate(int chart) const { return 1; }
 };

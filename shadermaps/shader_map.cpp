@@ -106,6 +106,41 @@ void ShaderMap::store(int slot, size_t at, float value) {
         reinterpret_cast<float*>(tileData(slot))[at] = value;
 }
 
+// The interior texels of tile `key` as the mean of the 2 x 2 texels of the level below each
+// covers (its four children resident: childrenResident()).
+void ShaderMap::averageChildren(const TileKey& key, int slot, int validW, int validH) {
+    const int resU = resolutionU(key.chart, key.level), resV = resolutionV(key.chart, key.level);
+    const int T = options_.tileSize, border = options_.border;
+    const size_t channels = static_cast<size_t>(channels_);
+    auto interior = [&](int i, int j) {
+        return i >= key.tx * T && i < (key.tx + 1) * T && i < resU && j >= key.ty * T &&
+               j < (key.ty + 1) * T && j < resV;
+    };
+    float child[4][64];
+    std::vector<float> wide;
+    float* c4[4];
+    if (channels > 64) {
+        wide.resize(4 * channels);
+        for (int q = 0; q < 4; ++q) c4[q] = wide.data() + q * channels;
+    } else {
+        for (int q = 0; q < 4; ++q) c4[q] = child[q];
+    }
+    for (int lj = 0; lj < validH; ++lj)
+        for (int li = 0; li < validW; ++li) {
+            const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
+            if (!interior(i, j)) continue;
+            for (int q = 0; q < 4; ++q) {
+                const int ci = 2 * i + (q & 1), cj = 2 * j + (q >> 1);
+                const TileKey ck = tileOf(key.chart, key.level - 1, ci, cj);
+                texel(ck, slotOf(ck), ci, cj, c4[q]);
+            }
+            const size_t at =
+                (static_cast<size_t>(lj) * stride_ + static_cast<size_t>(li)) * channels;
+            for (size_t c = 0; c < channels; ++c)
+                store(slot, at + c, 0.25f * ((c4[0][c] + c4[1][c]) + (c4[2][c] + c4[3][c])));
+        }
+}
+
 bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                          const PendingTiles& pending, ShadingBatch& scratch,
                          std::vector<ChartPoint>& points, std::vector<SurfaceSample>& geometry,
@@ -136,33 +171,15 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                j >= key.ty * T && j < (key.ty + 1) * T && j < resV;
     };
     // Border texels a resident neighbour holds are copied after the batch (copyBorders).
+    // Only the border can lie in a neighbour: the tile's own texels are not looked up.
     const Neighbours around = neighboursOf(key, &pending);
+    const int ownU0 = key.tx * T, ownV0 = key.ty * T;
     auto skipped = [&](int i, int j) {
-        return interior(i, j) || neighbourSlot(around, key, i, j) >= 0;
+        const bool own = i >= ownU0 && i < ownU0 + T && j >= ownV0 && j < ownV0 + T;
+        return interior(i, j) || (!own && neighbourSlot(around, key, i, j) >= 0);
     };
     if (fromChildren) {
-        float child[4][64];
-        std::vector<float> wide;
-        float* c4[4];
-        if (channels > 64) {
-            wide.resize(4 * channels);
-            for (int q = 0; q < 4; ++q) c4[q] = wide.data() + q * channels;
-        } else {
-            for (int q = 0; q < 4; ++q) c4[q] = child[q];
-        }
-        for (int lj = 0; lj < validH; ++lj)
-            for (int li = 0; li < validW; ++li) {
-                const int i = key.tx * T + li - border, j = key.ty * T + lj - border;
-                if (!interior(i, j)) continue;
-                for (int q = 0; q < 4; ++q) {
-                    const int ci = 2 * i + (q & 1), cj = 2 * j + (q >> 1);
-                    const TileKey ck = tileOf(key.chart, key.level - 1, ci, cj);
-                    texel(ck, slotOf(ck), ci, cj, c4[q]);
-                }
-                const size_t at = texelAt(li, lj);
-                for (size_t c = 0; c < channels; ++c)
-                    store(slot, at + c, 0.25f * ((c4[0][c] + c4[1][c]) + (c4[2][c] + c4[3][c])));
-            }
+        averageChildren(key, slot, validW, validH);
         ++stats.tilesFromChildren;
     }
     // The rest evaluated: chart points of every (super)sample of every texel left.
@@ -177,7 +194,11 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                         (static_cast<float>(i) + (static_cast<float>(si) + 0.5f) / ku) / resU;
                     const float v =
                         (static_cast<float>(j) + (static_cast<float>(sj) + 0.5f) / kv) / resV;
-                    points.push_back(adjacency_
+                    // Inside the chart a point is itself (what resolve() and the clamps
+                    // give it); only the border beyond the chart's edge is resolved.
+                    const bool inside = u >= 0.0f && u <= 1.0f && v >= 0.0f && v <= 1.0f;
+                    points.push_back(inside ? ChartPoint{static_cast<int>(key.chart), u, v}
+                                     : adjacency_
                                          ? adjacency_->resolve(static_cast<int>(key.chart), u, v)
                                          : ChartPoint{static_cast<int>(key.chart),
                                                       std::clamp(u, 0.0f, 1.0f),
@@ -203,6 +224,8 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
         float* const* channelOut = scratch.out.channels;
         const int k = ku * kv;
         const float inv = 1.0f / static_cast<float>(k);
+        float* const floats =
+            options_.halfPrecision ? nullptr : reinterpret_cast<float*>(tileData(slot));
         size_t first = 0;
         for (int lj = 0; lj < validH; ++lj)
             for (int li = 0; li < validW; ++li) {
@@ -213,7 +236,10 @@ bool ShaderMap::fillTile(const TileKey& key, int slot, bool fromChildren,
                     float sum = 0.0f;
                     for (int s = 0; s < k; ++s)
                         sum += channelOut[c][first + static_cast<size_t>(s)];
-                    store(slot, at + c, sum * inv);
+                    if (floats)
+                        floats[at + c] = sum * inv;
+                    else
+                        store(slot, at + c, sum * inv);
                 }
                 first += static_cast<size_t>(k);
             }

@@ -244,6 +244,7 @@ class ShaderMap {
                   std::vector<SurfaceSample>& geometry, std::vector<float>& workspace,
                   FillStats& stats, const StopSignal* stop);
     void store(int slot, size_t at, float value);
+    void averageChildren(const TileKey& key, int slot, int validW, int validH);
     // The slots of the eight tiles around `key` in its chart and level (-1: not resident,
     // or beyond the level), found once per tile; a border (at most a tile wide) lies in
     // them.
