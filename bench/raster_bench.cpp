@@ -144,7 +144,7 @@ void registerDepthTests() {
         {"avx2", DepthTestKernel::Avx2},
         {"avx512", DepthTestKernel::Avx512}};
     for (const auto& [name, kernel] : kernels)
-        for (size_t n : {4, 8, 16, 64, 128, 512})
+        for (size_t n : {1, 2, 3, 4, 8, 16, 64, 128, 512})
             benchmark::RegisterBenchmark(
                 ("DepthTest/" + std::string(name) + "/row_" + std::to_string(n)).c_str(),
                 [kernel = kernel, n](benchmark::State& s) { depthTest(s, kernel, n); });
