@@ -76,8 +76,10 @@ void cleanUpStore(const std::shared_ptr<TileStore>& store, const RunOptions& opt
                          "(tiles are keyed by the engine that filled them) and stored its own\n",
                          store->root().c_str(), others);
     }
-    if (c.written.load() > 0)
+    if (c.written.load() > 0) {
+        store->compactWritten();
         store->gc(static_cast<uint64_t>(options.storeMb > 0 ? options.storeMb : 8192) << 20);
+    }
     if (c.damaged.load() > 0)
         std::fprintf(stderr,
                      "mpshade: warning: %llu damaged tile(s) in the store %s were removed and "

@@ -99,9 +99,18 @@ int storeGc(const StoreCommandOptions& options) {
     const std::shared_ptr<TileStore> store = storeNamed(options.store);
     const uint64_t before = store->bytes();
     const uint64_t removed = store->gc(static_cast<uint64_t>(options.maxMb) << 20);
-    std::printf("store %s: removed %s of %s (least recently used maps first); %s left\n",
+    // What is left, each map in one pack where it had many (TileStore::compact).
+    size_t merged = 0, mapsMerged = 0;
+    for (const StoredMapSummary& m : store->maps(false)) {
+        const size_t packs = store->compact(m.digest);
+        merged += packs;
+        mapsMerged += packs > 0 ? 1 : 0;
+    }
+    std::printf("store %s: removed %s of %s (least recently used maps first); %s left",
                 store->root().c_str(), megabytes(removed).c_str(), megabytes(before).c_str(),
-                megabytes(before - removed).c_str());
+                megabytes(store->bytes()).c_str());
+    if (merged > 0) std::printf("; %zu packs of %zu maps merged, one a map", merged, mapsMerged);
+    std::printf("\n");
     return 0;
 }
 

@@ -17,95 +17,28 @@
 #include <nlohmann/json.hpp>
 
 #include "geometry/error.h"
+#include "shadermaps/tile_pack_format.h"
 
 namespace mpshade {
 namespace {
 
 namespace fs = std::filesystem;
+using pack::bytesOf;
+using pack::footerFor;
+using pack::IndexEntry;
+using pack::kPackMagic;
+using pack::kTileMagic;
+using pack::PackFooter;
+using pack::readAt;
+using pack::readIndex;
+using pack::TileHeader;
+using pack::uniqueName;
+using pack::writeAtomically;
 using Clock = std::chrono::steady_clock;
-
-constexpr char kTileMagic[8] = {'M', 'P', 'S', 'T', 'I', 'L', 'E', '1'};
-constexpr char kPackMagic[8] = {'M', 'P', 'S', 'P', 'A', 'C', 'K', '1'};
-
-struct TileHeader {
-    char magic[8];
-    uint64_t mapHigh, mapLow, key, payloadBytes, checksum;
-};
-static_assert(sizeof(TileHeader) == 48);
-
-struct IndexEntry {
-    uint64_t key, offset;
-};
-static_assert(sizeof(IndexEntry) == 16);
-
-struct PackFooter {
-    char magic[8];
-    uint64_t count, indexOffset, indexChecksum;
-};
-static_assert(sizeof(PackFooter) == 32);
 
 // Packs a reader keeps open at most; beyond, a read opens and closes its pack.
 constexpr int kOpenPacks = 256;
 std::atomic<int> openPacks{0};
-
-// A name in the same folder (so the rename stays on one file system) that no other writer,
-// in this process or another, on this machine or another, picks.
-std::string uniqueName() {
-    static std::atomic<uint64_t> counter{0};
-    char host[64] = "host";
-    ::gethostname(host, sizeof host - 1);
-    host[sizeof host - 1] = '\0';
-    char name[160];
-    std::snprintf(name, sizeof name, "%s.%ld.%llx.%llu", host, static_cast<long>(::getpid()),
-                  static_cast<unsigned long long>(Clock::now().time_since_epoch().count()),
-                  static_cast<unsigned long long>(counter.fetch_add(1)));
-    return name;
-}
-
-bool readAt(int fd, void* to, size_t bytes, uint64_t offset) {
-    auto* p = static_cast<unsigned char*>(to);
-    while (bytes > 0) {
-        const ssize_t got = ::pread(fd, p, bytes, static_cast<off_t>(offset));
-        if (got <= 0) return false;
-        p += got;
-        bytes -= static_cast<size_t>(got);
-        offset += static_cast<uint64_t>(got);
-    }
-    return true;
-}
-
-// Writes the pieces under a temporary name, then renames into place: readers see the whole
-// file or none.
-bool writeAtomically(const fs::path& path, std::span<const std::span<const unsigned char>> pieces) {
-    const fs::path temporary = path.string() + "." + uniqueName() + ".tmp";
-    std::FILE* f = std::fopen(temporary.c_str(), "wb");
-    if (!f) return false;
-    bool ok = true;
-    for (const auto& piece : pieces)
-        ok = ok && (piece.empty() || std::fwrite(piece.data(), 1, piece.size(), f) == piece.size());
-    ok = (std::fclose(f) == 0) && ok;
-    ok = ok && std::rename(temporary.c_str(), path.c_str()) == 0;
-    if (!ok) ::unlink(temporary.c_str());
-    return ok;
-}
-
-std::span<const unsigned char> bytesOf(const void* p, size_t n) {
-    return {static_cast<const unsigned char*>(p), n};
-}
-
-// A pack's index, checked against its footer; false if the pack is damaged.
-bool readIndex(int fd, uint64_t fileBytes, std::vector<IndexEntry>& entries) {
-    PackFooter footer{};
-    if (fileBytes < sizeof footer ||
-        !readAt(fd, &footer, sizeof footer, fileBytes - sizeof footer) ||
-        std::memcmp(footer.magic, kPackMagic, sizeof kPackMagic) != 0 ||
-        footer.count > (fileBytes / sizeof(TileHeader)) ||
-        footer.indexOffset + footer.count * sizeof(IndexEntry) + sizeof footer != fileBytes)
-        return false;
-    entries.resize(footer.count);
-    return readAt(fd, entries.data(), entries.size() * sizeof(IndexEntry), footer.indexOffset) &&
-           checksum64(entries.data(), entries.size() * sizeof(IndexEntry)) == footer.indexChecksum;
-}
 
 }  // namespace
 
@@ -313,11 +246,7 @@ void TileStore::write(const Digest128& map, std::span<const uint64_t> keys,
         entries[i] = {keys[i], offset};
         offset += sizeof(TileHeader) + tileBytes;
     }
-    PackFooter footer{};
-    std::memcpy(footer.magic, kPackMagic, sizeof kPackMagic);
-    footer.count = n;
-    footer.indexOffset = offset;
-    footer.indexChecksum = checksum64(entries.data(), n * sizeof(IndexEntry));
+    const PackFooter footer = footerFor(entries, offset);
     std::vector<std::span<const unsigned char>> pieces;
     for (size_t i = 0; i < n; ++i) {
         pieces.push_back(bytesOf(&headers[i], sizeof(TileHeader)));
@@ -342,6 +271,10 @@ void TileStore::write(const Digest128& map, std::span<const uint64_t> keys,
         return;
     }
     counters_.written.fetch_add(n, std::memory_order_relaxed);
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        written_.insert(map.hex());
+    }
     // Readers in this process find the pack at once.
     std::shared_ptr<MapIndex> index;
     {

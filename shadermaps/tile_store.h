@@ -13,7 +13,8 @@
 // tile key, payload size, XXH3-64 of the payload) and the tile's storage as the map holds
 // it, then an index of (key, offset) and a footer (magic, count, index offset, index
 // checksum). A pack a tile was written to disk separately had cost 60-250 us a tile in file
-// creation (the gallery's cold run +85%); a pack costs one file a map and fill.
+// creation (the gallery's cold run +85%); a pack costs one file a map and fill, and a run
+// merges a map's packs once they are many (compact()). The bytes: tile_pack_format.h.
 //
 // Concurrency: a pack is written under a name no other writer uses (host, process,
 // counter) and renamed into place whole, so readers see whole packs or none. A tile whose checks
@@ -136,6 +137,18 @@ class TileStore {
     // The bytes the store's packs and records take.
     uint64_t bytes() const;
 
+    // Merges a map's packs into one when it has more than `maxPacks`: every fill writes a
+    // pack, so a map played or rendered many times had hundreds, each listed when the map is
+    // first read and each opened for every tile read once more than kOpenPacks were open
+    // (docs/store.md). The newest whole copy of each tile goes into one new pack, written as
+    // any pack is; the others are then removed. Holds the map's fill lock meanwhile, so no
+    // process writes to it; a process reading it keeps reading the packs it holds open, and a
+    // tile it finds gone is filled again. Returns the packs removed.
+    size_t compact(const Digest128& map, size_t maxPacks = kCompactAbovePacks);
+    // compact() on every map this object wrote to.
+    size_t compactWritten(size_t maxPacks = kCompactAbovePacks);
+    static constexpr size_t kCompactAbovePacks = 8;
+
   private:
     struct Pack;
     struct MapIndex;
@@ -147,8 +160,9 @@ class TileStore {
 
     std::filesystem::path root_;
     TileStoreCounters counters_;
-    std::mutex mutex_;            // guards used_, warned_ and indices_
-    std::set<std::string> used_;  // maps marked used by this object
+    std::mutex mutex_;               // guards used_, written_, warned_ and indices_
+    std::set<std::string> used_;     // maps marked used by this object
+    std::set<std::string> written_;  // maps this object wrote packs of (hex digests)
     std::map<std::string, std::shared_ptr<MapIndex>> indices_;
     bool warned_ = false;
     std::atomic<bool> readOnly_{false};

@@ -1,0 +1,148 @@
+// TileStore::compact: a map's packs merged into one (tile_store.h).
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <unordered_set>
+
+#include "geometry/content_digest.h"
+#include "shadermaps/tile_pack_format.h"
+#include "shadermaps/tile_store.h"
+
+namespace mpshade {
+namespace {
+
+namespace fs = std::filesystem;
+using pack::IndexEntry;
+using pack::TileHeader;
+
+// A tile's storage is a few kilobytes (a 16 x 16 tile of a few float channels); a header
+// claiming more is damaged, not a reason to allocate.
+constexpr uint64_t kMaxTileBytes = uint64_t{1} << 26;
+
+struct SourcePack {
+    fs::path path;
+    fs::file_time_type written;
+    int fd = -1;
+    std::vector<IndexEntry> entries;
+};
+
+// The map's packs whose index reads whole, newest first (ties by name, so every process
+// orders them alike). Damaged ones are left for readers to count and remove.
+std::vector<SourcePack> listPacks(const fs::path& folder) {
+    std::vector<SourcePack> packs;
+    std::error_code ec;
+    for (const fs::directory_entry& f : fs::directory_iterator(folder, ec)) {
+        if (f.path().extension() != ".pack") continue;
+        SourcePack p;
+        p.path = f.path();
+        p.written = f.last_write_time(ec);
+        p.fd = ::open(p.path.c_str(), O_RDONLY | O_CLOEXEC);
+        if (p.fd < 0) continue;
+        struct stat st {};
+        if (::fstat(p.fd, &st) != 0 ||
+            !pack::readIndex(p.fd, static_cast<uint64_t>(st.st_size), p.entries)) {
+            ::close(p.fd);
+            continue;
+        }
+        packs.push_back(std::move(p));
+    }
+    std::sort(packs.begin(), packs.end(), [](const SourcePack& a, const SourcePack& b) {
+        return a.written != b.written ? a.written > b.written : a.path > b.path;
+    });
+    return packs;
+}
+
+// One tile of a source pack, checked as a read checks it (header, map, key, size, checksum).
+bool readTile(const SourcePack& p, const IndexEntry& e, const Digest128& map, TileHeader& header,
+              std::vector<unsigned char>& payload) {
+    if (!pack::readAt(p.fd, &header, sizeof header, e.offset) ||
+        std::memcmp(header.magic, pack::kTileMagic, sizeof pack::kTileMagic) != 0 ||
+        header.mapHigh != map.high || header.mapLow != map.low || header.key != e.key ||
+        header.payloadBytes > kMaxTileBytes)
+        return false;
+    payload.resize(header.payloadBytes);
+    return pack::readAt(p.fd, payload.data(), payload.size(), e.offset + sizeof header) &&
+           checksum64(payload.data(), payload.size()) == header.checksum;
+}
+
+}  // namespace
+
+size_t TileStore::compact(const Digest128& map, size_t maxPacks) {
+    if (readOnly_.load(std::memory_order_relaxed)) return 0;
+    const fs::path folder = mapFolder(map);
+    std::error_code ec;
+    if (!fs::is_directory(folder, ec)) return 0;
+    const std::unique_ptr<FillLock> lock = lockFills(map);
+    if (!lock) return 0;
+    std::vector<SourcePack> packs = listPacks(folder);
+    const auto closeAll = [&] {
+        for (SourcePack& p : packs) ::close(p.fd);
+    };
+    if (packs.size() <= std::max<size_t>(maxPacks, 1)) {
+        closeAll();
+        return 0;
+    }
+    const fs::path path = folder / (pack::uniqueName() + ".pack");
+    const fs::path temporary = path.string() + ".tmp";
+    std::FILE* f = std::fopen(temporary.c_str(), "wb");
+    if (!f) {
+        closeAll();
+        return 0;
+    }
+    std::vector<IndexEntry> index;
+    uint64_t offset = 0;
+    bool ok = true;
+    TileHeader header{};
+    std::vector<unsigned char> payload;
+    // Each tile's newest copy that reads whole: a damaged one gives way to an older copy.
+    std::unordered_set<uint64_t> done;
+    for (const SourcePack& p : packs)
+        for (const IndexEntry& e : p.entries) {
+            if (done.count(e.key)) continue;
+            if (!readTile(p, e, map, header, payload)) {
+                counters_.damaged.fetch_add(1, std::memory_order_relaxed);
+                continue;
+            }
+            ok = ok && std::fwrite(&header, sizeof header, 1, f) == 1 &&
+                 (payload.empty() || std::fwrite(payload.data(), payload.size(), 1, f) == 1);
+            index.push_back({e.key, offset});
+            offset += sizeof header + payload.size();
+            done.insert(e.key);
+        }
+    const pack::PackFooter footer = pack::footerFor(index, offset);
+    ok = ok &&
+         (index.empty() || std::fwrite(index.data(), sizeof(IndexEntry) * index.size(), 1, f) == 1);
+    ok = ok && std::fwrite(&footer, sizeof footer, 1, f) == 1;
+    ok = (std::fclose(f) == 0) && ok;
+    ok = ok && std::rename(temporary.c_str(), path.c_str()) == 0;
+    if (!ok) {
+        ::unlink(temporary.c_str());
+        closeAll();
+        return 0;
+    }
+    // Readers in this process find the merged pack (the newest) before the removed ones.
+    for (const SourcePack& p : packs) ::unlink(p.path.c_str());
+    closeAll();
+    refresh(map);
+    return packs.size();
+}
+
+size_t TileStore::compactWritten(size_t maxPacks) {
+    std::vector<std::string> maps;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        maps.assign(written_.begin(), written_.end());
+    }
+    size_t removed = 0;
+    for (const std::string& hex : maps) {
+        Digest128 map;
+        if (Digest128::fromHex(hex, map)) removed += compact(map, maxPacks);
+    }
+    return removed;
+}
+
+}  // namespace mpshade
