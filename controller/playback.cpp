@@ -37,6 +37,16 @@ std::vector<RefineStep> refineStepsAbove(const QualityRegulator& regulator, int 
     return steps;
 }
 
+QualityRegulatorOptions playbackRegulatorOptions(const PlaybackOptions& options) {
+    QualityRegulatorOptions r = options.regulator;
+    // Refining, the step is chosen for the cheap pass alone, within a share of the budget.
+    if (options.refine.enabled) {
+        r.refinedShare = options.refine.baseShare;
+        r.slowDownAt = options.refine.slowDownAt;
+    }
+    return r;
+}
+
 namespace {
 
 // One playback: the renderer, its regulator and predictor, and the steps of the pre-roll
@@ -49,7 +59,7 @@ class Player {
           renderer_(scene, rendererOptions(options)),
           regulator_(scene.settings.shadingRate,
                      options.render.resolved(scene.settings).samplesPerPixel,
-                     regulatorOptions(options)),
+                     playbackRegulatorOptions(options)),
           predictor_(renderer_),
           budget_(1.0 / options.fps) {
         renderer_.plan(options.first, options.last, options.render);
@@ -112,13 +122,6 @@ class Player {
     // docs/playback.md).
     std::vector<RefineStep> betterSteps(int level) const {
         return refineStepsAbove(regulator_, level);
-    }
-
-    // Refining, the step is chosen for the cheap pass alone, within a share of the budget.
-    static QualityRegulatorOptions regulatorOptions(const PlaybackOptions& options) {
-        QualityRegulatorOptions r = options.regulator;
-        if (options.refine.enabled) r.refinedShare = options.refine.baseShare;
-        return r;
     }
 
     static MultiphaseOptions rendererOptions(const PlaybackOptions& options) {

@@ -121,4 +121,8 @@ PlaybackSummary playScene(const Scene& scene, const PlaybackOptions& options,
 // of those at one rate only the best (the same points to shade, at a sharper footprint).
 std::vector<RefineStep> refineStepsAbove(const QualityRegulator& regulator, int level);
 
+// The regulator's options for a playback: options.regulator, and while refining its shares
+// scaled by RefineOptions::baseShare and its step down at RefineOptions::slowDownAt.
+QualityRegulatorOptions playbackRegulatorOptions(const PlaybackOptions& options);
+
 }  // namespace mpshade

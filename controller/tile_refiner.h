@@ -46,6 +46,15 @@ struct RefineOptions {
     // QualityRegulatorOptions::refinedShare while refining: a frame's own step is chosen to
     // take about this share of what it would otherwise, leaving the rest to refinement.
     double baseShare = 1.0;
+    // QualityRegulatorOptions::slowDownAt while refining. A frame's own step need only fit
+    // with refinement's minimum after it (refinement then stops at its deadline): stepping
+    // down at 0.7 had moved the teapot and the gallery at 640x360 to per pixel at footprint
+    // x2 on frames whose per-pixel pass took 23-24 ms of 33, to refine only back to per
+    // pixel. At 0.8, runs alternating with 0.7: frames at 38 dB or more from constant
+    // quality, teapot 48, 48, 48 of 48 (0.7: 33, 48, 48), gallery 48, 48, 48, 48, 48, 33
+    // (27, 48, 42, 32, 46, 46); deadlines met, gallery 45.7 of 48 on average (46.8), teapot
+    // 48 (48); vase and courtyard alike (docs/playback.md).
+    double slowDownAt = 0.8;
     double errorWeight = 0.9, ageWeight = 0.1;  // Watson's weights (normalized terms)
     double temporalWeight = 1.0;                // of the temporal error, against the estimated
     double hysteresis = 0.25;

@@ -519,5 +519,33 @@ TEST(Playback, AFrameAtFewerSamplesRefinesItsRateAtThem) {
     EXPECT_TRUE(refineStepsAbove(regulator, 0).empty());
 }
 
+TEST(Playback, RefiningTheStepGoesDownLaterThanTheWholeFrameLadder) {
+    // Frames whose dynamic phase takes 0.78 of the budget (0.5 + 0.28, exact in binary
+    // sums): two in a row step the whole-frame ladder down (above 0.7), not a refined one
+    // (at most 0.8); 0.8125 steps both down.
+    auto frame = [](double shade) {
+        FrameStats s;
+        s.dynamic.rasterSeconds = 0.5;
+        s.dynamic.shadeSeconds = shade;
+        return s;
+    };
+    PlaybackOptions refined;
+    PlaybackOptions whole;
+    whole.refine.enabled = false;
+    ASSERT_TRUE(refined.refine.enabled);
+    EXPECT_EQ(playbackRegulatorOptions(refined).slowDownAt, refined.refine.slowDownAt);
+    EXPECT_EQ(playbackRegulatorOptions(whole).slowDownAt, whole.regulator.slowDownAt);
+    for (const double shade : {0.28, 0.3125}) {
+        QualityRegulator r(ShadingRate::Sample, 4, playbackRegulatorOptions(refined));
+        QualityRegulator w(ShadingRate::Sample, 4, playbackRegulatorOptions(whole));
+        for (int k = 0; k < 2; ++k) {
+            r.update(frame(shade), 1.0);
+            w.update(frame(shade), 1.0);
+        }
+        EXPECT_EQ(w.level(), 1) << shade;
+        EXPECT_EQ(r.level(), shade > 0.3 ? 1 : 0) << shade;
+    }
+}
+
 }  // namespace
 }  // namespace mpshade

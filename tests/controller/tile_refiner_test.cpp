@@ -31,8 +31,11 @@ constexpr int kW = 64, kH = 36;
 // A grey plane filling the view from above, striped finely (much finer than a pixel at 2x2
 // shading) where the object-space x is above 1.3 (one side of the image), elsewhere a
 // gentle ramp (each tile's per-sample shading differs a little from its 2x2 shading).
+// A folder of the test's own: ctest runs the tests of this file in parallel processes, and
+// one rewriting a file another was reading had failed it now and then.
 std::string writeStripedPlane() {
-    const std::string dir = ::testing::TempDir() + "mpshade_refiner/";
+    const std::string dir = ::testing::TempDir() + "mpshade_refiner_" +
+                            ::testing::UnitTest::GetInstance()->current_test_info()->name() + "/";
     std::filesystem::create_directories(dir);
     std::ofstream(dir + "striped.sl")
         << "surface striped() { float on = step(1.3, P[0]);"

@@ -327,7 +327,10 @@ INSTANTIATE_TEST_SUITE_P(All, ExampleScenes,
                                            "examples/vase/lamplight.json"));
 
 std::string writeScene(const std::string& name, const std::string& json) {
-    const std::string dir = ::testing::TempDir() + "mpshade_scene_test/";
+    // A folder of the test's own: ctest runs this file's tests in parallel processes, each
+    // rewriting s.sl.
+    const std::string dir = ::testing::TempDir() + "mpshade_scene_test_" +
+                            ::testing::UnitTest::GetInstance()->current_test_info()->name() + "/";
     std::filesystem::create_directories(dir);
     std::ofstream(dir + "s.sl")
         << "surface s(float k = 1, color c = 0) { Ci = c * k + diffuse(N) + color(time); }";
