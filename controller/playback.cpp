@@ -70,6 +70,9 @@ class Player {
     // its fills go through the budgeted path, which stops when the cache is full), the
     // regulator calibrated, and the cache warmed.
     void preroll(PlaybackSummary& summary) {
+        // Built at the first occlusion ray otherwise: in a frame whose fill traces it, when
+        // the pre-roll's tiles all came from the store.
+        renderer_.resources().buildRayScenes();
         RenderOptions first = options_.render;
         first.shadingRate = scene_.settings.shadingRate;  // the regulator's top step
         FrameStats stats;

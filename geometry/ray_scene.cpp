@@ -145,6 +145,7 @@ void SurfaceRayScene::buildNow() const {
             triGeom_ = attachTessellation(device);
         rtcCommitScene(scene_);
     });
+    builtFlag_.store(true, std::memory_order_release);
 }
 
 SurfaceRayScene::~SurfaceRayScene() {

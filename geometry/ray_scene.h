@@ -10,6 +10,7 @@
 // chord sag (docs/geometry.md). Point clouds are traced as Embree oriented discs.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -82,6 +83,8 @@ class SurfaceRayScene {
         build();
         return triChart_.size();
     }
+    // Whether the scene has been built (by a query, or by asking for it ahead).
+    bool built() const { return builtFlag_.load(std::memory_order_acquire); }
 
   private:
     void build() const {
@@ -93,6 +96,7 @@ class SurfaceRayScene {
     const Surface& surface_;
     // Set once by build(), read only after it.
     mutable std::once_flag built_;
+    mutable std::atomic<bool> builtFlag_{false};
     mutable RTCScene scene_ = nullptr;
     mutable unsigned triGeom_ = RTC_INVALID_GEOMETRY_ID;
     mutable unsigned discGeom_ = RTC_INVALID_GEOMETRY_ID;

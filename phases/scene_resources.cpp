@@ -1,5 +1,6 @@
 #include "phases/scene_resources.h"
 
+#include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
 
 #include "geometry/error.h"
@@ -24,6 +25,12 @@ SceneResources::SceneResources(const Scene& scene, RayScenes rayScenes) : scene_
         r.occlusionBias = 1e-4f * std::max(surfaceBounds(*obj.surface).diagonal(), 1e-6f);
         objects_.push_back(std::move(r));
     }
+}
+
+void SceneResources::buildRayScenes() const {
+    std::vector<const SurfaceRayScene*> scenes;
+    for (const auto& [surface, rs] : rayScenes_) scenes.push_back(rs.get());
+    tbb::parallel_for(size_t{0}, scenes.size(), [&](size_t k) { scenes[k]->triangleCount(); });
 }
 
 bool objectInView(const Surface& surface, const ObjectState& state, const CameraState& camera) {

@@ -42,6 +42,10 @@ class SceneResources {
     const Scene& scene() const { return scene_; }
     const ObjectResources& object(size_t i) const { return objects_[i]; }
     size_t objectCount() const { return objects_.size(); }
+    // Builds every ray scene now, in parallel, rather than at the first ray each meets (a
+    // fill that traces occlusion rays): for a frame rate, whose frames must not pay 4-70 ms
+    // for a tessellation and its hierarchy (the gallery's objects at 640x360).
+    void buildRayScenes() const;
 
   private:
     const Scene& scene_;
