@@ -59,6 +59,7 @@ nlohmann::json storeReport(const std::shared_ptr<TileStore>& store) {
 void cleanUpStore(const std::shared_ptr<TileStore>& store, const RunOptions& options,
                   const Scene& scene) {
     if (!store) return;
+    store->flush();  // the counters below include what was written behind
     const TileStoreCounters& c = store->counters();
     if (c.loaded.load() == 0 && c.written.load() > 0) {
         // Before clean-up, which may remove those maps as the ones unused longest.

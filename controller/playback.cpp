@@ -6,6 +6,7 @@
 
 #include "controller/tile_predictor.h"
 #include "geometry/error.h"
+#include "shadermaps/tile_store.h"
 
 namespace mpshade {
 namespace {
@@ -62,6 +63,8 @@ class Player {
                      playbackRegulatorOptions(options)),
           predictor_(renderer_),
           budget_(1.0 / options.fps) {
+        // Packs written by the store's own thread, not inside the frames' fills.
+        if (options.store) options.store->setWriteBehind(true);
         renderer_.plan(options.first, options.last, options.render);
     }
 

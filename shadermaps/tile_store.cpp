@@ -228,8 +228,8 @@ bool TileStore::refresh(const Digest128& map) {
     return index->packs.size() > before;
 }
 
-void TileStore::write(const Digest128& map, std::span<const uint64_t> keys,
-                      std::span<const unsigned char* const> tiles, size_t tileBytes) {
+void TileStore::writeNow(const Digest128& map, std::span<const uint64_t> keys,
+                         std::span<const unsigned char* const> tiles, size_t tileBytes) {
     if (readOnly_.load(std::memory_order_relaxed) || keys.empty()) return;
     const size_t n = keys.size();
     std::vector<TileHeader> headers(n);

@@ -80,6 +80,7 @@ class TileStore {
     // Opens (creating it if needed) the store at `root`. Throws InputError naming the folder
     // when it cannot be made or is not a folder.
     explicit TileStore(std::filesystem::path root);
+    ~TileStore();  // writes what write-behind still holds
     TileStore(const TileStore&) = delete;
     TileStore& operator=(const TileStore&) = delete;
 
@@ -92,6 +93,13 @@ class TileStore {
     // tiles[i], `tileBytes` long. Failures are counted, never thrown.
     void write(const Digest128& map, std::span<const uint64_t> keys,
                std::span<const unsigned char* const> tiles, size_t tileBytes);
+    // With write-behind on, write() copies the tiles and returns; a thread of the store's
+    // own writes the pack. For a frame rate: a pack written inside a frame's fill took about
+    // 1 ms of it (a file made and renamed). Then a fill no longer writes its pack before
+    // letting the map's fill lock go: another process may fill the same tiles meanwhile (the
+    // same bits; one copy is read). flush() waits for every write queued so far.
+    void setWriteBehind(bool on);
+    void flush();
 
     // While one is held, no other holder -- in this process or another sharing the store, on
     // this machine or another (flock on the map's `fill.lock`) -- fills the map's tiles.
@@ -152,6 +160,9 @@ class TileStore {
   private:
     struct Pack;
     struct MapIndex;
+    struct WriteBehind;
+    void writeNow(const Digest128& map, std::span<const uint64_t> keys,
+                  std::span<const unsigned char* const> tiles, size_t tileBytes);
     std::filesystem::path mapFolder(const Digest128& map) const;
     void warnOnce(const std::string& message);
     // The map's index, its packs listed when it is first asked for.
@@ -166,6 +177,8 @@ class TileStore {
     std::map<std::string, std::shared_ptr<MapIndex>> indices_;
     bool warned_ = false;
     std::atomic<bool> readOnly_{false};
+    // Null: writes are made at once. Shared so the type is complete only where it is made.
+    std::shared_ptr<WriteBehind> writeBehind_;
 };
 
 // The store's default folder: $MPSHADE_STORE if set, else $XDG_CACHE_HOME/mpshade/store,

@@ -72,6 +72,7 @@ bool readTile(const SourcePack& p, const IndexEntry& e, const Digest128& map, Ti
 }  // namespace
 
 size_t TileStore::compact(const Digest128& map, size_t maxPacks) {
+    flush();  // the packs written behind are merged too
     if (readOnly_.load(std::memory_order_relaxed)) return 0;
     const fs::path folder = mapFolder(map);
     std::error_code ec;
@@ -132,6 +133,7 @@ size_t TileStore::compact(const Digest128& map, size_t maxPacks) {
 }
 
 size_t TileStore::compactWritten(size_t maxPacks) {
+    flush();
     std::vector<std::string> maps;
     {
         std::lock_guard<std::mutex> lock(mutex_);

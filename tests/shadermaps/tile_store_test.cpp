@@ -205,6 +205,31 @@ TEST(TileStore, ConcurrentWritersOfOneTileNeverShowAReaderAPartialFile) {
     (void)whole;
 }
 
+TEST(TileStore, WriteBehindWritesCopiesOfTheTilesByFlushOrDestruction) {
+    const fs::path root = freshFolder("behind");
+    const Digest128 map{4, 4};
+    const std::vector<unsigned char> first = bytes(600, 3), second = bytes(600, 8);
+    std::vector<unsigned char> out(first.size());
+    {
+        TileStore store(root);
+        store.setWriteBehind(true);
+        std::vector<unsigned char> a = first, b = second;
+        const std::vector<const unsigned char*> tiles = {a.data(), b.data()};
+        store.write(map, std::vector<uint64_t>{1, 2}, tiles, a.size());
+        std::fill(a.begin(), a.end(), 0);  // the caller's slots reused at once
+        std::fill(b.begin(), b.end(), 0);
+        store.flush();
+        EXPECT_EQ(store.counters().written.load(), 2u);
+        EXPECT_EQ(packs(root).size(), 1u);
+        writePack(store, map, {3}, second);
+    }  // the last write still queued: made before the store goes
+    TileStore later(root);
+    for (uint64_t key : {1, 2, 3}) {
+        ASSERT_TRUE(later.read(map, key, out)) << key;
+        EXPECT_EQ(out, key == 1 ? first : second) << key;
+    }
+}
+
 TEST(TileStore, AFolderThatCannotHoldAStoreIsAnInputError) {
     const fs::path file = freshFolder("file");
     std::ofstream(file) << "not a folder";
