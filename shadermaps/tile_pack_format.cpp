@@ -37,17 +37,30 @@ bool readAt(int fd, void* to, size_t bytes, uint64_t offset) {
 }
 
 bool writeAtomically(const std::filesystem::path& path,
-                     std::span<const std::span<const unsigned char>> pieces) {
+                     const std::function<bool(std::FILE*)>& write) {
     const std::filesystem::path temporary = path.string() + "." + uniqueName() + ".tmp";
     std::FILE* f = std::fopen(temporary.c_str(), "wb");
     if (!f) return false;
-    bool ok = true;
-    for (const auto& piece : pieces)
-        ok = ok && (piece.empty() || std::fwrite(piece.data(), 1, piece.size(), f) == piece.size());
+    bool ok = write(f);
     ok = (std::fclose(f) == 0) && ok;
     ok = ok && std::rename(temporary.c_str(), path.c_str()) == 0;
     if (!ok) ::unlink(temporary.c_str());
     return ok;
+}
+
+bool writeAtomically(const std::filesystem::path& path,
+                     std::span<const std::span<const unsigned char>> pieces) {
+    return writeAtomically(path, [&](std::FILE* f) {
+        for (const auto& piece : pieces)
+            if (!piece.empty() && std::fwrite(piece.data(), 1, piece.size(), f) != piece.size())
+                return false;
+        return true;
+    });
+}
+
+bool headerNames(const TileHeader& header, const Digest128& map, uint64_t key) {
+    return std::memcmp(header.magic, kTileMagic, sizeof kTileMagic) == 0 &&
+           header.mapHigh == map.high && header.mapLow == map.low && header.key == key;
 }
 
 bool readIndex(int fd, uint64_t fileBytes, std::vector<IndexEntry>& entries) {

@@ -6,10 +6,14 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
+
+#include "geometry/content_digest.h"
 
 namespace mpshade::pack {
 
@@ -40,10 +44,18 @@ std::string uniqueName();
 // Reads exactly `bytes` at `offset`; false on a short read or an error.
 bool readAt(int fd, void* to, size_t bytes, uint64_t offset);
 
-// Writes the pieces under a temporary name, then renames into place: readers see the whole
-// file or none.
+// Writes a file under a temporary name, then renames it into place: readers see the whole
+// file or none. `write` writes the contents and says whether it could; on failure nothing
+// is left.
+bool writeAtomically(const std::filesystem::path& path,
+                     const std::function<bool(std::FILE*)>& write);
+// The same for a file made of `pieces`, one after another.
 bool writeAtomically(const std::filesystem::path& path,
                      std::span<const std::span<const unsigned char>> pieces);
+
+// Whether a tile's header is one, of tile `key` of map `map` (its payload size and checksum
+// are the caller's to check against what it reads).
+bool headerNames(const TileHeader& header, const Digest128& map, uint64_t key);
 
 // A pack's index, checked against its footer; false if the pack is damaged.
 bool readIndex(int fd, uint64_t fileBytes, std::vector<IndexEntry>& entries);

@@ -25,6 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 using pack::bytesOf;
 using pack::footerFor;
+using pack::headerNames;
 using pack::IndexEntry;
 using pack::kPackMagic;
 using pack::kTileMagic;
@@ -176,9 +177,7 @@ bool TileStore::read(const Digest128& map, uint64_t key, std::span<unsigned char
         const ssize_t got = ::preadv(fd, parts, 2, static_cast<off_t>(copy.offset));
         if (transient) ::close(fd);
         if (got == static_cast<ssize_t>(sizeof header + out.size()) &&
-            std::memcmp(header.magic, kTileMagic, sizeof kTileMagic) == 0 &&
-            header.mapHigh == map.high && header.mapLow == map.low && header.key == key &&
-            header.payloadBytes == out.size() &&
+            headerNames(header, map, key) && header.payloadBytes == out.size() &&
             checksum64(out.data(), out.size()) == header.checksum) {
             counters_.loaded.fetch_add(1, std::memory_order_relaxed);
             return true;

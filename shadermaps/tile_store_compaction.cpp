@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 #include <unordered_set>
+#include <utility>
 
 #include "geometry/content_digest.h"
 #include "shadermaps/tile_pack_format.h"
@@ -23,11 +23,29 @@ using pack::TileHeader;
 // claiming more is damaged, not a reason to allocate.
 constexpr uint64_t kMaxTileBytes = uint64_t{1} << 26;
 
+// A pack being merged, open for reading while it is.
 struct SourcePack {
     fs::path path;
     fs::file_time_type written;
     int fd = -1;
     std::vector<IndexEntry> entries;
+
+    SourcePack() = default;
+    SourcePack(SourcePack&& o) noexcept
+        : path(std::move(o.path)),
+          written(o.written),
+          fd(std::exchange(o.fd, -1)),
+          entries(std::move(o.entries)) {}
+    SourcePack& operator=(SourcePack&& o) noexcept {
+        std::swap(path, o.path);
+        std::swap(written, o.written);
+        std::swap(fd, o.fd);
+        std::swap(entries, o.entries);
+        return *this;
+    }
+    ~SourcePack() {
+        if (fd >= 0) ::close(fd);
+    }
 };
 
 // The map's packs whose index reads whole, newest first (ties by name, so every process
@@ -41,14 +59,10 @@ std::vector<SourcePack> listPacks(const fs::path& folder) {
         p.path = f.path();
         p.written = f.last_write_time(ec);
         p.fd = ::open(p.path.c_str(), O_RDONLY | O_CLOEXEC);
-        if (p.fd < 0) continue;
         struct stat st {};
-        if (::fstat(p.fd, &st) != 0 ||
-            !pack::readIndex(p.fd, static_cast<uint64_t>(st.st_size), p.entries)) {
-            ::close(p.fd);
-            continue;
-        }
-        packs.push_back(std::move(p));
+        if (p.fd >= 0 && ::fstat(p.fd, &st) == 0 &&
+            pack::readIndex(p.fd, static_cast<uint64_t>(st.st_size), p.entries))
+            packs.push_back(std::move(p));
     }
     std::sort(packs.begin(), packs.end(), [](const SourcePack& a, const SourcePack& b) {
         return a.written != b.written ? a.written > b.written : a.path > b.path;
@@ -60,9 +74,7 @@ std::vector<SourcePack> listPacks(const fs::path& folder) {
 bool readTile(const SourcePack& p, const IndexEntry& e, const Digest128& map, TileHeader& header,
               std::vector<unsigned char>& payload) {
     if (!pack::readAt(p.fd, &header, sizeof header, e.offset) ||
-        std::memcmp(header.magic, pack::kTileMagic, sizeof pack::kTileMagic) != 0 ||
-        header.mapHigh != map.high || header.mapLow != map.low || header.key != e.key ||
-        header.payloadBytes > kMaxTileBytes)
+        !pack::headerNames(header, map, e.key) || header.payloadBytes > kMaxTileBytes)
         return false;
     payload.resize(header.payloadBytes);
     return pack::readAt(p.fd, payload.data(), payload.size(), e.offset + sizeof header) &&
@@ -79,55 +91,37 @@ size_t TileStore::compact(const Digest128& map, size_t maxPacks) {
     if (!fs::is_directory(folder, ec)) return 0;
     const std::unique_ptr<FillLock> lock = lockFills(map);
     if (!lock) return 0;
-    std::vector<SourcePack> packs = listPacks(folder);
-    const auto closeAll = [&] {
-        for (SourcePack& p : packs) ::close(p.fd);
-    };
-    if (packs.size() <= std::max<size_t>(maxPacks, 1)) {
-        closeAll();
-        return 0;
-    }
-    const fs::path path = folder / (pack::uniqueName() + ".pack");
-    const fs::path temporary = path.string() + ".tmp";
-    std::FILE* f = std::fopen(temporary.c_str(), "wb");
-    if (!f) {
-        closeAll();
-        return 0;
-    }
-    std::vector<IndexEntry> index;
-    uint64_t offset = 0;
-    bool ok = true;
-    TileHeader header{};
-    std::vector<unsigned char> payload;
+    const std::vector<SourcePack> packs = listPacks(folder);
+    if (packs.size() <= std::max<size_t>(maxPacks, 1)) return 0;
     // Each tile's newest copy that reads whole: a damaged one gives way to an older copy.
-    std::unordered_set<uint64_t> done;
-    for (const SourcePack& p : packs)
-        for (const IndexEntry& e : p.entries) {
-            if (done.count(e.key)) continue;
-            if (!readTile(p, e, map, header, payload)) {
-                counters_.damaged.fetch_add(1, std::memory_order_relaxed);
-                continue;
+    const auto writeMerged = [&](std::FILE* f) {
+        std::vector<IndexEntry> index;
+        std::unordered_set<uint64_t> done;
+        uint64_t offset = 0;
+        TileHeader header{};
+        std::vector<unsigned char> payload;
+        for (const SourcePack& p : packs)
+            for (const IndexEntry& e : p.entries) {
+                if (done.count(e.key)) continue;
+                if (!readTile(p, e, map, header, payload)) {
+                    counters_.damaged.fetch_add(1, std::memory_order_relaxed);
+                    continue;
+                }
+                if (std::fwrite(&header, sizeof header, 1, f) != 1 ||
+                    (!payload.empty() && std::fwrite(payload.data(), payload.size(), 1, f) != 1))
+                    return false;
+                index.push_back({e.key, offset});
+                offset += sizeof header + payload.size();
+                done.insert(e.key);
             }
-            ok = ok && std::fwrite(&header, sizeof header, 1, f) == 1 &&
-                 (payload.empty() || std::fwrite(payload.data(), payload.size(), 1, f) == 1);
-            index.push_back({e.key, offset});
-            offset += sizeof header + payload.size();
-            done.insert(e.key);
-        }
-    const pack::PackFooter footer = pack::footerFor(index, offset);
-    ok = ok &&
-         (index.empty() || std::fwrite(index.data(), sizeof(IndexEntry) * index.size(), 1, f) == 1);
-    ok = ok && std::fwrite(&footer, sizeof footer, 1, f) == 1;
-    ok = (std::fclose(f) == 0) && ok;
-    ok = ok && std::rename(temporary.c_str(), path.c_str()) == 0;
-    if (!ok) {
-        ::unlink(temporary.c_str());
-        closeAll();
-        return 0;
-    }
+        const pack::PackFooter footer = pack::footerFor(index, offset);
+        return (index.empty() ||
+                std::fwrite(index.data(), sizeof(IndexEntry) * index.size(), 1, f) == 1) &&
+               std::fwrite(&footer, sizeof footer, 1, f) == 1;
+    };
+    if (!pack::writeAtomically(folder / (pack::uniqueName() + ".pack"), writeMerged)) return 0;
     // Readers in this process find the merged pack (the newest) before the removed ones.
     for (const SourcePack& p : packs) ::unlink(p.path.c_str());
-    closeAll();
     refresh(map);
     return packs.size();
 }
