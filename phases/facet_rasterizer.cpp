@@ -148,7 +148,11 @@ struct TileGrid {
 // The objects' facets as chunks of whole clusters, so a culled cluster is skipped in one
 // step. Reuses `chunks`; returns how many are in use.
 size_t makeChunks(const std::vector<RasterObject>& objects, std::vector<Chunk>& chunks) {
-    constexpr size_t kFacetsPerChunk = 1 << 15;
+    // Chunks are binned in parallel, one task each: at 32768 facets an object of the
+    // teapot's size (27 800) was one chunk, binned on one thread whatever the cores (1.15 ms
+    // a frame on two threads; at 4096, 0.63 ms; the vase 0.35 -> 0.23 ms). The tile pass
+    // reads every chunk's bins for each tile, a few loads a chunk.
+    constexpr size_t kFacetsPerChunk = 1 << 12;
     size_t count = 0;
     auto add = [&](uint32_t o, size_t begin, size_t end, size_t cb, size_t ce) {
         if (count == chunks.size()) chunks.emplace_back();
