@@ -301,8 +301,7 @@ bool TileStore::readRecord(const Digest128& key, std::vector<unsigned char>& out
     TileHeader header{};
     bool ok = ::fstat(fd, &st) == 0 && static_cast<uint64_t>(st.st_size) >= sizeof header &&
               readAt(fd, &header, sizeof header, 0) &&
-              std::memcmp(header.magic, kTileMagic, sizeof kTileMagic) == 0 &&
-              header.mapHigh == key.high && header.mapLow == key.low &&
+              headerNames(header, key, 0) &&  // a record's key field is 0 (writeRecord)
               header.payloadBytes == static_cast<uint64_t>(st.st_size) - sizeof header;
     if (ok) {
         out.resize(header.payloadBytes);

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <thread>
 #include <vector>
@@ -114,6 +115,53 @@ TEST(TileStore, DamagedTilesAreNeverReadAndRefilledCopiesAre) {
     EXPECT_FALSE(store.read(map, 2, out));
     EXPECT_EQ(store.counters().damaged.load(), 2u);
     EXPECT_TRUE(packs(root).empty());
+}
+
+// Records (a stored representation's facets): read back as written under their key only; a
+// record whose header, size or checksum fails is never read, is counted and removed.
+TEST(TileStore, RecordsAreReadAsWrittenAndDamagedOnesNever) {
+    const fs::path root = freshFolder("records");
+    const Digest128 key{5, 6};
+    const std::vector<unsigned char> rep = bytes(3000, 3);
+    std::vector<unsigned char> out;
+    const fs::path file = root / "reps-v1" / (key.hex() + ".rep");
+    // Each case damages the written file one way: a payload byte, the header's tile key
+    // (records write 0), its map, the file cut short, a byte added.
+    const std::vector<std::pair<const char*, std::function<void()>>> damages = {
+        {"payload",
+         [&] {
+             std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+             f.seekp(48 + 2999);
+             f.put(static_cast<char>(rep[2999] ^ 1));
+         }},
+        {"key",
+         [&] {
+             std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+             f.seekp(24);
+             f.put(1);
+         }},
+        {"map",
+         [&] {
+             std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+             f.seekp(8);
+             f.put(7);
+         }},
+        {"cut", [&] { fs::resize_file(file, fs::file_size(file) - 1); }},
+        {"longer", [&] { std::ofstream(file, std::ios::app | std::ios::binary).put(0); }},
+    };
+    for (const auto& [name, damage] : damages) {
+        TileStore store(root);
+        store.writeRecord(key, rep);
+        ASSERT_TRUE(fs::exists(file));
+        ASSERT_TRUE(store.readRecord(key, out)) << name;
+        EXPECT_EQ(out, rep);
+        EXPECT_FALSE(store.readRecord(Digest128{5, 7}, out));  // another key
+        damage();
+        EXPECT_FALSE(store.readRecord(key, out)) << name;
+        EXPECT_EQ(store.counters().damaged.load(), 1u) << name;
+        EXPECT_EQ(store.counters().recordsRead.load(), 1u) << name;
+        EXPECT_FALSE(fs::exists(file)) << name;
+    }
 }
 
 TEST(TileStore, CleanUpRemovesTheMapsUnusedLongestFirst) {
