@@ -3,6 +3,7 @@
 // holding exactly what filling it gives, and writers racing on one tile.
 #include <atomic>
 #include <chrono>
+#include <cstddef>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,7 @@
 
 #include "geometry/error.h"
 #include "shadermaps/shader_map.h"
+#include "shadermaps/tile_pack_format.h"
 #include "shadermaps/tile_store.h"
 #include "shading/factoring.h"
 #include "shading/program_digest.h"
@@ -43,6 +45,15 @@ void writePack(TileStore& store, const Digest128& map, std::vector<uint64_t> key
     std::vector<const unsigned char*> tiles(keys.size(), tile.data());
     store.write(map, keys, tiles, tile.size());
 }
+
+// Overwrites the byte of `file` at `offset`.
+void putByte(const fs::path& file, size_t offset, char byte) {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(offset));
+    f.put(byte);
+}
+
+constexpr size_t kHeader = sizeof(pack::TileHeader);
 
 std::vector<fs::path> packs(const fs::path& root) {
     std::vector<fs::path> out;
@@ -86,13 +97,8 @@ TEST(TileStore, DamagedTilesAreNeverReadAndRefilledCopiesAre) {
         TileStore store(root);
         writePack(store, map, {1, 2}, tile);
     }
-    // One byte of tile 1's payload flipped (the first record: after its 48-byte header).
-    const fs::path pack = packs(root).at(0);
-    {
-        std::fstream f(pack, std::ios::in | std::ios::out | std::ios::binary);
-        f.seekp(48 + 100);
-        f.put(static_cast<char>(tile[100] ^ 0x10));
-    }
+    // One byte of tile 1's payload flipped (the first record: after its header).
+    putByte(packs(root).at(0), kHeader + 100, static_cast<char>(tile[100] ^ 0x10));
     {
         TileStore store(root);
         EXPECT_FALSE(store.read(map, 1, out));
@@ -128,24 +134,9 @@ TEST(TileStore, RecordsAreReadAsWrittenAndDamagedOnesNever) {
     // Each case damages the written file one way: a payload byte, the header's tile key
     // (records write 0), its map, the file cut short, a byte added.
     const std::vector<std::pair<const char*, std::function<void()>>> damages = {
-        {"payload",
-         [&] {
-             std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
-             f.seekp(48 + 2999);
-             f.put(static_cast<char>(rep[2999] ^ 1));
-         }},
-        {"key",
-         [&] {
-             std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
-             f.seekp(24);
-             f.put(1);
-         }},
-        {"map",
-         [&] {
-             std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
-             f.seekp(8);
-             f.put(7);
-         }},
+        {"payload", [&] { putByte(file, kHeader + 2999, static_cast<char>(rep[2999] ^ 1)); }},
+        {"key", [&] { putByte(file, offsetof(pack::TileHeader, key), 1); }},
+        {"map", [&] { putByte(file, offsetof(pack::TileHeader, mapHigh), 7); }},
         {"cut", [&] { fs::resize_file(file, fs::file_size(file) - 1); }},
         {"longer", [&] { std::ofstream(file, std::ios::app | std::ios::binary).put(0); }},
     };
