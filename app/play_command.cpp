@@ -219,6 +219,7 @@ int runPlayCommand(const PlayCommandOptions& options) {
                  {"footprint_scale", q.footprintScale},
                  {"samples_per_pixel", q.samplesPerPixel > 0 ? q.samplesPerPixel : spp},
                  {"preroll_dynamic_seconds", steps[k].dynamicSeconds},
+                 {"preroll_measured_seconds", steps[k].measuredSeconds},
                  {"preroll_probe_fallbacks", steps[k].probeFallbacks},
                  {"frames", steps[k].frames}});
         }

@@ -148,7 +148,8 @@ class Player {
     }
 
     // The regulator's ratios: the first frame again at every step, now warm (its objects
-    // built, its buffers allocated); each also fills what its own step reads. Each shades
+    // built, its buffers allocated), calibrationFrames times, the least kept; each also
+    // fills what its own step reads. Each shades
     // afresh: the same view again would otherwise run on the inputs the last one kept. A
     // step whose probes fell back (a coarser footprint reads levels no step before it had
     // filled) is measured again once they are filled: the fallbacks' slower path had priced
@@ -157,15 +158,23 @@ class Player {
     void calibrate(PlaybackSummary& summary) {
         std::vector<double> stepSeconds(static_cast<size_t>(regulator_.levels()));
         for (int k = 0; k < regulator_.levels(); ++k) {
-            FrameStats s;
             RenderOptions fresh = atStep(options_.render, regulator_.step(k), true);
             fresh.reuseStillView = false;
-            renderer_.renderFrame(options_.first, fresh, s, image_);
-            if (s.dynamic.probeFallbacks > 0)
+            PlaybackStep step;
+            step.step = regulator_.step(k);
+            double least = 0.0;
+            for (int m = 0; m < std::max(1, options_.calibrationFrames); ++m) {
+                FrameStats s;
                 renderer_.renderFrame(options_.first, fresh, s, image_);
-            stepSeconds[static_cast<size_t>(k)] = s.dynamic.seconds();
-            summary.steps.push_back({regulator_.step(k), stepSeconds[static_cast<size_t>(k)], 0,
-                                     s.dynamic.probeFallbacks});
+                if (m == 0 && s.dynamic.probeFallbacks > 0)
+                    renderer_.renderFrame(options_.first, fresh, s, image_);
+                step.probeFallbacks = std::max(step.probeFallbacks, s.dynamic.probeFallbacks);
+                const double seconds = s.dynamic.seconds();
+                step.measuredSeconds.push_back(seconds);
+                least = m == 0 ? seconds : std::min(least, seconds);
+            }
+            step.dynamicSeconds = stepSeconds[static_cast<size_t>(k)] = least;
+            summary.steps.push_back(std::move(step));
         }
         regulator_.calibrate(stepSeconds, budget_);
     }

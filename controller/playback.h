@@ -59,6 +59,11 @@ struct PlaybackOptions {
     // loads (a scene of dear static shaders would otherwise load for as long as its cache
     // takes to fill). 0: only the first frame's.
     double prerollPrefetchSeconds = 1.0;
+    // The pre-roll measures each step of the regulator's ladder this many times (the first
+    // frame again, warm) and keeps the least: one frame's time on a busy machine can be a
+    // third over its usual, and a step measured so had started the gallery one step too low
+    // (docs/playback.md).
+    int calibrationFrames = 2;
     double prerollPrefetchWallSeconds = 2.0;
     double predictSeconds = 0.1;
     int predictDivisor = 4;
@@ -83,8 +88,10 @@ struct PlaybackOptions {
 // One step of the quality regulator's ladder, as the pre-roll measured it.
 struct PlaybackStep {
     QualityStep step;
-    double dynamicSeconds = 0.0;  // the first frame's dynamic phase at this step, warm
-    int frames = 0;               // frames played at this step
+    double dynamicSeconds = 0.0;          // the first frame's dynamic phase at this step, warm: the
+                                          // least of measuredSeconds
+    std::vector<double> measuredSeconds;  // each of PlaybackOptions::calibrationFrames
+    int frames = 0;                       // frames played at this step
     // Of the frame measured, the probes that fell back to a coarser level: 0 unless the
     // cache could not hold the tiles the step reads.
     uint64_t probeFallbacks = 0;

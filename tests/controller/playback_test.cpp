@@ -1,5 +1,6 @@
 // Frame-rate-locked frames: the dynamic phase never waits, static work takes the time
 // left, and with time enough a frame is the constant-quality frame exactly.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -267,6 +268,28 @@ TEST(Playback, TheLadderIsMeasuredWithTheTilesOfEachStepFilled) {
                   [&](const FrameStats&, const Image&, const PlaybackQuality&) { return true; });
     ASSERT_GE(summary.steps.size(), 5u);
     for (const PlaybackStep& p : summary.steps) EXPECT_EQ(p.probeFallbacks, 0u);
+}
+
+TEST(Playback, CalibratesEachStepOnTheLeastOfItsMeasurements) {
+    const Scene scene = loadScene(test::sourcePath("examples/teapot/scene.json"));
+    for (const int frames : {1, 3}) {
+        PlaybackOptions options;
+        options.render = small();
+        options.first = 0;
+        options.last = 1;
+        options.calibrationFrames = frames;
+        const PlaybackSummary summary =
+            playScene(scene, options,
+                      [](const FrameStats&, const Image&, const PlaybackQuality&) { return true; });
+        ASSERT_EQ(summary.steps.size(), 7u);
+        for (const PlaybackStep& step : summary.steps) {
+            ASSERT_EQ(step.measuredSeconds.size(), static_cast<size_t>(frames));
+            for (const double s : step.measuredSeconds) EXPECT_GT(s, 0.0);
+            // The regulator is given the least: not the first, the last or a mean.
+            EXPECT_EQ(step.dynamicSeconds,
+                      *std::min_element(step.measuredSeconds.begin(), step.measuredSeconds.end()));
+        }
+    }
 }
 
 TEST(Playback, PlaysEveryFrameAndRegulatesItsQuality) {
