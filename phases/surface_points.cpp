@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <span>
 #include <type_traits>
 
@@ -43,12 +44,18 @@ std::span<const uint32_t> findRuns(const SurfacePoints& points, std::vector<uint
 }
 
 // One facet's constants for step 1, broadcast: a lane type T is float or Float4.
+// The ray through pixel (x, y) has the direction d = d0 + x dx + y dy, so its products
+// with the facet's A1, A2 and Dn (hitFacet) are each a plane in x and y: three numbers a
+// product, made once a facet. Made per point from d instead, the products and the copies
+// of d0, dx and dy into each run's constants had been a third of this step's instructions
+// on the courtyard, whose runs are mostly one point long (small facets, samples in order).
 template <typename T>
 struct FacetRay {
-    T P0[3], e1[3], e2[3], A1[3], A2[3], Dn[3];
+    T P0[3], e1[3], e2[3];
+    T cA1, cA2, cDn;  // at x = y = 0
     T dxA1, dyA1, dxA2, dyA2, dxDn, dyDn;
-    T d0[3], dx[3], dy[3];
 };
+constexpr size_t kFacetRayRows = 18;  // the floats of a FacetRay<float>, in its order
 
 template <typename T>
 T splatAs(float x) {
@@ -58,27 +65,135 @@ T splatAs(float x) {
         return splatFloat4(x);
 }
 
-template <typename T>
-FacetRay<T> facetRay(const ObjectView& view, const FacetMesh& mesh, uint32_t facet) {
-    const uint32_t* p = &mesh.positionIndex[3 * static_cast<size_t>(facet)];
-    const glm::vec3 P0 = mesh.format.dequantize(mesh.qx[p[0]], mesh.qy[p[0]], mesh.qz[p[0]]);
-    const glm::vec3 e1 = mesh.format.dequantize(mesh.qx[p[1]], mesh.qy[p[1]], mesh.qz[p[1]]) - P0;
-    const glm::vec3 e2 = mesh.format.dequantize(mesh.qx[p[2]], mesh.qy[p[2]], mesh.qz[p[2]]) - P0;
-    const glm::vec3 tv = view.eye - P0;
-    // b1 = (d . A1) / (d . Dn), b2 = (d . A2) / (d . Dn): Moller-Trumbore's weights with
-    // the triple products rearranged around the direction d.
-    const glm::vec3 A1 = glm::cross(e2, tv), A2 = glm::cross(tv, e1), Dn = glm::cross(e2, e1);
-    FacetRay<T> f;
-    for (int k = 0; k < 3; ++k) {
-        f.P0[k] = splatAs<T>(P0[k]), f.e1[k] = splatAs<T>(e1[k]), f.e2[k] = splatAs<T>(e2[k]);
-        f.A1[k] = splatAs<T>(A1[k]), f.A2[k] = splatAs<T>(A2[k]), f.Dn[k] = splatAs<T>(Dn[k]);
-        f.d0[k] = splatAs<T>(view.d0[k]), f.dx[k] = splatAs<T>(view.dx[k]);
-        f.dy[k] = splatAs<T>(view.dy[k]);
+// glm's cross and dot, lane by lane in the same order.
+struct Lanes3 {
+    Float4 x, y, z;
+};
+inline Lanes3 crossLanes(const Lanes3& a, const Lanes3& b) {
+    return {a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y};
+}
+inline Float4 dotLanes(const glm::vec3& a, const Lanes3& b) {
+    return splatFloat4(a.x) * b.x + splatFloat4(a.y) * b.y + splatFloat4(a.z) * b.z;
+}
+
+// m[j][i] <- m[i][j].
+inline void transpose4(Float4 (&m)[4]) {
+    const Float4 t0 = __builtin_shufflevector(m[0], m[1], 0, 4, 1, 5);
+    const Float4 t1 = __builtin_shufflevector(m[0], m[1], 2, 6, 3, 7);
+    const Float4 t2 = __builtin_shufflevector(m[2], m[3], 0, 4, 1, 5);
+    const Float4 t3 = __builtin_shufflevector(m[2], m[3], 2, 6, 3, 7);
+    m[0] = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
+    m[1] = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
+    m[2] = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
+    m[3] = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
+}
+
+// Step 1's facet constants of every run, four runs' facets at a time in vector lanes (a
+// facet alone, as one point's run had it made, was 200 instructions of scalar arithmetic:
+// its corners, three cross products and nine dot products). rays[r * kFacetRayRows ..] is
+// run r's FacetRay<float>; rays holds a multiple of 4 runs, at least as many as there are.
+void facetRays(const ObjectView& view, const FacetMesh& mesh, const SurfacePoints& points,
+               std::span<const uint32_t> runs, float* __restrict rays) {
+    const size_t runCount = runs.size() - 1;
+    const uint32_t* const positionIndex = mesh.positionIndex.data();
+    const FixedPointFormat& format = mesh.format;
+    const Float4 ox = splatFloat4(format.origin.x), oy = splatFloat4(format.origin.y),
+                 oz = splatFloat4(format.origin.z);
+    const Float4 sx = splatFloat4(format.step.x), sy = splatFloat4(format.step.y),
+                 sz = splatFloat4(format.step.z);
+    const Float4 ex = splatFloat4(view.eye.x), ey = splatFloat4(view.eye.y),
+                 ez = splatFloat4(view.eye.z);
+    for (size_t r0 = 0; r0 < runCount; r0 += 4) {
+        // A facet's indices and corners are read a few runs ahead: points come in object and
+        // sample order, so facets are scattered over the mesh, and their first reads had
+        // been a tenth of this step's time on the courtyard.
+        for (size_t r = r0 + 8; r < std::min(r0 + 12, runCount); ++r) {
+            const size_t ahead = 3 * static_cast<size_t>(points.facet[runs[r]]);
+            __builtin_prefetch(positionIndex + ahead);
+            __builtin_prefetch(mesh.attributeIndex.data() + ahead);  // for steps 3 and 4
+        }
+        for (size_t r = r0 + 4; r < std::min(r0 + 8, runCount); ++r) {
+            const uint32_t* q = positionIndex + 3 * static_cast<size_t>(points.facet[runs[r]]);
+            for (int k = 0; k < 3; ++k) {
+                __builtin_prefetch(mesh.qx.data() + q[k]);
+                __builtin_prefetch(mesh.qy.data() + q[k]);
+                __builtin_prefetch(mesh.qz.data() + q[k]);
+            }
+        }
+        alignas(16) float q[3][3][4];  // corner, axis, lane
+        for (int j = 0; j < 4; ++j) {
+            // Lanes past the last run repeat it.
+            const size_t r = std::min(r0 + static_cast<size_t>(j), runCount - 1);
+            const uint32_t* p = positionIndex + 3 * static_cast<size_t>(points.facet[runs[r]]);
+            for (int v = 0; v < 3; ++v) {
+                q[v][0][j] = static_cast<float>(mesh.qx[p[v]]);
+                q[v][1][j] = static_cast<float>(mesh.qy[p[v]]);
+                q[v][2][j] = static_cast<float>(mesh.qz[p[v]]);
+            }
+        }
+        Lanes3 corner[3];
+        for (int v = 0; v < 3; ++v)
+            corner[v] = {loadFloat4(q[v][0]), loadFloat4(q[v][1]), loadFloat4(q[v][2])};
+        // FixedPointFormat::dequantize: origin + step * q.
+        for (Lanes3& c : corner) c = {ox + sx * c.x, oy + sy * c.y, oz + sz * c.z};
+        const Lanes3& P0 = corner[0];
+        const Lanes3 e1 = {corner[1].x - P0.x, corner[1].y - P0.y, corner[1].z - P0.z};
+        const Lanes3 e2 = {corner[2].x - P0.x, corner[2].y - P0.y, corner[2].z - P0.z};
+        const Lanes3 tv = {ex - P0.x, ey - P0.y, ez - P0.z};
+        // b1 = (d . A1) / (d . Dn), b2 = (d . A2) / (d . Dn): Moller-Trumbore's weights with
+        // the triple products rearranged around the direction d.
+        const Lanes3 A1 = crossLanes(e2, tv), A2 = crossLanes(tv, e1), Dn = crossLanes(e2, e1);
+        const Float4 member[kFacetRayRows] = {P0.x,
+                                              P0.y,
+                                              P0.z,
+                                              e1.x,
+                                              e1.y,
+                                              e1.z,
+                                              e2.x,
+                                              e2.y,
+                                              e2.z,
+                                              dotLanes(view.d0, A1),
+                                              dotLanes(view.d0, A2),
+                                              dotLanes(view.d0, Dn),
+                                              dotLanes(view.dx, A1),
+                                              dotLanes(view.dy, A1),
+                                              dotLanes(view.dx, A2),
+                                              dotLanes(view.dy, A2),
+                                              dotLanes(view.dx, Dn),
+                                              dotLanes(view.dy, Dn)};
+        // Out run by run (each run's constants together, as FacetRay<float> lays them out):
+        // four members at a time, transposed from lanes.
+        float* out = rays + r0 * kFacetRayRows;
+        for (size_t k = 0; k + 4 <= kFacetRayRows; k += 4) {
+            Float4 m[4] = {member[k], member[k + 1], member[k + 2], member[k + 3]};
+            transpose4(m);
+            for (size_t j = 0; j < 4; ++j) storeFloat4(out + j * kFacetRayRows + k, m[j]);
+        }
+        for (size_t k = kFacetRayRows / 4 * 4; k < kFacetRayRows; ++k)
+            for (size_t j = 0; j < 4; ++j) out[j * kFacetRayRows + k] = member[k][j];
     }
-    f.dxA1 = splatAs<T>(glm::dot(view.dx, A1)), f.dyA1 = splatAs<T>(glm::dot(view.dy, A1));
-    f.dxA2 = splatAs<T>(glm::dot(view.dx, A2)), f.dyA2 = splatAs<T>(glm::dot(view.dy, A2));
-    f.dxDn = splatAs<T>(glm::dot(view.dx, Dn)), f.dyDn = splatAs<T>(glm::dot(view.dy, Dn));
-    return f;
+}
+
+// Run r's FacetRay, broadcast to T.
+template <typename T>
+FacetRay<T> facetRayOf(const float* rays, size_t r) {
+    static_assert(sizeof(FacetRay<float>) == kFacetRayRows * sizeof(float));
+    FacetRay<float> f;
+    std::memcpy(&f, rays + r * kFacetRayRows, sizeof f);
+    if constexpr (std::is_same_v<T, float>) {
+        return f;
+    } else {
+        FacetRay<T> b;
+        for (int k = 0; k < 3; ++k) {
+            b.P0[k] = splatAs<T>(f.P0[k]), b.e1[k] = splatAs<T>(f.e1[k]);
+            b.e2[k] = splatAs<T>(f.e2[k]);
+        }
+        b.cA1 = splatAs<T>(f.cA1), b.cA2 = splatAs<T>(f.cA2), b.cDn = splatAs<T>(f.cDn);
+        b.dxA1 = splatAs<T>(f.dxA1), b.dyA1 = splatAs<T>(f.dyA1);
+        b.dxA2 = splatAs<T>(f.dxA2), b.dyA2 = splatAs<T>(f.dyA2);
+        b.dxDn = splatAs<T>(f.dxDn), b.dyDn = splatAs<T>(f.dyDn);
+        return b;
+    }
 }
 
 // Step 1 at one point (T float) or four (Float4): the barycentric weights, their screen
@@ -91,14 +206,12 @@ struct RayHit {
 
 template <typename T>
 RayHit<T> hitFacet(const FacetRay<T>& f, T x, T y) {
-    T d[3];
-    for (int k = 0; k < 3; ++k) d[k] = f.d0[k] + x * f.dx[k] + y * f.dy[k];
-    const T den = d[0] * f.Dn[0] + d[1] * f.Dn[1] + d[2] * f.Dn[2];
+    const T den = f.cDn + x * f.dxDn + y * f.dyDn;
     const T tiny = splatAs<T>(1e-30f), one = splatAs<T>(1.0f), zero = splatAs<T>(0.0f);
     const auto big = den > tiny || den < -tiny;
     const T inv = one / (big ? den : one);
-    const T c1 = (d[0] * f.A1[0] + d[1] * f.A1[1] + d[2] * f.A1[2]) * inv;
-    const T c2 = (d[0] * f.A2[0] + d[1] * f.A2[1] + d[2] * f.A2[2]) * inv;
+    const T c1 = (f.cA1 + x * f.dxA1 + y * f.dyA1) * inv;
+    const T c2 = (f.cA2 + x * f.dxA2 + y * f.dyA2) * inv;
     // x - x is 0 for a finite x, NaN otherwise.
     const auto ok = big && (c1 - c1 == zero) && (c2 - c2 == zero);
     const T third = splatAs<T>(1.0f / 3.0f);
@@ -114,40 +227,20 @@ RayHit<T> hitFacet(const FacetRay<T>& f, T x, T y) {
 
 // Step 1: where each point's ray meets its facet: the barycentric weights (and, for a probe,
 // their screen derivatives, 4 rows of n) and P.
-void intersectFacets(const ObjectView& view, const FacetMesh& mesh, const SurfacePoints& points,
-                     std::span<const uint32_t> runs, float* __restrict bary1,
-                     float* __restrict bary2, float* __restrict px, float* __restrict py,
-                     float* __restrict pz, float* __restrict derivatives) {
+void intersectFacets(const SurfacePoints& points, std::span<const uint32_t> runs,
+                     const float* __restrict rays, float* __restrict bary1, float* __restrict bary2,
+                     float* __restrict px, float* __restrict py, float* __restrict pz,
+                     float* __restrict derivatives) {
     const size_t n = points.n;
     float* const P[3] = {px, py, pz};
     const size_t runCount = runs.size() - 1;
-    const uint32_t* const positionIndex = mesh.positionIndex.data();
-    const uint32_t* const attributeIndex = mesh.attributeIndex.data();
     for (size_t r = 0; r < runCount; ++r) {
         const size_t first = runs[r], end = runs[r + 1];
-        const uint32_t facet = points.facet[first];
-        // A facet's indices and corners are read a few runs ahead: points come in object and
-        // sample order, so facets are scattered over the mesh, and their first reads were a
-        // tenth of this function's time on the courtyard (the load of a run's indices, then
-        // of its corners, each waiting for memory).
-        if (r + 8 < runCount) {
-            const size_t ahead = 3 * static_cast<size_t>(points.facet[runs[r + 8]]);
-            __builtin_prefetch(positionIndex + ahead);
-            __builtin_prefetch(attributeIndex + ahead);
-        }
-        if (r + 4 < runCount) {
-            const uint32_t* q = positionIndex + 3 * static_cast<size_t>(points.facet[runs[r + 4]]);
-            for (int k = 0; k < 3; ++k) {
-                __builtin_prefetch(mesh.qx.data() + q[k]);
-                __builtin_prefetch(mesh.qy.data() + q[k]);
-                __builtin_prefetch(mesh.qz.data() + q[k]);
-            }
-        }
         size_t i = first;
         // Two points or more go four at a time, the last four past the run's end while
         // inside the batch: the next run writes its own points' results over those lanes.
         if (end - first >= 2) {
-            const FacetRay<Float4> f = facetRay<Float4>(view, mesh, facet);
+            const FacetRay<Float4> f = facetRayOf<Float4>(rays, r);
             for (; i < end && i + 4 <= n; i += 4) {
                 const RayHit<Float4> h =
                     hitFacet(f, loadFloat4(points.x + i), loadFloat4(points.y + i));
@@ -162,7 +255,7 @@ void intersectFacets(const ObjectView& view, const FacetMesh& mesh, const Surfac
             }
         }
         if (i >= end) continue;
-        const FacetRay<float> f = facetRay<float>(view, mesh, facet);
+        const FacetRay<float> f = facetRayOf<float>(rays, r);
         for (; i < end; ++i) {
             const RayHit<float> h = hitFacet(f, points.x[i], points.y[i]);
             bary1[i] = h.b1, bary2[i] = h.b2;
@@ -375,7 +468,9 @@ size_t shadeSurfacePoints(const ObjectView& view, const ProbeOptions& probe, boo
     const float* pz = rows[ShadingBatch::P + 2];
 
     const std::span<const uint32_t> runs = findRuns(points, scratch.runs);
-    intersectFacets(view, mesh, points, runs, scratch.b1.data(), scratch.b2.data(),
+    growTo(scratch.facetRays, kFacetRayRows * ((runs.size() - 1 + 3) / 4 * 4));
+    facetRays(view, mesh, points, runs, scratch.facetRays.data());
+    intersectFacets(points, runs, scratch.facetRays.data(), scratch.b1.data(), scratch.b2.data(),
                     rows[ShadingBatch::P], rows[ShadingBatch::P + 1], rows[ShadingBatch::P + 2],
                     useMap ? scratch.derivatives.data() : nullptr);
     viewDirections(view, points, px, py, pz, rows[ShadingBatch::I], rows[ShadingBatch::I + 1],

@@ -48,6 +48,7 @@ struct SurfaceShadingScratch {
     std::vector<float> b1, b2;       // per point: barycentric weights
     std::vector<float> derivatives;  // their screen derivatives: 4 rows of n points
     std::vector<uint32_t> runs;     // the first point of each run on one facet, then n (grown only)
+    std::vector<float> facetRays;   // per run, its facet's constants for the ray hits
     std::vector<TileKey> reported;  // the probes' report buffer
     std::vector<TileKey> missing;   // missing tiles of the calls since it was cleared
 };
