@@ -229,74 +229,109 @@ namespace {
 // pixels whose samples all came out alike (the resolve reads those once). A pixel one point
 // covers whole has all its samples alike: only its first is composited and written, the one
 // the resolve reads (at per-pixel shading, three quarters of the samples' passes over
-// memory).
-inline void compositePixel(const BandPoints& pts, const BandRange& r, const VisibilityBuffer& vis,
-                           size_t pixel, int spp, const glm::vec3& background, float* rgbaOut,
-                           uint8_t* uniform) {
-    const int layers = vis.layers;
-    const size_t first = pixel * static_cast<size_t>(spp);
-    if (!pts.pixelPoint.empty()) {
-        if (const uint32_t p = pts.pixelPoint[pixel - r.firstPixel]; p != kNoPoint) {
-            SampleComposite c;
-            c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
-            c.finish(background, &rgbaOut[4 * first]);
-            uniform[pixel] = 1;
-            return;
-        }
-    }
-    // Whether the pixel's samples came out alike is decided on the values in registers:
-    // reading the samples back from rgbaOut waited on their stores (the whole band's
-    // composite took a fifth of the shading time of a one-sphere scene).
-    const Float4 background4 = {background.x, background.y, background.z, 0.0f};
-    const Float4 zero = {}, one = splatFloat4(1.0f);
-    Float4 firstRgba = zero;
-    bool same = true;
-    for (size_t smp = first; smp < first + spp; ++smp) {
-        Float4 rgba;
-        if (vis.count[smp] == 1) {
-            // One surface (most samples): SampleComposite's arithmetic written out for one
-            // layer in one vector, the same bits without its loops over layers and channels.
-            // A point's three floats are read as four (BandPoints pads its rows by one).
-            const uint32_t p = pts.fragmentPoint[smp * layers - r.firstSlot];
-            const Float4 ci = loadFloat4(&pts.color[3 * p]);
-            const Float4 oi = loadFloat4(&pts.opacity[3 * p]);
-            const Float4 t = one - oi;
-            rgba = (zero + oi * ci) + t * background4;
-            rgba[3] = 1.0f - (t[0] + t[1] + t[2]) / 3.0f;
-        } else if (vis.count[smp] == 0) {
-            // The background alone: SampleComposite's finish with nothing over it (C 0, T 1;
-            // 0 + 1 bg rather than bg, so a -0 comes out +0 as there), coverage 0.
-            rgba = zero + one * background4;
-            rgba[3] = 0.0f;
-        } else {
-            SampleComposite c;
-            for (int l = 0; l < vis.count[smp]; ++l) {
-                const uint32_t p = pts.fragmentPoint[smp * layers + l - r.firstSlot];
-                c.over(&pts.color[3 * p], &pts.opacity[3 * p]);
+// memory). The band's arrays are looked up once, and samples of several layers composited
+// out of line: a pixel's loop had reloaded them through the band's structures and kept its
+// sample counter on the stack.
+class BandCompositor {
+  public:
+    BandCompositor(const BandPoints& pts, const BandRange& r, const VisibilityBuffer& vis, int spp,
+                   const glm::vec3& background, float* rgbaOut, uint8_t* uniform)
+        : count_(vis.count.data()),
+          fragment_(pts.fragmentPoint.data()),
+          pixelPoint_(pts.pixelPoint.empty() ? nullptr : pts.pixelPoint.data()),
+          color_(pts.color.data()),
+          opacity_(pts.opacity.data()),
+          rgbaOut_(rgbaOut),
+          uniform_(uniform),
+          layers_(static_cast<size_t>(vis.layers)),
+          spp_(static_cast<size_t>(spp)),
+          firstSlot_(r.firstSlot),
+          firstPixel_(r.firstPixel),
+          background_(background),
+          background4_{background.x, background.y, background.z, 0.0f} {}
+
+    void pixel(size_t pixel) const {
+        const size_t first = pixel * spp_;
+        if (pixelPoint_) {
+            if (const uint32_t p = pixelPoint_[pixel - firstPixel_]; p != kNoPoint) {
+                SampleComposite c;
+                c.over(&color_[3 * p], &opacity_[3 * p]);
+                c.finish(background_, &rgbaOut_[4 * first]);
+                uniform_[pixel] = 1;
+                return;
             }
-            float out[4];
-            c.finish(background, out);
-            rgba = loadFloat4(out);
         }
-        storeFloat4(&rgbaOut[4 * smp], rgba);
-        // Bit for bit, as the resolve compares alike blocks.
-        const Int4 differ = reinterpret_cast<Int4>(rgba) ^ reinterpret_cast<Int4>(firstRgba);
-        if (smp == first)
-            firstRgba = rgba;
-        else
-            same = same && (differ[0] | differ[1] | differ[2] | differ[3]) == 0;
+        // Whether the pixel's samples came out alike is decided on the values in registers:
+        // reading the samples back from rgbaOut waited on their stores (the whole band's
+        // composite took a fifth of the shading time of a one-sphere scene).
+        const Float4 zero = {}, one = splatFloat4(1.0f);
+        Float4 firstRgba = zero;
+        bool same = true;
+        for (size_t smp = first; smp < first + spp_; ++smp) {
+            Float4 rgba;
+            const uint8_t surfaces = count_[smp];
+            if (surfaces == 1) {
+                // One surface (most samples): SampleComposite's arithmetic written out for one
+                // layer in one vector, the same bits without its loops over layers and
+                // channels. A point's three floats are read as four (BandPoints pads its rows
+                // by one).
+                const uint32_t p = fragment_[smp * layers_ - firstSlot_];
+                const Float4 ci = loadFloat4(&color_[3 * p]);
+                const Float4 oi = loadFloat4(&opacity_[3 * p]);
+                const Float4 t = one - oi;
+                rgba = (zero + oi * ci) + t * background4_;
+                rgba[3] = 1.0f - (t[0] + t[1] + t[2]) / 3.0f;
+            } else if (surfaces == 0) {
+                // The background alone: SampleComposite's finish with nothing over it (C 0,
+                // T 1; 0 + 1 bg rather than bg, so a -0 comes out +0 as there), coverage 0.
+                rgba = zero + one * background4_;
+                rgba[3] = 0.0f;
+            } else {
+                rgba = layered(smp, surfaces);
+            }
+            storeFloat4(&rgbaOut_[4 * smp], rgba);
+            // Bit for bit, as the resolve compares alike blocks.
+            const Int4 differ = reinterpret_cast<Int4>(rgba) ^ reinterpret_cast<Int4>(firstRgba);
+            if (smp == first)
+                firstRgba = rgba;
+            else
+                same = same && (differ[0] | differ[1] | differ[2] | differ[3]) == 0;
+        }
+        uniform_[pixel] = same ? 1 : 0;
     }
-    uniform[pixel] = same ? 1 : 0;
-}
+
+  private:
+    [[gnu::noinline]] Float4 layered(size_t smp, int surfaces) const {
+        SampleComposite c;
+        for (int l = 0; l < surfaces; ++l) {
+            const uint32_t p = fragment_[smp * layers_ + static_cast<size_t>(l) - firstSlot_];
+            c.over(&color_[3 * p], &opacity_[3 * p]);
+        }
+        float out[4];
+        c.finish(background_, out);
+        return loadFloat4(out);
+    }
+
+    const uint8_t* count_;
+    const uint32_t* fragment_;
+    const uint32_t* pixelPoint_;
+    const float* color_;
+    const float* opacity_;
+    float* rgbaOut_;
+    uint8_t* uniform_;
+    size_t layers_, spp_, firstSlot_, firstPixel_;
+    glm::vec3 background_;
+    Float4 background4_;
+};
 
 // A band's (or a refined tile's) pixels, row by row.
 void compositeBand(const BandPoints& pts, const BandRange& r, const VisibilityBuffer& vis,
                    int width, int spp, const glm::vec3& background, float* rgbaOut,
                    uint8_t* uniform) {
+    const BandCompositor compositor(pts, r, vis, spp, background, rgbaOut, uniform);
     for (int py = r.row0; py < r.row1; ++py) {
         const size_t row = static_cast<size_t>(py) * static_cast<size_t>(width);
-        for (size_t pixel = row + r.col0; pixel < row + r.col1; ++pixel)
-            compositePixel(pts, r, vis, pixel, spp, background, rgbaOut, uniform);
+        for (size_t pixel = row + r.col0; pixel < row + r.col1; ++pixel) compositor.pixel(pixel);
     }
 }
 
