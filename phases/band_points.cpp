@@ -29,12 +29,16 @@ void sizePoints(BandPoints& pts, size_t objects) {
 }
 
 // Calls f(sample) for every sample of the range's rows and columns that holds a fragment.
+// The row's bounds are taken before its loop: f stores through pointers the compiler cannot
+// tell from the layout's, and it had computed the end again for every sample.
 template <typename F>
 void forEachCoveredSample(const SampleLayout& layout, const BandRange& r, const uint8_t* count,
                           F&& f) {
-    for (int py = r.row0; py < r.row1; ++py)
-        for (size_t smp = layout.index(r.col0, py, 0); smp < layout.index(r.col1, py, 0); ++smp)
+    for (int py = r.row0; py < r.row1; ++py) {
+        const size_t end = layout.index(r.col1, py, 0);
+        for (size_t smp = layout.index(r.col0, py, 0); smp < end; ++smp)
             if (count[smp]) f(smp);
+    }
 }
 
 // samplePoints with one layer (every object opaque): a sample holds at most one fragment,
@@ -67,6 +71,8 @@ void samplePointsOneLayer(const SampleLayout& layout, const VisibilityBuffer& vi
     float* const pointX = pts.x.data();
     float* const pointY = pts.y.data();
     uint32_t* const fragmentPoint = pts.fragmentPoint.data();
+    const size_t firstSlot = r.firstSlot;  // the first sample's (one layer)
+    const float* const xy = layout.positions();
     current = kNone;
     uint32_t at = 0;
     forEachCoveredSample(layout, r, count, [&](size_t smp) {
@@ -76,9 +82,9 @@ void samplePointsOneLayer(const SampleLayout& layout, const VisibilityBuffer& vi
         }
         pointObject[at] = current;
         pointFacet[at] = facet[smp];
-        pointX[at] = layout.x(smp);
-        pointY[at] = layout.y(smp);
-        fragmentPoint[smp - r.firstSlot] = at++;
+        pointX[at] = xy[2 * smp];
+        pointY[at] = xy[2 * smp + 1];
+        fragmentPoint[smp - firstSlot] = at++;
     });
 }
 
@@ -87,24 +93,24 @@ void samplePoints(const SampleLayout& layout, const VisibilityBuffer& vis, const
                   size_t objects, BandPoints& pts, BandPointScratch& s) {
     const int layers = vis.layers;
     pts.pixelPoint.clear();
-    for (int py = r.row0; py < r.row1; ++py)
-        for (size_t smp = layout.index(r.col0, py, 0); smp < layout.index(r.col1, py, 0); ++smp)
-            for (int l = 0; l < vis.count[smp]; ++l)
-                ++pts.objectStart[vis.object[smp * layers + l] + 1];
+    forEachCoveredSample(layout, r, vis.count.data(), [&](size_t smp) {
+        for (int l = 0; l < vis.count[smp]; ++l)
+            ++pts.objectStart[vis.object[smp * layers + l] + 1];
+    });
     sizePoints(pts, objects);
     s.cursor.assign(pts.objectStart.begin(), pts.objectStart.end() - 1);
-    for (int py = r.row0; py < r.row1; ++py)
-        for (size_t smp = layout.index(r.col0, py, 0); smp < layout.index(r.col1, py, 0); ++smp)
-            for (int l = 0; l < vis.count[smp]; ++l) {
-                const size_t slot = smp * layers + l;
-                const uint32_t o = vis.object[slot];
-                const uint32_t at = s.cursor[o]++;
-                pts.object[at] = o;
-                pts.facet[at] = vis.facet[slot];
-                pts.x[at] = layout.x(smp);
-                pts.y[at] = layout.y(smp);
-                pts.fragmentPoint[slot - r.firstSlot] = at;
-            }
+    forEachCoveredSample(layout, r, vis.count.data(), [&](size_t smp) {
+        for (int l = 0; l < vis.count[smp]; ++l) {
+            const size_t slot = smp * layers + l;
+            const uint32_t o = vis.object[slot];
+            const uint32_t at = s.cursor[o]++;
+            pts.object[at] = o;
+            pts.facet[at] = vis.facet[slot];
+            pts.x[at] = layout.x(smp);
+            pts.y[at] = layout.y(smp);
+            pts.fragmentPoint[slot - r.firstSlot] = at;
+        }
+    });
 }
 
 // Per pixel or per block of 2x2 pixels, in two passes over the blocks. The first finds

@@ -58,6 +58,9 @@ class SampleLayout {
     }
     float x(size_t s) const { return xy_[2 * s]; }
     float y(size_t s) const { return xy_[2 * s + 1]; }
+    // x and y of every sample, in index order (2 * count() floats): for loops that store
+    // through other pointers, where x() and y() would reload the array each time.
+    const float* positions() const { return xy_.data(); }
     // Per pixel: the mean of its samples' positions (summed in sample order, then divided by
     // spp), and which of its samples lies nearest to it (the first, in sample order, of
     // those nearest). A surface covering a whole pixel is shaded there, per pixel.
