@@ -46,9 +46,8 @@ std::span<const uint32_t> findRuns(const SurfacePoints& points, std::vector<uint
 // One facet's constants for step 1, broadcast: a lane type T is float or Float4.
 // The ray through pixel (x, y) has the direction d = d0 + x dx + y dy, so its products
 // with the facet's A1, A2 and Dn (hitFacet) are each a plane in x and y: three numbers a
-// product, made once a facet. Made per point from d instead, the products and the copies
-// of d0, dx and dy into each run's constants had been a third of this step's instructions
-// on the courtyard, whose runs are mostly one point long (small facets, samples in order).
+// product, made once a facet (facetRays), where each point had formed d and three dot
+// products of its own.
 template <typename T>
 struct FacetRay {
     T P0[3], e1[3], e2[3];
