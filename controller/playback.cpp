@@ -149,8 +149,8 @@ class Player {
 
     // The regulator's ratios: the first frame again at every step, now warm (its objects
     // built, its buffers allocated), calibrationFrames times, the least kept; each also
-    // fills what its own step reads. Each shades
-    // afresh: the same view again would otherwise run on the inputs the last one kept. A
+    // fills what its own step reads. Each shades afresh: the same view again would
+    // otherwise run on the inputs the last one kept. A
     // step whose probes fell back (a coarser footprint reads levels no step before it had
     // filled) is measured again once they are filled: the fallbacks' slower path had priced
     // per pixel at 1280x720 (teapot) at 36-38 ms and per pixel at twice the footprint above
@@ -162,18 +162,16 @@ class Player {
             fresh.reuseStillView = false;
             PlaybackStep step;
             step.step = regulator_.step(k);
-            double least = 0.0;
             for (int m = 0; m < std::max(1, options_.calibrationFrames); ++m) {
                 FrameStats s;
                 renderer_.renderFrame(options_.first, fresh, s, image_);
                 if (m == 0 && s.dynamic.probeFallbacks > 0)
                     renderer_.renderFrame(options_.first, fresh, s, image_);
                 step.probeFallbacks = std::max(step.probeFallbacks, s.dynamic.probeFallbacks);
-                const double seconds = s.dynamic.seconds();
-                step.measuredSeconds.push_back(seconds);
-                least = m == 0 ? seconds : std::min(least, seconds);
+                step.measuredSeconds.push_back(s.dynamic.seconds());
             }
-            step.dynamicSeconds = stepSeconds[static_cast<size_t>(k)] = least;
+            step.dynamicSeconds = stepSeconds[static_cast<size_t>(k)] =
+                *std::min_element(step.measuredSeconds.begin(), step.measuredSeconds.end());
             summary.steps.push_back(std::move(step));
         }
         regulator_.calibrate(stepSeconds, budget_);

@@ -59,12 +59,12 @@ struct PlaybackOptions {
     // loads (a scene of dear static shaders would otherwise load for as long as its cache
     // takes to fill). 0: only the first frame's.
     double prerollPrefetchSeconds = 1.0;
+    double prerollPrefetchWallSeconds = 2.0;
     // The pre-roll measures each step of the regulator's ladder this many times (the first
     // frame again, warm) and keeps the least: one frame's time on a busy machine can be a
     // third over its usual, and a step measured so had started the gallery one step too low
     // (docs/playback.md).
     int calibrationFrames = 2;
-    double prerollPrefetchWallSeconds = 2.0;
     double predictSeconds = 0.1;
     int predictDivisor = 4;
     // A prediction starts when the slack holds its last cost. One still running when the

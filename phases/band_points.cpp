@@ -99,6 +99,7 @@ void samplePoints(const SampleLayout& layout, const VisibilityBuffer& vis, const
     });
     sizePoints(pts, objects);
     s.cursor.assign(pts.objectStart.begin(), pts.objectStart.end() - 1);
+    const float* const xy = layout.positions();
     forEachCoveredSample(layout, r, vis.count.data(), [&](size_t smp) {
         for (int l = 0; l < vis.count[smp]; ++l) {
             const size_t slot = smp * layers + l;
@@ -106,8 +107,8 @@ void samplePoints(const SampleLayout& layout, const VisibilityBuffer& vis, const
             const uint32_t at = s.cursor[o]++;
             pts.object[at] = o;
             pts.facet[at] = vis.facet[slot];
-            pts.x[at] = layout.x(smp);
-            pts.y[at] = layout.y(smp);
+            pts.x[at] = xy[2 * smp];
+            pts.y[at] = xy[2 * smp + 1];
             pts.fragmentPoint[slot - r.firstSlot] = at;
         }
     });
