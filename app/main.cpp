@@ -69,6 +69,12 @@ int main(int argc, char** argv) {
     renderCmd->add_flag("--no-single-phase", render.noSinglePhase,
                         "Multiphase: every frame multi-phase, even where its static work would "
                         "cost more than rendering the frames asked for single-phase");
+    renderCmd
+        ->add_option("--view-lookahead", render.viewLookahead,
+                     "Multiphase: an object's static phase may be built for the view up to this "
+                     "many frames ahead whose range holds the present frame, so a moving camera "
+                     "re-runs it less often (0: always the present view)")
+        ->capture_default_str();
     renderCmd->add_flag("--quiet", render.quiet, "No progress bar");
     renderCmd->add_option("--cache-mb", render.cacheMb,
                           "Multiphase: memory budget of the shader maps' tiles, MB (default 96; "

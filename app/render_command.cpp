@@ -134,6 +134,10 @@ MultiphaseOptions multiphaseOptions(const RenderCommandOptions& options) {
                              "expected 1..1048576 MB, found " + std::to_string(options.cacheMb));
         mo.mapMemoryBytes = static_cast<size_t>(options.cacheMb) << 20;
     }
+    if (options.viewLookahead < 0 || options.viewLookahead > 1000)
+        throw InputError({"--view-lookahead", 0, 0, {}},
+                         "expected 0..1000 frames, found " + std::to_string(options.viewLookahead));
+    mo.viewLookahead = options.viewLookahead;
     // --compare measures the multi-phase engine against the reference: a frame the
     // reference rendered in its place would only be compared with itself.
     mo.singlePhaseFrames = !options.noSinglePhase && !options.compare;

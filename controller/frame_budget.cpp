@@ -45,8 +45,10 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
             const ScopedSpan span(options_.trace, "build ahead", PhaseKind::Static,
                                   SpanLevel::Phase, static_cast<int64_t>(i), frame);
             StaticCosts costs;
-            slot.representation = static_.build(i, kind, ahead.objects[i], ahead.camera,
-                                                ahead.uniforms[i], nullptr, costs);
+            ShadingUniforms uniforms = ahead.uniforms[i];
+            const auto [state, camera] = buildView(i, f, ahead.objects[i], ahead.camera);
+            uniforms.eye = state.eye;
+            slot.representation = static_.build(i, kind, state, camera, uniforms, nullptr, costs);
             recordBuild(i, kind, costs, ahead.uniforms[i]);
             ++built;
             if (secondsSince(start) >= seconds) return secondsSince(start);

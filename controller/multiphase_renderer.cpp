@@ -4,10 +4,15 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include <tbb/parallel_for.h>
+#include <glm/geometric.hpp>
 
 #include "controller/static_run_triggers.h"
+#include "controller/view_lookahead.h"
+#include "scene/scene_state.h"
 
 namespace mpshade {
 namespace {
@@ -332,9 +337,10 @@ void MultiphaseRenderer::sendRebuildsToBackground(FramePlan& plan, FrameStats& s
             RebuildJob job;
             job.object = i;
             job.kind = slot.kind;
-            job.state = frame_.objects[i];
-            job.camera = frame_.camera;
+            std::tie(job.state, job.camera) =
+                buildView(i, frame_.index, frame_.objects[i], frame_.camera);
             job.uniforms = frame_.uniforms[i];
+            job.uniforms.eye = job.state.eye;
             job.params.assign(job.uniforms.params.begin(), job.uniforms.params.end());
             job.lights.assign(job.uniforms.lights.begin(), job.uniforms.lights.end());
             job.previous = slot.representation.get();
@@ -394,9 +400,11 @@ void MultiphaseRenderer::buildDue(const FramePlan& plan, FrameStats& stats) {
         const ScopedSpan task(options_.trace, "build", PhaseKind::Static, SpanLevel::Task,
                               static_cast<int64_t>(i), plan.frame);
         ObjectSlot& slot = slots_[i];
-        slot.representation =
-            static_.build(i, slot.kind, frame_.objects[i], frame_.camera, frame_.uniforms[i],
-                          slot.representation.get(), costs[k]);
+        ShadingUniforms uniforms = frame_.uniforms[i];
+        const auto [state, camera] = buildView(i, plan.frame, frame_.objects[i], frame_.camera);
+        uniforms.eye = state.eye;
+        slot.representation = static_.build(i, slot.kind, state, camera, uniforms,
+                                            slot.representation.get(), costs[k]);
         slot.builtThisFrame = true;
     });
     for (size_t k = 0; k < plan.due.size(); ++k) {
@@ -405,6 +413,41 @@ void MultiphaseRenderer::buildDue(const FramePlan& plan, FrameStats& stats) {
         slots_[i].frameStaticSeconds += costs[k].seconds;
         stats.staticWork.work += costs[k];
     }
+}
+
+// The view object i's static phase is built for at frame `frame`, where the object's state
+// is `present` and the camera `camera`: that view, or one ahead whose range holds it
+// (view_lookahead.h). The same whichever path builds it (in the frame, in the background,
+// ahead of a locked frame rate's frames), so a frame does not depend on which did. The
+// object stands where it stands at `frame` over the frames considered, so its placement,
+// and what its static part reads, are that frame's.
+std::pair<ObjectState, CameraState> MultiphaseRenderer::buildView(size_t i, int frame,
+                                                                  const ObjectState& present,
+                                                                  const CameraState& camera) const {
+    // Views up to twice the look-ahead: a view ahead is worth as many frames as its range
+    // holds, before it and after.
+    const int ahead = options_.viewLookahead;
+    const int last = std::min(frame + 2 * ahead, planLast_ - 1);
+    if (ahead <= 0 || last <= frame || !viewAnimated()) return {present, camera};
+    auto viewpoint = [](const ObjectState& s, const CameraState& c) {
+        return ObjectViewpoint{
+            s.eye, glm::normalize(glm::vec3(s.worldToObject * glm::vec4(c.forward, 0.0f))),
+            s.objectToWorld};
+    };
+    std::vector<ObjectViewpoint> views = {viewpoint(present, camera)};
+    std::vector<std::pair<ObjectState, CameraState>> states = {{present, camera}};
+    for (int f = frame + 1; f <= last; ++f) {
+        const float t = scene_.frameTime(f);
+        const CameraState c = cameraAt(scene_, t, camera.width, camera.height);
+        const ObjectState state = objectAt(scene_.objects[i], t, c);
+        views.push_back(viewpoint(state, c));
+        states.emplace_back(state, c);
+    }
+    const ObjectSlot& slot = slots_[i];
+    const glm::vec3 center = slot.representation
+                                 ? slot.representation->center
+                                 : surfaceBounds(*scene_.objects[i].surface).center();
+    return states[holdingView(views, static_cast<size_t>(ahead), center, scene_.objects[i].range)];
 }
 
 void MultiphaseRenderer::recordBuild(size_t i, Representation kind, const StaticCosts& costs,

@@ -20,6 +20,14 @@ bool ObjectRepresentation::inRange(const glm::vec3& eye, const glm::vec3& forwar
 
 ObjectRepresentation::RangeCheck ObjectRepresentation::checkRange(const glm::vec3& eye,
                                                                   const glm::vec3& forward) const {
+    return checkRange(range, center, representativeEye, representativeForward, frustumCulled, eye,
+                      forward);
+}
+
+ObjectRepresentation::RangeCheck ObjectRepresentation::checkRange(
+    const RangeOptions& range, const glm::vec3& center, const glm::vec3& representativeEye,
+    const glm::vec3& representativeForward, bool frustumCulled, const glm::vec3& eye,
+    const glm::vec3& forward) {
     RangeCheck c;
     auto degrees = [](float cosine) {
         return glm::degrees(std::acos(std::clamp(cosine, -1.0f, 1.0f)));

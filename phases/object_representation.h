@@ -71,6 +71,13 @@ struct ObjectRepresentation {
         float measured = 0.0f, threshold = 0.0f;  // degrees, or the distance ratio
     };
     RangeCheck checkRange(const glm::vec3& eye, const glm::vec3& forward) const;
+    // The same for any representative view: `range` around `center`, from representativeEye
+    // looking along representativeForward (object space, unit), its patches frustum culled or
+    // not.
+    static RangeCheck checkRange(const RangeOptions& range, const glm::vec3& center,
+                                 const glm::vec3& representativeEye,
+                                 const glm::vec3& representativeForward, bool frustumCulled,
+                                 const glm::vec3& eye, const glm::vec3& forward);
     // Bytes of the facets and their attributes (the map is counted apart: it is shared).
     size_t bytes() const { return mesh.bytes(); }
 };

@@ -336,6 +336,8 @@ TEST(Cli, BadInputExitsTwoNamingThePlace) {
          "mpshade: --footprint-scale: error: expected 0.05..8, found 9"},
         {"render examples/vase/scene.json --footprint-scale nan --out /tmp/x",
          "mpshade: --footprint-scale: error: expected 0.05..8, found"},
+        {"render examples/vase/scene.json --view-lookahead -1 --out /tmp/x",
+         "mpshade: --view-lookahead: error: expected 0..1000 frames, found -1"},
         {"paint", "mpshade: error: "},
     };
     for (const BadRun& c : cases) {

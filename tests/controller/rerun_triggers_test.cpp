@@ -48,7 +48,9 @@ TEST(RerunTriggers, AnOrbitWithinTheRangeRunsNothingAfterTheFirstFrame) {
 
 TEST(RerunTriggers, LeavingTheRangeRunsExactlyTheObjectsThatLeftItAndSaysWhy) {
     const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
-    MultiphaseRenderer renderer(scene, everyFrame());
+    MultiphaseOptions o = everyFrame();
+    o.viewLookahead = 0;  // built for the present view: the range is frame 0's
+    MultiphaseRenderer renderer(scene, o);
     FrameStats stats;
     const int floorIndex = scene.objects[0].name == "floor" ? 0 : 1;
     for (int frame = 0; frame <= 6; ++frame) renderer.renderFrame(frame, tiny(), stats);
@@ -68,6 +70,39 @@ TEST(RerunTriggers, LeavingTheRangeRunsExactlyTheObjectsThatLeftItAndSaysWhy) {
     // The floor was re-run at frame 6: frame 7 is in its new range.
     renderer.renderFrame(7, tiny(), stats);
     EXPECT_TRUE(stats.staticWork.due.empty());
+}
+
+// With the camera's path known, the floor is built for a view ahead whose range holds the
+// present one: it is built less often over the orbit, and every frame drawn from a
+// representation is inside that representation's range.
+TEST(RerunTriggers, BuildingForAViewAheadRunsTheStaticPhaseLessOften) {
+    const Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
+    const int floorIndex = scene.objects[0].name == "floor" ? 0 : 1;
+    auto floorRuns = [&](int lookahead) {
+        MultiphaseOptions o = everyFrame();
+        o.viewLookahead = lookahead;
+        MultiphaseRenderer renderer(scene, o);
+        FrameStats stats;
+        for (int frame = 0; frame < 24; ++frame) {
+            renderer.renderFrame(frame, tiny(), stats);
+            const ObjectRepresentation* rep = renderer.representation(floorIndex);
+            const CameraState camera = cameraAt(scene, scene.frameTime(frame), 64, 36);
+            const ObjectState state =
+                objectAt(scene.objects[floorIndex], scene.frameTime(frame), camera);
+            const glm::vec3 forward =
+                glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
+            EXPECT_TRUE(rep->inRange(state.eye, forward)) << lookahead << " " << frame;
+            if (frame == 0 && lookahead > 0) {
+                EXPECT_NE(rep->representativeEye, state.eye);
+            }
+        }
+        return renderer.slot(floorIndex).report.staticCosts.runs;
+    };
+    const int present = floorRuns(0), ahead = floorRuns(8);
+    // 1.875 degrees a frame against a 10-degree range: a range about the present view holds
+    // 6 frames (0-5), one about the view 5 frames ahead 11 (0-10).
+    EXPECT_EQ(present, 4);
+    EXPECT_EQ(ahead, 3);
 }
 
 TEST(RerunTriggers, ANewImageHeightIsDueWithBothHeights) {
