@@ -30,7 +30,7 @@ struct RenderCommandOptions {
     // Multiphase: never render a frame single-phase, even where the static work it needs
     // would not pay for itself over the frames asked for (MultiphaseOptions).
     bool noSinglePhase = false;
-    int viewLookahead = 8;  // frames ahead a static run may be built for; 0: the present view
+    int viewLookahead = 24;  // frames ahead a static run may be built for; 0: the present view
     // Multiphase: the shader maps' tiles' memory budget, MB (MultiphaseOptions::
     // mapMemoryBytes); 0: its default.
     int64_t cacheMb = 0;

@@ -54,7 +54,7 @@ struct MultiphaseOptions {
     // (view_lookahead.h): a camera moving steadily leaves the range about half as often.
     // Constant quality only (a locked frame rate builds for the present view); 0: the present
     // view, always.
-    int viewLookahead = 8;
+    int viewLookahead = 24;
     // Where every phase reports its spans (phase_trace.h; not owned, must outlive the
     // renderer). Null: nowhere, and nothing is measured for it.
     PhaseTrace* trace = nullptr;
