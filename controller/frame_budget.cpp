@@ -45,10 +45,10 @@ double MultiphaseRenderer::buildAhead(int frame, int frames, const RenderOptions
             const ScopedSpan span(options_.trace, "build ahead", PhaseKind::Static,
                                   SpanLevel::Phase, static_cast<int64_t>(i), frame);
             StaticCosts costs;
-            ShadingUniforms uniforms = ahead.uniforms[i];
-            const auto [state, camera] = buildView(i, f, ahead.objects[i], ahead.camera);
-            uniforms.eye = state.eye;
-            slot.representation = static_.build(i, kind, state, camera, uniforms, nullptr, costs);
+            const BuildView view =
+                buildView(i, f, ahead.objects[i], ahead.camera, ahead.uniforms[i]);
+            slot.representation =
+                static_.build(i, kind, view.state, view.camera, view.uniforms, nullptr, costs);
             recordBuild(i, kind, costs, ahead.uniforms[i]);
             ++built;
             if (secondsSince(start) >= seconds) return secondsSince(start);

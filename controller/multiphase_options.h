@@ -49,11 +49,11 @@ struct MultiphaseOptions {
     // renderer instead, and nothing is built (a camera cut every frame, a short request).
     // Off: every frame is multi-phase.
     bool singlePhaseFrames = true;
-    // An object's static phase is built for the latest view among this many frames ahead
-    // whose range still holds the frame being rendered and every frame between
-    // (view_lookahead.h): a camera moving steadily leaves the range about half as often.
-    // Constant quality only (a locked frame rate builds for the present view); 0: the present
-    // view, always.
+    // An object's static phase is built for whichever of the present view and this many
+    // frames' views ahead has the range holding the longest run of frames from the present
+    // one (view_lookahead.h): a camera moving steadily leaves the range less often. Every
+    // path that builds (in the frame, in the background, ahead of a locked frame rate's
+    // frames) builds for the same view; 0: the present view, always.
     int viewLookahead = 24;
     // Where every phase reports its spans (phase_trace.h; not owned, must outlive the
     // renderer). Null: nowhere, and nothing is measured for it.

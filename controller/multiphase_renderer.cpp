@@ -8,7 +8,6 @@
 #include <utility>
 
 #include <tbb/parallel_for.h>
-#include <glm/geometric.hpp>
 
 #include "controller/static_run_triggers.h"
 #include "controller/view_lookahead.h"
@@ -337,10 +336,11 @@ void MultiphaseRenderer::sendRebuildsToBackground(FramePlan& plan, FrameStats& s
             RebuildJob job;
             job.object = i;
             job.kind = slot.kind;
-            std::tie(job.state, job.camera) =
-                buildView(i, frame_.index, frame_.objects[i], frame_.camera);
-            job.uniforms = frame_.uniforms[i];
-            job.uniforms.eye = job.state.eye;
+            BuildView view =
+                buildView(i, frame_.index, frame_.objects[i], frame_.camera, frame_.uniforms[i]);
+            job.state = view.state;
+            job.camera = view.camera;
+            job.uniforms = view.uniforms;
             job.params.assign(job.uniforms.params.begin(), job.uniforms.params.end());
             job.lights.assign(job.uniforms.lights.begin(), job.uniforms.lights.end());
             job.previous = slot.representation.get();
@@ -400,10 +400,9 @@ void MultiphaseRenderer::buildDue(const FramePlan& plan, FrameStats& stats) {
         const ScopedSpan task(options_.trace, "build", PhaseKind::Static, SpanLevel::Task,
                               static_cast<int64_t>(i), plan.frame);
         ObjectSlot& slot = slots_[i];
-        ShadingUniforms uniforms = frame_.uniforms[i];
-        const auto [state, camera] = buildView(i, plan.frame, frame_.objects[i], frame_.camera);
-        uniforms.eye = state.eye;
-        slot.representation = static_.build(i, slot.kind, state, camera, uniforms,
+        const BuildView view =
+            buildView(i, plan.frame, frame_.objects[i], frame_.camera, frame_.uniforms[i]);
+        slot.representation = static_.build(i, slot.kind, view.state, view.camera, view.uniforms,
                                             slot.representation.get(), costs[k]);
         slot.builtThisFrame = true;
     });
@@ -416,38 +415,40 @@ void MultiphaseRenderer::buildDue(const FramePlan& plan, FrameStats& stats) {
 }
 
 // The view object i's static phase is built for at frame `frame`, where the object's state
-// is `present` and the camera `camera`: that view, or one ahead whose range holds it
-// (view_lookahead.h). The same whichever path builds it (in the frame, in the background,
-// ahead of a locked frame rate's frames), so a frame does not depend on which did. The
-// object stands where it stands at `frame` over the frames considered, so its placement,
-// and what its static part reads, are that frame's.
-std::pair<ObjectState, CameraState> MultiphaseRenderer::buildView(size_t i, int frame,
-                                                                  const ObjectState& present,
-                                                                  const CameraState& camera) const {
+// is `present`, the camera `camera` and its uniforms `uniforms`: that view, or one ahead
+// whose range holds it (view_lookahead.h). The same whichever path builds it (in the frame,
+// in the background, ahead of a locked frame rate's frames), so a frame does not depend on
+// which did. The object stands where it stands at `frame` over the frames considered, so
+// its placement, and what its static part reads, are that frame's: of the uniforms only the
+// eye is the chosen view's.
+MultiphaseRenderer::BuildView MultiphaseRenderer::buildView(size_t i, int frame,
+                                                            const ObjectState& present,
+                                                            const CameraState& camera,
+                                                            const ShadingUniforms& uniforms) const {
+    BuildView view{present, camera, uniforms};
     // Views up to twice the look-ahead: a view ahead is worth as many frames as its range
     // holds, before it and after.
     const int ahead = options_.viewLookahead;
     const int last = std::min(frame + 2 * ahead, planLast_ - 1);
-    if (ahead <= 0 || last <= frame || !viewAnimated()) return {present, camera};
-    auto viewpoint = [](const ObjectState& s, const CameraState& c) {
-        return ObjectViewpoint{
-            s.eye, glm::normalize(glm::vec3(s.worldToObject * glm::vec4(c.forward, 0.0f))),
-            s.objectToWorld};
-    };
-    std::vector<ObjectViewpoint> views = {viewpoint(present, camera)};
+    if (ahead <= 0 || last <= frame || !viewAnimated()) return view;
+    std::vector<ObjectViewpoint> views = {
+        {present.eye, viewForward(present, camera), present.objectToWorld}};
     std::vector<std::pair<ObjectState, CameraState>> states = {{present, camera}};
     for (int f = frame + 1; f <= last; ++f) {
         const float t = scene_.frameTime(f);
         const CameraState c = cameraAt(scene_, t, camera.width, camera.height);
         const ObjectState state = objectAt(scene_.objects[i], t, c);
-        views.push_back(viewpoint(state, c));
+        views.push_back({state.eye, viewForward(state, c), state.objectToWorld});
         states.emplace_back(state, c);
     }
     const ObjectSlot& slot = slots_[i];
     const glm::vec3 center = slot.representation
                                  ? slot.representation->center
                                  : surfaceBounds(*scene_.objects[i].surface).center();
-    return states[holdingView(views, static_cast<size_t>(ahead), center, scene_.objects[i].range)];
+    std::tie(view.state, view.camera) =
+        states[holdingView(views, static_cast<size_t>(ahead), center, scene_.objects[i].range)];
+    view.uniforms.eye = view.state.eye;
+    return view;
 }
 
 void MultiphaseRenderer::recordBuild(size_t i, Representation kind, const StaticCosts& costs,

@@ -128,9 +128,14 @@ class MultiphaseRenderer : public Renderer {
     void render(int frame, const RenderOptions& options, FrameStats& stats,
                 const ProgressFn& progress);
 
-    // The object's state and camera its static phase is built for at a frame.
-    std::pair<ObjectState, CameraState> buildView(size_t i, int frame, const ObjectState& present,
-                                                  const CameraState& camera) const;
+    // What object i's static phase is built for at a frame (multiphase_renderer.cpp).
+    struct BuildView {
+        ObjectState state;
+        CameraState camera;
+        ShadingUniforms uniforms;
+    };
+    BuildView buildView(size_t i, int frame, const ObjectState& present, const CameraState& camera,
+                        const ShadingUniforms& uniforms) const;
     // Records one static run of object i (its slot, its report, the inputs it read).
     void recordBuild(size_t i, Representation kind, const StaticCosts& costs,
                      const ShadingUniforms& uniforms);

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include <glm/geometric.hpp>
+#include "scene/scene_state.h"
 
 namespace mpshade {
 
@@ -20,9 +20,8 @@ std::optional<StaticRunDue> staticRunDue(uint32_t object, const ObjectSlot& slot
         due.threshold = slot.referenceMs;
         return due;
     }
-    const glm::vec3 forward =
-        glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
-    const ObjectRepresentation::RangeCheck range = rep->checkRange(state.eye, forward);
+    const ObjectRepresentation::RangeCheck range =
+        rep->checkRange(state.eye, viewForward(state, camera));
     float inputsMoved = 0.0f;
     if (range.fiducial == ObjectRepresentation::RangeCheck::None && !slot.staticInputs.empty()) {
         slot.staticInputs.read(uniforms, scratch);

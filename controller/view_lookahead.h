@@ -2,11 +2,11 @@
 // (the view distance within a factor, the direction around the object and the view
 // direction within an angle) holds on both sides of its representative view, so a
 // representation built for the view a few frames ahead serves the frames before it as well
-// as those after: where the camera's path is known (an animation rendered), the controller
-// builds for the latest view ahead whose range still holds every view from the present one
-// to it, and a camera moving steadily goes back through the static phase about half as
-// often (patent col. 11, the controller re-running the static phase when the view leaves
-// the range; Fearing 2000, predicting the views to come rather than reacting to them).
+// as those after: where the camera's path is known (the scene's keys), the controller
+// builds for the view ahead whose range holds the longest run of frames from the present
+// one, and a camera moving steadily goes back through the static phase less often (patent
+// col. 11, the controller re-running the static phase when the view leaves the range;
+// Fearing 2000, predicting the views to come rather than reacting to them).
 #pragma once
 
 #include <span>

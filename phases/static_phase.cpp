@@ -13,6 +13,7 @@
 
 #include "phases/fixed_point_warp.h"
 #include "phases/stored_representation.h"
+#include "scene/scene_state.h"
 #include "scene/variability.h"
 #include "shadermaps/tile_store.h"
 #include "shading/builtins.h"
@@ -149,7 +150,7 @@ DicingView StaticPhase::dicingView(const ObjectState& state, const CameraState& 
     const float tx = camera.tanHalfFovY * camera.aspect, ty = camera.tanHalfFovY;
     view.fovSlack = 1.0f + tx * tx + ty * ty;
     view.nearDistance = camera.zNear / state.scale;
-    view.forward = glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
+    view.forward = viewForward(state, camera);
     view.halfDiagonalFov = std::atan(std::sqrt(tx * tx + ty * ty));
     view.projects = true;
     objectToScreen(state.objectToWorld, camera, view.screen);

@@ -48,6 +48,10 @@ CameraState cameraAt(const Scene& scene, float t, int width, int height) {
     return c;
 }
 
+glm::vec3 viewForward(const ObjectState& state, const CameraState& camera) {
+    return glm::normalize(glm::vec3(state.worldToObject * glm::vec4(camera.forward, 0.0f)));
+}
+
 ObjectState objectAt(const SceneObject& object, float t, const CameraState& camera) {
     const ObjectTransform& tr = object.transform;
     const glm::vec4 rot = tr.rotate.at(t);

@@ -39,6 +39,10 @@ struct ObjectState {
 
 ObjectState objectAt(const SceneObject& object, float t, const CameraState& camera);
 
+// The camera's view direction in the object's space (unit): what a representation's range
+// compares (its representative view's and a frame's), made the same way everywhere.
+glm::vec3 viewForward(const ObjectState& state, const CameraState& camera);
+
 // Fills the animated parameter block `program` expects (IrProgram::paramFloats floats).
 void animatedParamsAt(const SceneObject& object, const IrProgram& program, float t,
                       std::vector<float>& block);
