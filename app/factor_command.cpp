@@ -182,7 +182,8 @@ nlohmann::json factoringJson(const std::string& shaderFile, const ShaderAst& ast
 // What the scene's frames ask of a binding's shader map (phases/map_demand.h).
 struct BoundMap {
     MapDemand demand;
-    bool half = false;  // the object's "shadermap_precision"
+    bool half = false;            // the object's "shadermap_precision", or what auto chooses
+    std::string precisionReason;  // auto: why (map_precision.h); empty: set by the scene
 };
 
 void printMapDemand(const BoundMap& map, int floats) {
@@ -204,6 +205,8 @@ void printMapDemand(const BoundMap& map, int floats) {
             d.bytes(floats, !map.half) / 1048576.0, map.half ? "float32" : "binary16");
     std::printf(";\n    play keeps %.0f tiles of coarse levels resident besides: %.2f MB\n",
                 d.pinnedTiles, pinned);
+    if (!map.precisionReason.empty())
+        std::printf("  precision auto: %s\n", map.precisionReason.c_str());
 }
 
 nlohmann::json mapDemandJson(const BoundMap& map, int floats) {
@@ -215,6 +218,7 @@ nlohmann::json mapDemandJson(const BoundMap& map, int floats) {
             {"pinned_tiles", d.pinnedTiles},
             {"finest_level", d.finestLevel},
             {"precision", map.half ? "half" : "float"},
+            {"precision_reason", map.precisionReason},
             {"bytes", d.bytes(floats, map.half)},
             {"pinned_bytes", d.bytes(d.pinnedTiles, floats, map.half)}};
 }
@@ -374,7 +378,7 @@ void addToGroups(std::vector<SplitGroup>& groups, const SceneObject& object,
                             std::to_string(f.staticInstructions) + " " +
                             std::to_string(f.dynamicInstructions) + " " +
                             std::to_string(f.staticCost) + " " + std::to_string(f.dynamicCost) +
-                            " " + std::to_string(object.shadermapHalf);
+                            " " + std::to_string(map.half);
     for (SplitGroup& g : groups)
         if (g.key == key) {
             g.objects.push_back(object.name);
@@ -386,7 +390,7 @@ void addToGroups(std::vector<SplitGroup>& groups, const SceneObject& object,
     g.shader = object.shader->name;
     g.objects = {object.name};
     g.channels = f.chosenWidth;
-    g.bytesPerTexel = f.chosenWidth * (object.shadermapHalf ? 2 : 4);
+    g.bytesPerTexel = f.chosenWidth * (map.half ? 2 : 4);
     g.staticCost = f.staticCost;
     g.dynamicCost = f.dynamicCost;
     g.mapBytes = bytes;
@@ -525,14 +529,19 @@ int runFactorCommand(const FactorCommandOptions& options) {
         const std::string file = options.shader.empty() ? object.shader->file : options.shader;
         if (k > 0 && !options.json) std::printf("\n----\n\n");
         nlohmann::json doc;
-        const BoundMap map{demands[k], object.shadermapHalf};
+        BoundMap map{demands[k], object.shadermapPrecision == MapPrecision::Half, {}};
+        if (object.shadermapPrecision == MapPrecision::Auto) {
+            const MapPrecisionCheck check = measures.precisionAt(objects[k], demands[k].frame);
+            map.half = check.half;
+            map.precisionReason = check.reason;
+        }
         std::optional<FactoredShader> without;
         const FactoredShader f = factorOne(options, file, *object.shader,
                                            objectBinding(scene, object, *object.shader, file),
                                            "object '" + object.name + "' in " + options.scene, &map,
                                            options.json ? &doc : nullptr, &without);
         addToGroups(groups, object, f, map);
-        addToBusiest(byFrame, demands[k], f.chosenWidth, object.shadermapHalf);
+        addToBusiest(byFrame, demands[k], f.chosenWidth, map.half);
         within = measures.report(f, without ? &*without : nullptr, objects[k],
                                  options.json ? &doc : nullptr) &&
                  within;

@@ -112,6 +112,14 @@ SplitVerification SplitMeasures::asTheSceneHasIt(size_t object) {
     return verifySplit(*statics_, resources_, object);
 }
 
+MapPrecisionCheck SplitMeasures::precisionAt(size_t object, int frame) {
+    if (!statics_) statics_ = std::make_unique<StaticPhase>(scene_, resources_, staticOptions_);
+    const FrameState state = frameStateAt(resources_, std::max(frame, 0), scene_.settings.width,
+                                          scene_.settings.height, 1);
+    return checkHalfPrecision(*statics_, *scene_.objects[object].surface, object,
+                              state.uniforms[object], staticOptions_.precision);
+}
+
 SplitVerification SplitMeasures::withTheWhatIf(size_t object) {
     if (!whatIfStatics_) {
         whatIfScene_ = std::make_unique<Scene>(scene_);

@@ -38,6 +38,9 @@ class SplitMeasures {
 
     SplitVerification asTheSceneHasIt(size_t object);
     SplitVerification withTheWhatIf(size_t object);
+    // The precision "auto" gives object `object`'s map (phases/map_precision.h), checked at
+    // frame `frame`'s view as a static run there would check it.
+    MapPrecisionCheck precisionAt(size_t object, int frame);
 
     // The measures of object `object`'s split `f` (--verify, its bakes, and with a what-if
     // `without`, the split without it, measured beside it; null: no what-if), printed to

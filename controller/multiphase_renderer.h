@@ -101,6 +101,8 @@ class MultiphaseRenderer : public Renderer {
     const Scene& scene() const { return scene_; }
     // The frame states' source (ray scenes for occlusion included), fixed for the render.
     const SceneResources& resources() const { return resources_; }
+    // The static phase (its objects' shading, their maps' precision checks).
+    const StaticPhase& statics() const { return static_; }
     // The dynamic phase's options for a frame rendered with `options`: its shading rate
     // and footprint scale where it sets them, else MultiphaseOptions', else the scene's
     // shading rate.

@@ -93,7 +93,7 @@ ObjectCostInputs RepresentationPlanner::costInputs(size_t i, const ObjectSlot& s
         coarseLevelTiles(shifts, map.resolution, map.tileSize, map.alwaysResidentLevels);
     in.pinnedBytes = in.pinnedTiles * tile * tile *
                      static_cast<double>(shading.factored.staticPart.channelOutputs.size()) *
-                     (mapOptions.halfPrecision || obj.shadermapHalf ? 2.0 : 4.0);
+                     (map.halfPrecision ? 2.0 : 4.0);
     in.haveMap = slot.representation && slot.representation->map;
     in.pinnedUpFront = mapOptions.fillPinnedUpFront;
     // The screen area: the object's bounding sphere, projected, within the screen.

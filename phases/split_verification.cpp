@@ -10,22 +10,6 @@
 namespace mpshade {
 namespace {
 
-// Cell centres of a k x k grid on each chart, k chosen so the total stays within `budget`;
-// past `budget` charts, every so many charts' centres.
-std::vector<ChartPoint> spreadPoints(const Surface& surface, int budget) {
-    const int charts = chartCount(surface);
-    std::vector<ChartPoint> points;
-    if (charts <= 0) return points;
-    const int k = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(budget) / charts)));
-    const int stride = std::max(1, charts / std::max(1, budget));
-    for (int c = 0; c < charts; c += stride)
-        for (int j = 0; j < k; ++j)
-            for (int i = 0; i < k; ++i)
-                points.push_back(
-                    {c, (i + 0.5f) / static_cast<float>(k), (j + 0.5f) / static_cast<float>(k)});
-    return points;
-}
-
 std::vector<int> spreadFrames(int count, int budget) {
     std::vector<int> frames;
     const int n = std::clamp(budget, 1, std::max(1, count));
@@ -67,6 +51,20 @@ struct Tally {
 
 }  // namespace
 
+std::vector<ChartPoint> spreadChartPoints(const Surface& surface, int budget) {
+    const int charts = chartCount(surface);
+    std::vector<ChartPoint> points;
+    if (charts <= 0) return points;
+    const int k = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(budget) / charts)));
+    const int stride = std::max(1, charts / std::max(1, budget));
+    for (int c = 0; c < charts; c += stride)
+        for (int j = 0; j < k; ++j)
+            for (int i = 0; i < k; ++i)
+                points.push_back(
+                    {c, (i + 0.5f) / static_cast<float>(k), (j + 0.5f) / static_cast<float>(k)});
+    return points;
+}
+
 double SplitVerification::maxRelative() const {
     double m = 0.0;
     for (const SplitDifference& d : outputs) m = std::max(m, d.maxRelative);
@@ -78,7 +76,7 @@ SplitVerification verifySplit(const StaticPhase& statics, const SceneResources& 
     const Scene& scene = resources.scene();
     const ObjectShading& obj = statics.shading(object);
     const Surface& surface = *scene.objects[object].surface;
-    const std::vector<ChartPoint> at = spreadPoints(surface, options.points);
+    const std::vector<ChartPoint> at = spreadChartPoints(surface, options.points);
     const std::vector<int> frames = spreadFrames(scene.frameCount(), options.frames);
     const size_t n = at.size();
     const size_t channels = obj.factored.staticPart.channelOutputs.size();

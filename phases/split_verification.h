@@ -45,6 +45,10 @@ struct SplitVerification {
     double maxRelative() const;             // over the outputs
 };
 
+// Cell centres of a k x k grid on each chart, k chosen so the total stays within `budget`;
+// past `budget` charts, every so many charts' centres.
+std::vector<ChartPoint> spreadChartPoints(const Surface& surface, int budget);
+
 // Verifies object `object` of the scene `statics` was made for (its shading as the
 // renderers factor it; `resources` the same scene's).
 SplitVerification verifySplit(const StaticPhase& statics, const SceneResources& resources,

@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include "phases/fixed_point_warp.h"
+#include "phases/map_precision.h"
 #include "phases/stored_representation.h"
 #include "scene/scene_state.h"
 #include "scene/variability.h"
@@ -137,6 +138,7 @@ StaticPhase::StaticPhase(const Scene& scene, const SceneResources& resources,
         s->directAllowed = !castsRays(s->directKernel->program());
         objects_.push_back(std::move(s));
     }
+    checks_.resize(objects_.size());
 }
 
 StaticPhase::~StaticPhase() = default;
@@ -454,7 +456,7 @@ ShaderMapOptions StaticPhase::mapOptions(size_t object) const {
     while (resolution < cap && resolution < (1 << 20)) resolution *= 2;
     map.resolution = resolution;
     map.tileSize = std::min(map.tileSize, resolution);
-    map.halfPrecision = map.halfPrecision || sceneObject.shadermapHalf;
+    map.halfPrecision = map.halfPrecision || sceneObject.shadermapPrecision == MapPrecision::Half;
     return map;
 }
 
@@ -464,11 +466,68 @@ std::shared_ptr<ShaderMap> StaticPhase::makeShaderMap(size_t index,
     const ObjectShading& obj = *objects_[index];
     const SceneObject& sceneObject = scene_.objects[index];
     const size_t channels = obj.factored.staticPart.channelOutputs.size();
-    const ShaderMapOptions mapOptions = this->mapOptions(index);
+    ShaderMapOptions mapOptions = this->mapOptions(index);
+    mapOptions.halfPrecision = mapOptions.halfPrecision || measuredHalf(index, uniforms);
     return std::make_shared<ShaderMap>(
         *sceneObject.surface, *obj.staticKernel, uniforms, mapOptions,
         pools_.forTileBytes(ShaderMap::tileBytesFor(mapOptions, static_cast<int>(channels))),
         storedTiles(index, uniforms, mapOptions));
+}
+
+bool StaticPhase::measuredHalf(size_t index, const ShadingUniforms& uniforms) const {
+    const SceneObject& sceneObject = scene_.objects[index];
+    const ObjectShading& obj = *objects_[index];
+    if (!options_.measurePrecision || sceneObject.shadermapPrecision != MapPrecision::Auto ||
+        obj.factored.staticPart.channelOutputs.empty())
+        return false;
+    // What the check depends on: both parts and the uniforms they read, the surface, the
+    // check's own options.
+    ContentHasher h;
+    h.addString("mpshade map precision").addDigest(engineDigest());
+    addProgram(h, obj.staticKernel->program());
+    addUniformsRead(h, obj.staticKernel->program(), uniforms);
+    addProgram(h, obj.dynamicKernel->program());
+    addUniformsRead(h, obj.dynamicKernel->program(), uniforms);
+    h.addDigest(sceneObject.geometryDigest)
+        .addI32(options_.precision.points)
+        .addBytes(&options_.precision.tolerance, sizeof(double))
+        .addBytes(&options_.precision.maxValue, sizeof(double));
+    const Digest128 key = h.finish();
+    MapPrecisionCheck check;
+    std::vector<unsigned char> record;
+    TileStore* store = stores(index) ? options_.store.get() : nullptr;
+    if (store && store->readRecord(key, record) && record.size() == 1 + 2 * sizeof(double) + 4) {
+        check.half = record[0] != 0;
+        std::memcpy(&check.largestValue, &record[1], sizeof(double));
+        std::memcpy(&check.largestChange, &record[1 + sizeof(double)], sizeof(double));
+        std::memcpy(&check.points, &record[1 + 2 * sizeof(double)], 4);
+        check.reason =
+            (check.half ? "half" : "float") + std::string(" (checked before: in the store)");
+    } else {
+        check =
+            checkHalfPrecision(*this, *sceneObject.surface, index, uniforms, options_.precision);
+        if (store) {
+            record.assign(1 + 2 * sizeof(double) + 4, 0);
+            record[0] = check.half ? 1 : 0;
+            std::memcpy(&record[1], &check.largestValue, sizeof(double));
+            std::memcpy(&record[1 + sizeof(double)], &check.largestChange, sizeof(double));
+            std::memcpy(&record[1 + 2 * sizeof(double)], &check.points, 4);
+            store->writeRecord(key, record);
+        }
+    }
+    std::lock_guard<std::mutex> lock(checksMutex_);
+    checks_[index] = check;
+    return check.half;
+}
+
+bool StaticPhase::precisionMeasured(size_t object) const {
+    std::lock_guard<std::mutex> lock(checksMutex_);
+    return checks_[object].has_value();
+}
+
+MapPrecisionCheck StaticPhase::precisionCheck(size_t object) const {
+    std::lock_guard<std::mutex> lock(checksMutex_);
+    return checks_[object].value_or(MapPrecisionCheck{});
 }
 
 // Everything a tile's texels depend on (tile_store.h): the static program and the uniform

@@ -8,10 +8,13 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include "phases/dicing.h"
+#include "phases/map_precision.h"
 #include "phases/object_representation.h"
 #include "phases/phase_trace.h"
 #include "phases/scene_resources.h"
@@ -27,6 +30,10 @@ struct StaticPhaseOptions {
     // The separate representation: within 1/4 pixel of the surface over the range.
     DicingOptions separateDicing = {DicingTarget::Flatness, 0.5f, 0.25f, true};
     ShaderMapOptions shaderMap;  // resolution: capped per object by the scene
+    // Objects whose "shadermap_precision" is auto: binary16 where measured not to show
+    // (map_precision.h); false: float.
+    bool measurePrecision = true;
+    MapPrecisionOptions precision;
     // Where shader-map tiles are kept between runs (shadermaps/tile_store.h); null: nowhere,
     // every tile is filled by the static shader.
     std::shared_ptr<TileStore> store;
@@ -113,7 +120,8 @@ class StaticPhase {
     const StaticPhaseOptions& options() const { return options_; }
     // The options object `object`'s shader map is made with: the options' but for its
     // resolution (the object's cap, else the options', rounded up to a power of two), a
-    // tile no larger than that, and half precision where the object asks for it.
+    // tile no larger than that, and half precision where the object asks for it (an object
+    // whose precision is auto is measured when its map is made: float here).
     ShaderMapOptions mapOptions(size_t object) const;
 
     // Object `object`'s representation for the view of `camera` (its representative view).
@@ -141,12 +149,21 @@ class StaticPhase {
               std::span<const ObjectRepresentation* const> representations, StaticCosts& costs,
               FillTiming* timing = nullptr, const StopSignal* stop = nullptr) const;
 
+    // The last precision check of object `object`'s map (map_precision.h): whether one ran
+    // (its precision auto, a map made) and what it found.
+    bool precisionMeasured(size_t object) const;
+    MapPrecisionCheck precisionCheck(size_t object) const;
+
   private:
     static DicingView dicingView(const ObjectState& state, const CameraState& camera);
     std::shared_ptr<ShaderMap> makeShaderMap(size_t index, const ShadingUniforms& uniforms) const;
     StoredTiles storedTiles(size_t index, const ShadingUniforms& uniforms,
                             const ShaderMapOptions& map) const;
     bool stores(size_t index) const;
+    // For a map made with `uniforms`: binary16 if the object's precision is auto and the check
+    // finds it does not show; the check's verdict is kept in the store, if any, so a run whose
+    // tiles all come from it does not run the static part to decide.
+    bool measuredHalf(size_t index, const ShadingUniforms& uniforms) const;
     // The dicing of an object's combined facets, or of its separate or direct ones: chart
     // coordinates kept exact (DicingOptions::chartExact) unless nothing reads them -- no
     // map, and a dynamic part that reads no u, v, s, t, dPdu or dPdv.
@@ -161,6 +178,8 @@ class StaticPhase {
     StaticPhaseOptions options_;
     std::vector<std::unique_ptr<ObjectShading>> objects_;
     mutable TilePools pools_;
+    mutable std::mutex checksMutex_;
+    mutable std::vector<std::optional<MapPrecisionCheck>> checks_;  // per object, the last
 };
 
 }  // namespace mpshade

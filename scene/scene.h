@@ -85,6 +85,8 @@ struct RangeOptions {
     float angle = 20.0f;          // degrees around the object
 };
 
+enum class MapPrecision { Auto, Float, Half };
+
 struct SceneObject {
     std::string name;
     std::string geometryType;  // scene-format name
@@ -99,8 +101,9 @@ struct SceneObject {
     Representation representation = Representation::Auto;
     int shadermapResolution = 0;  // a cap on level 0's texels per chart side; 0: the limit, 2^20
     // The shader map's channels as binary16 (shadermaps/half_float.h: relative error 2^-11,
-    // finite up to 65504): half the memory; false: float.
-    bool shadermapHalf = false;
+    // finite up to 65504, half the memory) or float; Auto: binary16 where rounding to it is
+    // measured not to show (phases/map_precision.h).
+    MapPrecision shadermapPrecision = MapPrecision::Auto;
     // "factoring": {"store": [...], "repeat": [...]}: decisions outside the source, checked
     // against the analysis when the shader is factored (shading/binding.h).
     std::vector<FactoringOverride> factoring;

@@ -519,9 +519,11 @@ class SceneLoader {
         if (auto r = o.optional("shadermap_precision")) {
             const std::string precision = r->string();
             if (precision == "half")
-                obj.shadermapHalf = true;
-            else if (precision != "float")
-                r->fail("unknown precision '" + precision + "' (expected float or half)");
+                obj.shadermapPrecision = MapPrecision::Half;
+            else if (precision == "float")
+                obj.shadermapPrecision = MapPrecision::Float;
+            else if (precision != "auto")
+                r->fail("unknown precision '" + precision + "' (expected auto, float or half)");
         }
         if (auto r = o.optional("factoring")) obj.factoring = factoringOverrides(*r);
         if (auto r = o.optional("range")) {

@@ -117,7 +117,7 @@ TEST(Cli, FactorTheWholeSceneGroupsSplitsAlike) {
         if (g["shader"] == "marble") {
             ++marbleGroups;
             EXPECT_EQ(g["objects"].size(), 11u);
-            EXPECT_EQ(g["bytes_per_texel"], 4 * g["channels"].get<int>());
+            EXPECT_EQ(g["bytes_per_texel"], 2 * g["channels"].get<int>());  // auto: binary16
             double bytes = 0.0;  // the group's estimate is its objects'
             for (const nlohmann::json& o : doc["objects"])
                 for (const nlohmann::json& name : g["objects"])
@@ -145,8 +145,13 @@ TEST(Cli, FactorEstimatesTheMapBytesARenderOfThatFrameFills) {
         const nlohmann::json& estimate = object["map_estimate"];
         const int channels = object["chosen_width"];
         ASSERT_GT(channels, 0);
+        // The precision auto chooses, as the render's map is made.
+        const int bytes = estimate["precision"] == "half" ? 2 : 4;
+        EXPECT_EQ(estimate["precision"], "half");
+        EXPECT_NE(estimate["precision_reason"].get<std::string>().find("half: rounding"),
+                  std::string::npos);
         EXPECT_DOUBLE_EQ(estimate["bytes"].get<double>(),
-                         estimate["tiles"].get<double>() * 18 * 18 * channels * 4);
+                         estimate["tiles"].get<double>() * 18 * 18 * channels * bytes);
         const int frame = estimate["frame"];
         ASSERT_GE(frame, 0);
         const std::string out = tempDir("map_estimate_" + name);

@@ -226,12 +226,15 @@ TEST(MultiphaseRenderer, KeepsTheFirstViewOnlyWhenNothingOfTheViewIsAnimated) {
 // the bytes.
 TEST(MultiphaseRenderer, HalfPrecisionMapsMatchFloatOnesInHalfTheBytes) {
     Scene scene = loadScene(test::sourcePath("examples/vase/scene.json"));
-    for (SceneObject& o : scene.objects) o.representation = Representation::ShaderMap;
+    for (SceneObject& o : scene.objects) {
+        o.representation = Representation::ShaderMap;
+        o.shadermapPrecision = MapPrecision::Float;
+    }
     const RenderOptions options = smallFrame();
     FrameStats stats;
     MultiphaseRenderer full(scene, machineryOnly());
     const Image a = full.renderFrame(3, options, stats);
-    for (SceneObject& o : scene.objects) o.shadermapHalf = true;
+    for (SceneObject& o : scene.objects) o.shadermapPrecision = MapPrecision::Half;
     MultiphaseRenderer half(scene, machineryOnly());
     const Image b = half.renderFrame(3, options, stats);
     const ImageError e = compareImages(b, a);

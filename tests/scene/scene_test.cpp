@@ -254,6 +254,7 @@ TEST(BadScenes, EveryDocumentedRangeOnBothSidesOfItsBound) {
         {"", "", R"(, "shadermap_resolution": 0)", sphere, "objects[0].shadermap_resolution"},
         {"", "", R"(, "shadermap_precision": "half")", sphere, ""},
         {"", "", R"(, "shadermap_precision": "float")", sphere, ""},
+        {"", "", R"(, "shadermap_precision": "auto")", sphere, ""},
         {"", "", R"(, "shadermap_precision": "double")", sphere, "objects[0].shadermap_precision"},
         {"", "", R"(, "shadermap_precision": 16)", sphere, "objects[0].shadermap_precision"},
         {"", "", R"(, "factoring": {"store": ["10:13"], "repeat": []})", sphere, ""},
@@ -336,6 +337,24 @@ std::string writeScene(const std::string& name, const std::string& json) {
         << "surface s(float k = 1, color c = 0) { Ci = c * k + diffuse(N) + color(time); }";
     std::ofstream(dir + name) << json;
     return dir + name;
+}
+
+TEST(SceneLoader, MapPrecisionIsAutoUnlessTheObjectSaysFloatOrHalf) {
+    const std::string path = writeScene("precision.json", R"({
+      "camera": { "eye": [0, 0, 5], "target": [0, 0, 0] }, "shaders": { "s": "s.sl" },
+      "objects": [ { "name": "a", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s" },
+                   { "name": "f", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s",
+                     "shadermap_precision": "float" },
+                   { "name": "h", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s",
+                     "shadermap_precision": "half" },
+                   { "name": "x", "geometry": { "type": "sphere", "radius": 1 }, "shader": "s",
+                     "shadermap_precision": "auto" } ] })");
+    const Scene scene = loadScene(path);
+    ASSERT_EQ(scene.objects.size(), 4u);
+    EXPECT_EQ(scene.objects[0].shadermapPrecision, MapPrecision::Auto);
+    EXPECT_EQ(scene.objects[1].shadermapPrecision, MapPrecision::Float);
+    EXPECT_EQ(scene.objects[2].shadermapPrecision, MapPrecision::Half);
+    EXPECT_EQ(scene.objects[3].shadermapPrecision, MapPrecision::Auto);
 }
 
 TEST(Variability, FollowsWhatTheSceneAnimates) {

@@ -1,0 +1,96 @@
+#include "phases/map_precision.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <glm/geometric.hpp>
+
+#include "phases/split_verification.h"
+#include "phases/static_phase.h"
+#include "shadermaps/half_float.h"
+#include "shading/shading_batch.h"
+
+namespace mpshade {
+namespace {
+
+// |a - b| relative to max(|a|, |b|, 1); two NaNs agree, a value that stops being finite
+// (or becomes so) is an infinite change.
+double relativeChange(float a, float b) {
+    if (std::isnan(a) && std::isnan(b)) return 0.0;
+    if (!std::isfinite(a) || !std::isfinite(b)) return a == b ? 0.0 : INFINITY;
+    const double d = std::fabs(double(a) - double(b));
+    return d / std::max({std::fabs(double(a)), std::fabs(double(b)), 1.0});
+}
+
+std::string describe(const MapPrecisionCheck& c, const MapPrecisionOptions& o) {
+    char text[200];
+    if (c.largestValue > o.maxValue)
+        std::snprintf(text, sizeof text, "float: a channel reaches %.3g, past %.3g", c.largestValue,
+                      o.maxValue);
+    else if (!(c.largestChange <= o.tolerance))
+        std::snprintf(text, sizeof text,
+                      "float: rounding the channels to binary16 moved an output by %.3g, "
+                      "past %.3g",
+                      c.largestChange, o.tolerance);
+    else
+        std::snprintf(text, sizeof text,
+                      "half: rounding the channels to binary16 moved the outputs by at most %.3g "
+                      "(%d points)",
+                      c.largestChange, c.points);
+    return text;
+}
+
+}  // namespace
+
+MapPrecisionCheck checkHalfPrecision(const StaticPhase& statics, const Surface& surface,
+                                     size_t object, const ShadingUniforms& uniforms,
+                                     const MapPrecisionOptions& options) {
+    MapPrecisionCheck check;
+    const ObjectShading& obj = statics.shading(object);
+    const size_t channels = obj.factored.staticPart.channelOutputs.size();
+    if (channels == 0) {
+        check.reason = "float: no channels";
+        return check;
+    }
+    const std::vector<ChartPoint> at = spreadChartPoints(surface, options.points);
+    const size_t n = at.size();
+    check.points = static_cast<int>(n);
+    ShadingBatch batch;
+    batch.resize(n, channels);
+    for (size_t i = 0; i < n; ++i) {
+        const SurfaceSample g = evaluate(surface, at[i]);
+        const glm::vec3 d = g.P - uniforms.eye;
+        const float len = glm::length(d);
+        batch.setPoint(i, g, at[i], len > 0.0f ? d / len : glm::vec3(0, 0, 1));
+    }
+    std::vector<float> workspace, outputs(6 * n);
+    ShadingCounters counters;
+    obj.staticKernel->run(uniforms, batch.in, n, batch.out, workspace, counters);
+    obj.dynamicKernel->run(uniforms, batch.in, n, batch.out, workspace, counters);
+    for (int k = 0; k < 3; ++k) {
+        std::copy_n(batch.out.Ci[k], n, &outputs[static_cast<size_t>(k) * n]);
+        std::copy_n(batch.out.Oi[k], n, &outputs[static_cast<size_t>(3 + k) * n]);
+    }
+    for (size_t c = 0; c < channels; ++c) {
+        float* values = batch.channel(c);
+        for (size_t i = 0; i < n; ++i) {
+            if (std::isfinite(values[i]))
+                check.largestValue = std::max(check.largestValue, std::fabs(double(values[i])));
+            values[i] = halfToFloat(floatToHalf(values[i]));
+        }
+    }
+    obj.dynamicKernel->run(uniforms, batch.in, n, batch.out, workspace, counters);
+    for (int k = 0; k < 3; ++k)
+        for (size_t i = 0; i < n; ++i) {
+            check.largestChange = std::max(
+                {check.largestChange,
+                 relativeChange(outputs[static_cast<size_t>(k) * n + i], batch.out.Ci[k][i]),
+                 relativeChange(outputs[static_cast<size_t>(3 + k) * n + i], batch.out.Oi[k][i])});
+        }
+    check.half = check.largestValue <= options.maxValue && check.largestChange <= options.tolerance;
+    check.reason = describe(check, options);
+    return check;
+}
+
+}  // namespace mpshade
