@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
 #include "phases/split_verification.h"
 #include "phases/static_phase.h"
 #include "shadermaps/half_float.h"
+#include "shadermaps/tile_store.h"
 #include "shading/shading_batch.h"
 
 namespace mpshade {
@@ -90,6 +93,35 @@ MapPrecisionCheck checkHalfPrecision(const StaticPhase& statics, const Surface& 
         }
     check.half = check.largestValue <= options.maxValue && check.largestChange <= options.tolerance;
     check.reason = describe(check, options);
+    return check;
+}
+
+MapPrecisionCheck checkHalfPrecisionKept(const StaticPhase& statics, const Surface& surface,
+                                         size_t object, const ShadingUniforms& uniforms,
+                                         const MapPrecisionOptions& options, TileStore* store,
+                                         const Digest128& key) {
+    // The record: the verdict, the largest value and change, the points.
+    constexpr size_t kBytes = 1 + 2 * sizeof(double) + sizeof(int32_t);
+    MapPrecisionCheck check;
+    std::vector<unsigned char> record;
+    if (store && store->readRecord(key, record) && record.size() == kBytes) {
+        check.half = record[0] != 0;
+        std::memcpy(&check.largestValue, &record[1], sizeof(double));
+        std::memcpy(&check.largestChange, &record[1 + sizeof(double)], sizeof(double));
+        std::memcpy(&check.points, &record[1 + 2 * sizeof(double)], sizeof(int32_t));
+        check.reason =
+            (check.half ? "half" : "float") + std::string(" (checked before: in the store)");
+        return check;
+    }
+    check = checkHalfPrecision(statics, surface, object, uniforms, options);
+    if (store) {
+        record.assign(kBytes, 0);
+        record[0] = check.half ? 1 : 0;
+        std::memcpy(&record[1], &check.largestValue, sizeof(double));
+        std::memcpy(&record[1 + sizeof(double)], &check.largestChange, sizeof(double));
+        std::memcpy(&record[1 + 2 * sizeof(double)], &check.points, sizeof(int32_t));
+        store->writeRecord(key, record);
+    }
     return check;
 }
 

@@ -20,12 +20,14 @@
 #include <cstddef>
 #include <string>
 
+#include "geometry/content_digest.h"
 #include "geometry/surface.h"
 #include "shading/interpreter.h"
 
 namespace mpshade {
 
 class StaticPhase;
+class TileStore;
 
 struct MapPrecisionOptions {
     int points = 256;  // at most, spread as a grid over each chart (at least one a chart)
@@ -50,5 +52,13 @@ struct MapPrecisionCheck {
 MapPrecisionCheck checkHalfPrecision(const StaticPhase& statics, const Surface& surface,
                                      size_t object, const ShadingUniforms& uniforms,
                                      const MapPrecisionOptions& options = {});
+
+// The same, its verdict kept in `store` (may be null) as a record under `key` (a digest of
+// everything the check depends on) and read back from there when present: a run whose
+// tiles all come from a store does not run the static part to decide.
+MapPrecisionCheck checkHalfPrecisionKept(const StaticPhase& statics, const Surface& surface,
+                                         size_t object, const ShadingUniforms& uniforms,
+                                         const MapPrecisionOptions& options, TileStore* store,
+                                         const Digest128& key);
 
 }  // namespace mpshade

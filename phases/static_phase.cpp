@@ -492,29 +492,9 @@ bool StaticPhase::measuredHalf(size_t index, const ShadingUniforms& uniforms) co
         .addI32(options_.precision.points)
         .addBytes(&options_.precision.tolerance, sizeof(double))
         .addBytes(&options_.precision.maxValue, sizeof(double));
-    const Digest128 key = h.finish();
-    MapPrecisionCheck check;
-    std::vector<unsigned char> record;
     TileStore* store = stores(index) ? options_.store.get() : nullptr;
-    if (store && store->readRecord(key, record) && record.size() == 1 + 2 * sizeof(double) + 4) {
-        check.half = record[0] != 0;
-        std::memcpy(&check.largestValue, &record[1], sizeof(double));
-        std::memcpy(&check.largestChange, &record[1 + sizeof(double)], sizeof(double));
-        std::memcpy(&check.points, &record[1 + 2 * sizeof(double)], 4);
-        check.reason =
-            (check.half ? "half" : "float") + std::string(" (checked before: in the store)");
-    } else {
-        check =
-            checkHalfPrecision(*this, *sceneObject.surface, index, uniforms, options_.precision);
-        if (store) {
-            record.assign(1 + 2 * sizeof(double) + 4, 0);
-            record[0] = check.half ? 1 : 0;
-            std::memcpy(&record[1], &check.largestValue, sizeof(double));
-            std::memcpy(&record[1 + sizeof(double)], &check.largestChange, sizeof(double));
-            std::memcpy(&record[1 + 2 * sizeof(double)], &check.points, 4);
-            store->writeRecord(key, record);
-        }
-    }
+    const MapPrecisionCheck check = checkHalfPrecisionKept(
+        *this, *sceneObject.surface, index, uniforms, options_.precision, store, h.finish());
     std::lock_guard<std::mutex> lock(checksMutex_);
     checks_[index] = check;
     return check.half;

@@ -100,8 +100,12 @@ void ShaderMap::texel(const TileKey& key, int slot, int i, int j, float* out) co
 }
 
 void ShaderMap::store(int slot, size_t at, float value) {
+    // A finite value past binary16's range is kept as the largest finite half of its sign,
+    // not made infinite: an "auto" map's precision is checked at sampled points only
+    // (phases/map_precision.h), and a value between them must not turn into inf * 0 later.
     if (options_.halfPrecision)
-        reinterpret_cast<uint16_t*>(tileData(slot))[at] = floatToHalf(value);
+        reinterpret_cast<uint16_t*>(tileData(slot))[at] =
+            floatToHalf(std::isfinite(value) ? std::clamp(value, -65504.0f, 65504.0f) : value);
     else
         reinterpret_cast<float*>(tileData(slot))[at] = value;
 }

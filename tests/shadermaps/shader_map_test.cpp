@@ -437,6 +437,36 @@ TEST(ShaderMap, HalfPrecisionErrorIsBounded) {
         }
 }
 
+TEST(ShaderMap, HalfPrecisionKeepsFiniteValuesPastItsRangeFinite) {
+    // (x + 2) 10^5 over the plane's x in [-2, 2]: 0 to 4 10^5, past 65504 beyond x = -1.34.
+    // Stored as binary16 those texels hold 65504, not infinity; texels within the range
+    // round as binary16 does; the float map keeps them all.
+    MapFixture f("surface b() { Ci = color(bake((P[0] + 2) * 100000.0)) * (1 + time); }");
+    ShaderMapOptions half;
+    half.resolution = 16;
+    half.halfPrecision = true;
+    ShaderMap map(f.surface, *f.kernel, f.uniforms, half);
+    map.fillLevels(0, 0);
+    ProbeOptions probe;
+    probe.filter = ProbeFilter::Trilinear;
+    int saturated = 0;
+    for (int i = 0; i < 16; ++i) {
+        const float u = (i + 0.5f) / 16;
+        const ProbeQuery q = query(u, 0.5f, 0.0f, 0.0f);
+        float got[3];
+        probeShaderMap(map, probe, {&q, 1}, got);
+        const float exact = f.direct(u, 0.5f)[0];
+        ASSERT_TRUE(std::isfinite(got[0])) << u;
+        if (exact > 65504.0f) {
+            EXPECT_EQ(got[0], 65504.0f) << u;
+            ++saturated;
+        } else {
+            EXPECT_EQ(got[0], halfToFloat(floatToHalf(exact))) << u;
+        }
+    }
+    EXPECT_GE(saturated, 12);  // texels of x > -1.34: 13 of 16 (their centres from x = -1.25)
+}
+
 TEST(ShaderMap, NoSeamsAcrossChartEdges) {
     // Bilinear probes between a chart's last texel centre and its edge interpolate towards
     // the border texel: evaluated on the neighbouring chart it continues the function;
