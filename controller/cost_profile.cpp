@@ -77,6 +77,14 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
         o.name = r.name;
         o.representation = representationName(renderer, i);
         o.reason = r.reason;
+        // A map's precision beside its representation, and what the auto check found.
+        const ObjectSlot& slot = renderer.slot(i);
+        if (slot.representation && slot.representation->map) {
+            o.representation +=
+                slot.representation->map->options().halfPrecision ? " (half)" : " (float)";
+            if (renderer.statics().precisionMeasured(i))
+                o.reason += "; map precision " + renderer.statics().precisionCheck(i).reason;
+        }
         o.staticRuns = r.staticRuns;
         o.framesDrawn = r.framesDrawn;
         for (double s : o.staticSecondsPerFrame) o.staticSeconds += s;

@@ -33,8 +33,9 @@ struct ProfileOptions {
 
 struct ObjectProfile {
     std::string name;
-    std::string representation;  // as stats.json names it
-    std::string reason;          // why it was chosen
+    // As stats.json names it, a shader map's precision after it: "shadermap (half)".
+    std::string representation;
+    std::string reason;  // why it was chosen
     int staticRuns = 0, framesDrawn = 0;
     double staticSeconds = 0.0;  // building and filling, summed over threads
     double shadeSeconds = 0.0;   // probing and shading its points, summed over threads

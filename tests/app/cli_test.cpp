@@ -482,7 +482,8 @@ TEST(Cli, ProfileWritesTheCostsAndATraceThatOpens) {
     EXPECT_NE(run.output.find("profile.md"), std::string::npos) << run.output;
     std::ifstream md(out + "/profile.md");
     const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
-    for (const char* row : {"| vase | shadermap |", "| floor | shadermap |", "| 2 |", "| 3 |"})
+    for (const char* row :
+         {"| vase | shadermap (half) |", "| floor | shadermap (half) |", "| 2 |", "| 3 |"})
         EXPECT_NE(text.find(row), std::string::npos) << row << "\n" << text;
     std::ifstream traceFile(out + "/trace.json");
     const nlohmann::json trace = nlohmann::json::parse(traceFile);
