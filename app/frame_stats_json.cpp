@@ -192,22 +192,19 @@ nlohmann::json objectReportsJson(const MultiphaseRenderer& renderer) {
                            {"tiles_filled", r.staticCosts.tilesFilled},
                            {"tiles_from_store", r.staticCosts.tilesLoaded},
                            {"map_bytes", r.mapBytes}});
+        if (const std::string precision = mapPrecisionName(renderer, i); !precision.empty()) {
+            objects.back()["map_precision"] = precision;
+            if (const auto check = renderer.statics().precisionCheck(i))
+                objects.back()["map_precision_check"] = {
+                    {"reason", check->reason},
+                    {"points", check->points},
+                    {"largest_value", check->largestValue},
+                    {"largest_change", std::isfinite(check->largestChange)
+                                           ? nlohmann::json(check->largestChange)
+                                           : nlohmann::json("inf")}};
+        }
         // The direct rule's last priced frame (static_run_triggers.h): CPU ms by the model.
         const ObjectSlot& slot = renderer.slot(i);
-        if (slot.representation && slot.representation->map) {
-            objects.back()["map_precision"] =
-                slot.representation->map->options().halfPrecision ? "half" : "float";
-            if (renderer.statics().precisionMeasured(i)) {
-                const MapPrecisionCheck check = renderer.statics().precisionCheck(i);
-                objects.back()["map_precision_check"] = {
-                    {"reason", check.reason},
-                    {"points", check.points},
-                    {"largest_value", check.largestValue},
-                    {"largest_change", std::isfinite(check.largestChange)
-                                           ? nlohmann::json(check.largestChange)
-                                           : nlohmann::json("inf")}};
-            }
-        }
         if (r.footprint.pixels > 0)
             objects.back()["footprint"] = {{"scale", r.footprintScale},
                                            {"pixels", r.footprint.pixels},

@@ -33,6 +33,12 @@ std::string representationName(const MultiphaseRenderer& renderer, size_t object
     return r.kind == Representation::Facets ? "facets" : "shadermap";
 }
 
+std::string mapPrecisionName(const MultiphaseRenderer& renderer, size_t object) {
+    const ObjectSlot& slot = renderer.slot(object);
+    if (!slot.representation || !slot.representation->map) return "";
+    return slot.representation->map->options().halfPrecision ? "half" : "float";
+}
+
 CostProfile profileScene(const Scene& scene, const std::string& scenePath,
                          const ProfileOptions& options, TraceRecorder& trace,
                          const std::function<void(int)>& progress) {
@@ -78,13 +84,10 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
         o.representation = representationName(renderer, i);
         o.reason = r.reason;
         // A map's precision beside its representation, and what the auto check found.
-        const ObjectSlot& slot = renderer.slot(i);
-        if (slot.representation && slot.representation->map) {
-            o.representation +=
-                slot.representation->map->options().halfPrecision ? " (half)" : " (float)";
-            if (renderer.statics().precisionMeasured(i))
-                o.reason += "; map precision " + renderer.statics().precisionCheck(i).reason;
-        }
+        const std::string precision = mapPrecisionName(renderer, i);
+        if (!precision.empty()) o.representation += " (" + precision + ")";
+        if (const auto check = renderer.statics().precisionCheck(i); check && !precision.empty())
+            o.reason += "; map precision " + check->reason;
         o.staticRuns = r.staticRuns;
         o.framesDrawn = r.framesDrawn;
         for (double s : o.staticSecondsPerFrame) o.staticSeconds += s;

@@ -71,6 +71,8 @@ CostProfile profileScene(const Scene& scene, const std::string& scenePath,
 // The representation of object `object` as reports name it: "none (never seen)",
 // "geometry" (a static part not worth storing), "facets", "shadermap" or "direct".
 std::string representationName(const MultiphaseRenderer& renderer, size_t object);
+// "half" or "float": the precision of the object's shader map; empty without a map.
+std::string mapPrecisionName(const MultiphaseRenderer& renderer, size_t object);
 
 // profile.md: the run, static against dynamic, the dynamic stages against the machine, per
 // object and per frame their costs.

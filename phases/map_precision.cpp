@@ -17,15 +17,6 @@
 namespace mpshade {
 namespace {
 
-// |a - b| relative to max(|a|, |b|, 1); two NaNs agree, a value that stops being finite
-// (or becomes so) is an infinite change.
-double relativeChange(float a, float b) {
-    if (std::isnan(a) && std::isnan(b)) return 0.0;
-    if (!std::isfinite(a) || !std::isfinite(b)) return a == b ? 0.0 : INFINITY;
-    const double d = std::fabs(double(a) - double(b));
-    return d / std::max({std::fabs(double(a)), std::fabs(double(b)), 1.0});
-}
-
 std::string describe(const MapPrecisionCheck& c, const MapPrecisionOptions& o) {
     char text[200];
     if (c.largestValue > o.maxValue)
@@ -86,10 +77,12 @@ MapPrecisionCheck checkHalfPrecision(const StaticPhase& statics, const Surface& 
     obj.dynamicKernel->run(uniforms, batch.in, n, batch.out, workspace, counters);
     for (int k = 0; k < 3; ++k)
         for (size_t i = 0; i < n; ++i) {
-            check.largestChange = std::max(
-                {check.largestChange,
-                 relativeChange(outputs[static_cast<size_t>(k) * n + i], batch.out.Ci[k][i]),
-                 relativeChange(outputs[static_cast<size_t>(3 + k) * n + i], batch.out.Oi[k][i])});
+            check.largestChange =
+                std::max({check.largestChange,
+                          relativeOutputDifference(outputs[static_cast<size_t>(k) * n + i],
+                                                   batch.out.Ci[k][i]),
+                          relativeOutputDifference(outputs[static_cast<size_t>(3 + k) * n + i],
+                                                   batch.out.Oi[k][i])});
         }
     check.half = check.largestValue <= options.maxValue && check.largestChange <= options.tolerance;
     check.reason = describe(check, options);

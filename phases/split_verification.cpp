@@ -27,19 +27,12 @@ struct Tally {
     size_t count = 0;
 
     void add(float a, float b, const SplitPoint& where) {
-        double diff;
-        if (std::isnan(a) && std::isnan(b))
-            diff = 0.0;
-        else if (!std::isfinite(a) || !std::isfinite(b))
-            diff = a == b ? 0.0 : INFINITY;
-        else
-            diff = std::fabs(double(a) - double(b));
-        const double relative = diff / std::max({std::fabs(double(a)), std::fabs(double(b)), 1.0});
+        const double diff = outputDifference(a, b), relative = relativeOutputDifference(a, b);
         if (count == 0 || diff > d.maxAbs) {
             d.maxAbs = diff;
             d.worst = where;
         }
-        d.maxRelative = std::max(d.maxRelative, std::isfinite(relative) ? relative : INFINITY);
+        d.maxRelative = std::max(d.maxRelative, relative);
         sumSquares += std::isfinite(diff) ? diff * diff : 0.0;
         ++count;
     }
@@ -63,6 +56,17 @@ std::vector<ChartPoint> spreadChartPoints(const Surface& surface, int budget) {
                 points.push_back(
                     {c, (i + 0.5f) / static_cast<float>(k), (j + 0.5f) / static_cast<float>(k)});
     return points;
+}
+
+double outputDifference(float a, float b) {
+    if (std::isnan(a) && std::isnan(b)) return 0.0;
+    if (!std::isfinite(a) || !std::isfinite(b)) return a == b ? 0.0 : INFINITY;
+    return std::fabs(double(a) - double(b));
+}
+
+double relativeOutputDifference(float a, float b) {
+    const double d = outputDifference(a, b);  // infinite: so is the relative difference
+    return std::isfinite(d) ? d / std::max({std::fabs(double(a)), std::fabs(double(b)), 1.0}) : d;
 }
 
 double SplitVerification::maxRelative() const {

@@ -49,6 +49,11 @@ struct SplitVerification {
 // past `budget` charts, every so many charts' centres.
 std::vector<ChartPoint> spreadChartPoints(const Surface& surface, int budget);
 
+// How far apart two outputs are: |a - b|, 0 for two NaNs, infinite where one is finite and
+// the other not (or two infinities differ); relative: over max(|a|, |b|, 1).
+double outputDifference(float a, float b);
+double relativeOutputDifference(float a, float b);
+
 // Verifies object `object` of the scene `statics` was made for (its shading as the
 // renderers factor it; `resources` the same scene's).
 SplitVerification verifySplit(const StaticPhase& statics, const SceneResources& resources,

@@ -500,14 +500,9 @@ bool StaticPhase::measuredHalf(size_t index, const ShadingUniforms& uniforms) co
     return check.half;
 }
 
-bool StaticPhase::precisionMeasured(size_t object) const {
+std::optional<MapPrecisionCheck> StaticPhase::precisionCheck(size_t object) const {
     std::lock_guard<std::mutex> lock(checksMutex_);
-    return checks_[object].has_value();
-}
-
-MapPrecisionCheck StaticPhase::precisionCheck(size_t object) const {
-    std::lock_guard<std::mutex> lock(checksMutex_);
-    return checks_[object].value_or(MapPrecisionCheck{});
+    return checks_[object];
 }
 
 // Everything a tile's texels depend on (tile_store.h): the static program and the uniform

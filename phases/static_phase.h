@@ -149,10 +149,9 @@ class StaticPhase {
               std::span<const ObjectRepresentation* const> representations, StaticCosts& costs,
               FillTiming* timing = nullptr, const StopSignal* stop = nullptr) const;
 
-    // The last precision check of object `object`'s map (map_precision.h): whether one ran
-    // (its precision auto, a map made) and what it found.
-    bool precisionMeasured(size_t object) const;
-    MapPrecisionCheck precisionCheck(size_t object) const;
+    // The last precision check of object `object`'s map (map_precision.h); none if none ran
+    // (its precision not auto, or no map made).
+    std::optional<MapPrecisionCheck> precisionCheck(size_t object) const;
 
   private:
     static DicingView dicingView(const ObjectState& state, const CameraState& camera);

@@ -116,8 +116,8 @@ TEST(MapPrecision, TheMapIsMadeAsCheckedAndTheVerdictIsKeptInTheStore) {
                           state.uniforms[0], nullptr, costs);
         ASSERT_TRUE(rep->map);
         EXPECT_TRUE(rep->map->options().halfPrecision) << run;
-        ASSERT_TRUE(statics.precisionMeasured(0));
-        const MapPrecisionCheck c = statics.precisionCheck(0);
+        ASSERT_TRUE(statics.precisionCheck(0).has_value());
+        const MapPrecisionCheck c = *statics.precisionCheck(0);
         EXPECT_TRUE(c.half);
         EXPECT_GT(c.largestChange, 0.0);
         EXPECT_EQ(c.reason.find("in the store") != std::string::npos, run == 1) << c.reason;
@@ -133,7 +133,7 @@ TEST(MapPrecision, TheMapIsMadeAsCheckedAndTheVerdictIsKeptInTheStore) {
                       state.uniforms[0], nullptr, costs);
     ASSERT_TRUE(rep->map);
     EXPECT_FALSE(rep->map->options().halfPrecision);
-    EXPECT_FALSE(statics.precisionMeasured(0));
+    EXPECT_FALSE(statics.precisionCheck(0).has_value());
 }
 
 }  // namespace
