@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "phases/sample_depth_test.h"
+#include "phases/small_facet_depth_test.h"
 #include "phases/work_deadline.h"
 
 namespace mpshade {
@@ -46,12 +47,6 @@ struct Chunk {
     RasterStats stats;
     int64_t longestEdge2 = 0;  // squared, in (1/256 pixel)^2
 };
-
-// The tie rule: a sample exactly on edge (dx, dy) is inside for this direction and not for
-// the reverse, so a shared edge's samples go to exactly one facet.
-inline bool ownsEdge(int64_t dx, int64_t dy) {
-    return dy > 0 || (dy == 0 && dx < 0);
-}
 
 inline int64_t signedArea(const ScreenTriangle& t) {
     return int64_t(t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) -
@@ -343,12 +338,17 @@ class TileRasterizer {
 
     void draw(const ScreenTriangle& tri, uint32_t object, uint32_t facet, bool opaque,
               const std::vector<uint8_t>& objectOpaque) {
-        FacetEdges su;
-        setUp(tri, ox_, oy_, su);
         const int32_t minX = std::min({tri.x[0], tri.x[1], tri.x[2]}),
                       maxX = std::max({tri.x[0], tri.x[1], tri.x[2]});
         const int32_t minY = std::min({tri.y[0], tri.y[1], tri.y[2]}),
                       maxY = std::max({tri.y[0], tri.y[1], tri.y[2]});
+        const int px0 = minX >> kSub, px1 = maxX >> kSub, py0 = minY >> kSub, py1 = maxY >> kSub;
+        if (px1 - px0 < kSmallFacetPixels && py1 - py0 < kSmallFacetPixels) {
+            drawSmall(tri, px0, py0, px1, py1, object, facet, opaque, objectOpaque);
+            return;
+        }
+        FacetEdges su;
+        setUp(tri, ox_, oy_, su);
         // The edges at the tile's corners: all inside, the tile is covered whole; one wholly
         // outside, nothing to do. A facet whose box leaves out a corner of the tile covers
         // neither, and its box within the tile is what the samples are tested in anyway: the
@@ -390,23 +390,69 @@ class TileRasterizer {
             s_.fragments += depthTestRows(rows, {&su, ox_, oy_, !whole, object, facet});
             return;
         }
+        drawLayers(bx0, by0, bx1, by1, object, facet, opaque, objectOpaque,
+                   [&](int32_t x, int32_t y, float& z) {
+                       const double lx = x - ox_, ly = y - oy_;
+                       bool in = true;
+                       for (int k = 0; k < 3; ++k)
+                           in = in && su.c[k] + su.a[k] * lx + su.b[k] * ly > 0.0;
+                       z = static_cast<float>(su.zc + su.zx * lx + su.zy * ly);
+                       return in;
+                   });
+    }
+
+    // Into the tile's k-buffer: the samples of pixels [bx0, bx1] x [by0, by1] of the tile
+    // that inside(x, y, z) says are in the facet (setting z, their 1 / depth).
+    template <typename Inside>
+    void drawLayers(int bx0, int by0, int bx1, int by1, uint32_t object, uint32_t facet,
+                    bool opaque, const std::vector<uint8_t>& objectOpaque, Inside&& inside) {
+        const size_t spp = static_cast<size_t>(grid_.spp);
         for (int py = by0; py <= by1; ++py) {
             const size_t g = samples_.index(bx0, py, 0);
             const size_t n = static_cast<size_t>(bx1 - bx0 + 1) * spp;
             const size_t l = static_cast<size_t>(py - ty0_) * rowSamples_ +
                              static_cast<size_t>(bx0 - tx0_) * spp;
             for (size_t i = 0; i < n; ++i) {
-                const double lx = fx_[g + i] - ox_, ly = fy_[g + i] - oy_;
-                bool in = true;
-                for (int k = 0; k < 3; ++k) in = in && su.c[k] + su.a[k] * lx + su.b[k] * ly > 0.0;
-                if (!in) continue;
-                const float z = static_cast<float>(su.zc + su.zx * lx + su.zy * ly);
-                if (!(z > grid_.farInv)) continue;
+                float z;
+                if (!inside(fx_[g + i], fy_[g + i], z) || !(z > grid_.farInv)) continue;
                 ++s_.fragments;
                 insertLayer(scratch_, l + i, grid_.layers, z, object, facet, opaque, objectOpaque,
                             s_);
             }
         }
+    }
+
+    // A facet whose box of pixels is at most kSmallFacetPixels on a side, in float lanes
+    // relative to the box's corner (small_facet_depth_test.h). Its box is smaller than a
+    // tile, so the corner tests for covering a tile whole are skipped.
+    void drawSmall(const ScreenTriangle& tri, int px0, int py0, int px1, int py1, uint32_t object,
+                   uint32_t facet, bool opaque, const std::vector<uint8_t>& objectOpaque) {
+        const int32_t ox = px0 * (1 << kSub), oy = py0 * (1 << kSub);
+        const SmallFacetEdges edges = smallFacetEdges(tri.x, tri.y, tri.invDepth, ox, oy);
+        const int bx0 = std::max(tx0_, px0), by0 = std::max(ty0_, py0);
+        const int bx1 = std::min(tx1_, px1), by1 = std::min(ty1_, py1);
+        if (bx0 > bx1 || by0 > by1) return;
+        ++s_.facetsBinned;
+        if (!direct_) {
+            drawLayers(bx0, by0, bx1, by1, object, facet, opaque, objectOpaque,
+                       [&](int32_t x, int32_t y, float& z) {
+                           const float lx = static_cast<float>(x - ox),
+                                       ly = static_cast<float>(y - oy);
+                           z = smallFacetDepth(edges, lx, ly);
+                           return smallFacetInside(edges, lx, ly);
+                       });
+            return;
+        }
+        const size_t g = samples_.index(bx0, by0, 0);
+        const SampleRows rows{fx_ + g,
+                              fy_ + g,
+                              &out_.invDepth[g],
+                              &out_.object[g],
+                              &out_.facet[g],
+                              static_cast<size_t>(by1 - by0 + 1),
+                              static_cast<size_t>(bx1 - bx0 + 1) * grid_.spp,
+                              static_cast<size_t>(grid_.width) * grid_.spp};
+        s_.fragments += smallFacetDepthTest(rows, edges, object, facet);
     }
 
     // Out to the frame's buffer, row by row: the sample counts (one layer), or the k-buffer.

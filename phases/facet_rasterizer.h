@@ -14,7 +14,9 @@
 // in fixed chunks (deterministic order). Within a tile, a facet's edge functions and
 // depth are evaluated for a row of samples at a time in double lanes (exact for these
 // integers, and vectorized: AVX2 where the CPU has it, chosen at run time, SSE2
-// otherwise); a tile a facet covers whole skips the edge tests. Each sample keeps its
+// otherwise); a tile a facet covers whole skips the edge tests. A facet whose box is at most
+// kSmallFacetPixels on a side (most of them) is tested in float lanes instead, eight samples a
+// vector, exact there (small_facet_depth_test.h). Each sample keeps its
 // nearest `layers` surfaces in depth order (a k-buffer) cut short behind the first opaque
 // one; with every object opaque, one layer and a plain depth test.
 #pragma once

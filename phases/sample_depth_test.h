@@ -15,6 +15,13 @@
 
 namespace mpshade {
 
+// The tie rule: a sample exactly on edge (dx, dy) is inside for this direction and not for
+// the reverse, so a shared edge's samples go to exactly one facet (folded into an edge
+// function's constant as +1 where the facet owns the edge).
+inline bool ownsEdge(int64_t dx, int64_t dy) {
+    return dy > 0 || (dy == 0 && dx < 0);
+}
+
 // A facet's edge functions and depth relative to a tile's origin, in 1/256 pixels:
 // e_i(lx, ly) = c_i + a_i lx + b_i ly, inside when every e_i > 0 (the watertight tie rule is
 // folded into c_i); 1 / depth = zc + zx lx + zy ly. Every edge value is an exact integer
