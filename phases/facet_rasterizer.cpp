@@ -63,33 +63,6 @@ inline ScreenTriangle screenTriangle(const WarpedVertices& w, const uint32_t* p)
     return t;
 }
 
-// A facet's edge functions and depth relative to a tile's origin (ox, oy), in 1/256 pixels.
-void setUp(const ScreenTriangle& tri, int64_t ox, int64_t oy, FacetEdges& s) {
-    int64_t x[3] = {tri.x[0], tri.x[1], tri.x[2]}, y[3] = {tri.y[0], tri.y[1], tri.y[2]};
-    float w[3] = {tri.invDepth[0], tri.invDepth[1], tri.invDepth[2]};
-    int64_t area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
-    if (area < 0) {
-        std::swap(x[1], x[2]);
-        std::swap(y[1], y[2]);
-        std::swap(w[1], w[2]);
-        area = -area;
-    }
-    // Edge i runs from vertex i + 1 to i + 2, opposite vertex i; e_i is +area at vertex i.
-    const double invArea = 1.0 / static_cast<double>(area);
-    s.zc = s.zx = s.zy = 0.0;
-    for (int i = 0; i < 3; ++i) {
-        const int j = (i + 1) % 3, k = (i + 2) % 3;
-        const int64_t dx = x[k] - x[j], dy = y[k] - y[j];
-        const int64_t c = dx * (oy - y[j]) - dy * (ox - x[j]);
-        s.c[i] = static_cast<double>(c + (ownsEdge(dx, dy) ? 1 : 0));
-        s.a[i] = static_cast<double>(-dy);
-        s.b[i] = static_cast<double>(dx);
-        s.zc += w[i] * static_cast<double>(c) * invArea;
-        s.zx += w[i] * static_cast<double>(-dy) * invArea;
-        s.zy += w[i] * static_cast<double>(dx) * invArea;
-    }
-}
-
 // Per thread: one tile's samples, `layers` slots each, local while the tile is drawn.
 struct TileScratch {
     std::vector<float> inv;
@@ -348,7 +321,7 @@ class TileRasterizer {
             return;
         }
         FacetEdges su;
-        setUp(tri, ox_, oy_, su);
+        setUpFacetEdges<int64_t>(tri.x, tri.y, tri.invDepth, ox_, oy_, su);
         // The edges at the tile's corners: all inside, the tile is covered whole; one wholly
         // outside, nothing to do. A facet whose box leaves out a corner of the tile covers
         // neither, and its box within the tile is what the samples are tested in anyway: the
@@ -376,18 +349,9 @@ class TileRasterizer {
         s_.tilesCoveredWhole += whole;
         const int bx0 = std::max(tx0_, minX >> kSub), by0 = std::max(ty0_, minY >> kSub);
         const int bx1 = std::min(tx1_, maxX >> kSub), by1 = std::min(ty1_, maxY >> kSub);
-        const int spp = grid_.spp;
         if (direct_) {
-            const size_t g = samples_.index(bx0, by0, 0);
-            const SampleRows rows{fx_ + g,
-                                  fy_ + g,
-                                  &out_.invDepth[g],
-                                  &out_.object[g],
-                                  &out_.facet[g],
-                                  static_cast<size_t>(by1 - by0 + 1),
-                                  static_cast<size_t>(bx1 - bx0 + 1) * spp,
-                                  static_cast<size_t>(grid_.width) * spp};
-            s_.fragments += depthTestRows(rows, {&su, ox_, oy_, !whole, object, facet});
+            s_.fragments += depthTestRows(frameRows(bx0, by0, bx1, by1),
+                                          {&su, ox_, oy_, !whole, object, facet});
             return;
         }
         drawLayers(bx0, by0, bx1, by1, object, facet, opaque, objectOpaque,
@@ -443,16 +407,21 @@ class TileRasterizer {
                        });
             return;
         }
+        s_.fragments += smallFacetDepthTest(frameRows(bx0, by0, bx1, by1), edges, object, facet);
+    }
+
+    // The frame buffer's samples of pixels [bx0, bx1] x [by0, by1] (one layer), row by row.
+    SampleRows frameRows(int bx0, int by0, int bx1, int by1) const {
         const size_t g = samples_.index(bx0, by0, 0);
-        const SampleRows rows{fx_ + g,
-                              fy_ + g,
-                              &out_.invDepth[g],
-                              &out_.object[g],
-                              &out_.facet[g],
-                              static_cast<size_t>(by1 - by0 + 1),
-                              static_cast<size_t>(bx1 - bx0 + 1) * grid_.spp,
-                              static_cast<size_t>(grid_.width) * grid_.spp};
-        s_.fragments += smallFacetDepthTest(rows, edges, object, facet);
+        const size_t spp = static_cast<size_t>(grid_.spp);
+        return {fx_ + g,
+                fy_ + g,
+                &out_.invDepth[g],
+                &out_.object[g],
+                &out_.facet[g],
+                static_cast<size_t>(by1 - by0 + 1),
+                static_cast<size_t>(bx1 - bx0 + 1) * spp,
+                static_cast<size_t>(grid_.width) * spp};
     }
 
     // Out to the frame's buffer, row by row: the sample counts (one layer), or the k-buffer.

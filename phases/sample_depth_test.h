@@ -12,6 +12,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 
 namespace mpshade {
 
@@ -30,6 +32,45 @@ struct FacetEdges {
     double c[3], a[3], b[3];
     double zc, zx, zy;
 };
+
+// A facet's edge functions (the tie rule folded in) and depth plane relative to (ox, oy), from
+// its corners (xs[i], ys[i]) in 1/256 pixels and their 1 / depth ws[i]: the edges in Int,
+// which must hold the corners' offsets from the origin and their products exactly (int64
+// anywhere in the guard band; int32 within a small facet's box, small_facet_depth_test.h),
+// the plane in double, both stored in Edges' own type (FacetEdges: double; SmallFacetEdges:
+// float). Edge i runs from corner i + 1 to i + 2, opposite corner i; it is +area there.
+// Inlined into each caller, as the two setups were before they shared this (out of line, the
+// small facets' copy was a call of its own per facet-tile pair).
+template <typename Int, typename Edges>
+[[gnu::always_inline]] inline void setUpFacetEdges(const int32_t xs[3], const int32_t ys[3],
+                                                   const float ws[3], Int ox, Int oy, Edges& s) {
+    using Value = std::remove_reference_t<decltype(s.c[0])>;
+    using Plane = std::remove_reference_t<decltype(s.zc)>;
+    Int x[3], y[3];
+    float w[3];
+    for (int i = 0; i < 3; ++i) x[i] = Int{xs[i]} - ox, y[i] = Int{ys[i]} - oy, w[i] = ws[i];
+    Int area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
+    if (area < 0) {
+        std::swap(x[1], x[2]);
+        std::swap(y[1], y[2]);
+        std::swap(w[1], w[2]);
+        area = -area;
+    }
+    const double invArea = 1.0 / static_cast<double>(area);
+    double zc = 0.0, zx = 0.0, zy = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3, k = (i + 2) % 3;
+        const Int dx = x[k] - x[j], dy = y[k] - y[j];
+        const Int c = dy * x[j] - dx * y[j];
+        s.c[i] = static_cast<Value>(c + (ownsEdge(dx, dy) ? 1 : 0));
+        s.a[i] = static_cast<Value>(-dy);
+        s.b[i] = static_cast<Value>(dx);
+        zc += w[i] * static_cast<double>(c) * invArea;
+        zx += w[i] * static_cast<double>(-dy) * invArea;
+        zy += w[i] * static_cast<double>(dx) * invArea;
+    }
+    s.zc = static_cast<Plane>(zc), s.zx = static_cast<Plane>(zx), s.zy = static_cast<Plane>(zy);
+}
 
 // `rows` runs of `n` samples, `stride` apart in every array: sample positions (fx, fy, in
 // 1/256 pixels) and the frame's nearest surface so far per sample (1 / depth, object, facet),

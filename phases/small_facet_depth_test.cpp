@@ -1,43 +1,17 @@
 #include "phases/small_facet_depth_test.h"
 
-#include <utility>
-
 #if defined(__x86_64__)
 #include <immintrin.h>
 #endif
 
 namespace mpshade {
 
-// The edge functions in int32 (exact: below 2^24, see the header), the depth plane in double
-// as the large facets' setup makes it, then both in float. A tenth of the instructions of
-// rasterizing facets a pixel across had gone to that setup's 64-bit edges.
-SmallFacetEdges smallFacetEdges(const int32_t xs[3], const int32_t ys[3], const float ws[3],
+// The edges in int32 (exact within the box: see the header). A tenth of the instructions of
+// rasterizing facets a pixel across had gone to the large facets' 64-bit edges.
+SmallFacetEdges smallFacetEdges(const int32_t x[3], const int32_t y[3], const float w[3],
                                 int32_t ox, int32_t oy) {
-    int32_t x[3], y[3];
-    float w[3];
-    for (int i = 0; i < 3; ++i) x[i] = xs[i] - ox, y[i] = ys[i] - oy, w[i] = ws[i];
-    int32_t area = (x[1] - x[0]) * (y[2] - y[0]) - (y[1] - y[0]) * (x[2] - x[0]);
-    if (area < 0) {
-        std::swap(x[1], x[2]);
-        std::swap(y[1], y[2]);
-        std::swap(w[1], w[2]);
-        area = -area;
-    }
-    const double invArea = 1.0 / static_cast<double>(area);
-    double zc = 0.0, zx = 0.0, zy = 0.0;
     SmallFacetEdges s;
-    for (int i = 0; i < 3; ++i) {
-        const int j = (i + 1) % 3, k = (i + 2) % 3;
-        const int32_t dx = x[k] - x[j], dy = y[k] - y[j];
-        const int32_t c = dy * x[j] - dx * y[j];
-        s.c[i] = static_cast<float>(c + (ownsEdge(dx, dy) ? 1 : 0));
-        s.a[i] = static_cast<float>(-dy);
-        s.b[i] = static_cast<float>(dx);
-        zc += w[i] * static_cast<double>(c) * invArea;
-        zx += w[i] * static_cast<double>(-dy) * invArea;
-        zy += w[i] * static_cast<double>(dx) * invArea;
-    }
-    s.zc = static_cast<float>(zc), s.zx = static_cast<float>(zx), s.zy = static_cast<float>(zy);
+    setUpFacetEdges<int32_t>(x, y, w, ox, oy, s);
     s.ox = ox, s.oy = oy;
     return s;
 }
